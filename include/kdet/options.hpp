@@ -1,0 +1,65 @@
+#pragma once
+/// @file options.hpp
+/// @brief Enumerations and options that select how a Detector works.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace kdet {
+
+/// @brief Where the pipeline runs.
+enum class Backend { cpu, cuda };
+
+/// @brief How candidate pairs are found. All methods report the same pairs.
+enum class Method {
+    kdet,              ///< hierarchical grid, candidates, sort+unique, narrow phase: all unique pairs
+    kdet_no_pairs,     ///< the thesis's old method: per-tet colliding flags only, no pair list
+    brute_force_loop,  ///< every tet against every later tet, one work item per tet
+    brute_force_pairs, ///< one work item per tet pair
+};
+
+/// @brief The tetrahedron-tetrahedron test run on each unique candidate pair.
+enum class NarrowPhase {
+    sat,          ///< separating axis test over the 44 axes (default)
+    sat_no_edges, ///< face normals only: conservative, may report extra pairs
+    sat_mtv,      ///< 44-axis SAT that also returns depth and direction
+    gjk,          ///< GJK with a signed-volumes distance sub-algorithm
+    fast,         ///< Ganovelli-Ponchio-Rocchini face-plane test
+};
+
+/// @brief Hash function of the hierarchical grid.
+enum class HashFunction { djb2, fnv1a, simple, morton };
+
+/// @brief Name of an enumerator as used on the command line.
+const char* to_string(Backend value);
+const char* to_string(Method value);
+const char* to_string(NarrowPhase value);
+const char* to_string(HashFunction value);
+
+/// @brief Parses a command-line name; returns false when the name is unknown.
+bool parse(const std::string& name, Backend& out);
+bool parse(const std::string& name, Method& out);
+bool parse(const std::string& name, NarrowPhase& out);
+bool parse(const std::string& name, HashFunction& out);
+
+/// @brief Settings of a Detector; all have working defaults.
+struct DetectorOptions {
+    Backend backend = Backend::cpu;
+    Method method = Method::kdet;
+    NarrowPhase narrow_phase = NarrowPhase::sat;
+    HashFunction hash = HashFunction::djb2;
+    /// CPU threads; 0 leaves OpenMP's default.
+    int threads = 0;
+    /// CUDA block size (threads per block).
+    int block_size = 128;
+    /// Tet ids per grid bucket before an overflow bucket is chained.
+    std::uint32_t bucket_capacity = 32;
+    /// Initial capacity of the candidate buffer in pairs; 0 sizes it from the tet count.
+    /// It grows (and the stage reruns) whenever a frame needs more, so any value is safe.
+    std::size_t initial_candidate_capacity = 0;
+    /// Return depth and direction per colliding pair (computed with the 44-axis SAT).
+    bool contacts = false;
+};
+
+} // namespace kdet

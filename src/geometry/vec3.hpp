@@ -1,0 +1,48 @@
+#pragma once
+/// @file vec3.hpp
+/// @brief A minimal float 3-vector and box used by all per-element code.
+
+#include <kdet/config.hpp>
+
+#include <cmath>
+
+namespace kdet {
+
+struct vec3 {
+    float x, y, z;
+};
+
+KDET_HD inline vec3 make_vec3(float x, float y, float z) { return vec3{x, y, z}; }
+KDET_HD inline vec3 operator+(vec3 a, vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+KDET_HD inline vec3 operator-(vec3 a, vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+KDET_HD inline vec3 operator-(vec3 a) { return {-a.x, -a.y, -a.z}; }
+KDET_HD inline vec3 operator*(vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+KDET_HD inline vec3 operator*(float s, vec3 a) { return {a.x * s, a.y * s, a.z * s}; }
+KDET_HD inline vec3 operator/(vec3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
+KDET_HD inline float dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+KDET_HD inline vec3 cross(vec3 a, vec3 b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+KDET_HD inline float length_squared(vec3 a) { return dot(a, a); }
+KDET_HD inline float min_f(float a, float b) { return a < b ? a : b; }
+KDET_HD inline float max_f(float a, float b) { return a > b ? a : b; }
+KDET_HD inline vec3 min_v(vec3 a, vec3 b) { return {min_f(a.x, b.x), min_f(a.y, b.y), min_f(a.z, b.z)}; }
+KDET_HD inline vec3 max_v(vec3 a, vec3 b) { return {max_f(a.x, b.x), max_f(a.y, b.y), max_f(a.z, b.z)}; }
+KDET_HD inline float component(vec3 a, int axis) { return axis == 0 ? a.x : (axis == 1 ? a.y : a.z); }
+
+/// @brief Axis-aligned box, closed on both ends.
+struct Aabb {
+    vec3 lo, hi;
+};
+
+KDET_HD inline bool boxes_overlap(const Aabb& a, const Aabb& b) {
+    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y &&
+           a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
+}
+
+KDET_HD inline Aabb tet_box(const vec3 v[4]) {
+    Aabb b{min_v(min_v(v[0], v[1]), min_v(v[2], v[3])), max_v(max_v(v[0], v[1]), max_v(v[2], v[3]))};
+    return b;
+}
+
+} // namespace kdet
