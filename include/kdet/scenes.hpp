@@ -1,0 +1,91 @@
+#pragma once
+/// @file scenes.hpp
+/// @brief Meshes and moving scenes that the code builds itself, so that kdet runs without data files.
+
+#include <kdet/mesh.hpp>
+
+#include <cstddef>
+#include <vector>
+
+namespace kdet {
+
+/// @brief A full box of nx*ny*nz cubes of edge `cell_size`, corner at the origin, each split into 6 tets.
+///
+/// Every cube is split along its main diagonal (Kuhn/Freudenthal split), which is conforming between
+/// neighbouring cubes; all tets are positively oriented, i.e. dot(b-a, cross(c-a, d-a)) > 0.
+/// Vertex (i, j, k) of the grid sits at (i, j, k) * cell_size.
+/// Throws kdet::Error for a non-positive count or cell size, or more vertices than 32-bit indices hold.
+TetMesh make_box_mesh(int nx, int ny, int nz, double cell_size);
+
+/// @brief A solid torus around the z axis, centred at the origin, as a conforming tet mesh.
+///
+/// The region (sqrt(x^2+y^2) - major_radius)^2 + z^2 < minor_radius^2 is sampled on a regular grid:
+/// cubes whose centre is inside are kept and split as in make_box_mesh; unused vertices are removed.
+/// The grid is shifted slightly off the torus's symmetry planes and its cell size is chosen so that the
+/// tet count is within 10% of `target_tets` (within 1% for large targets); below a few hundred tets the
+/// mesh is too coarse to look like a torus, but it is still valid.
+/// Throws kdet::Error unless 0 < minor_radius < major_radius and target_tets > 0.
+TetMesh make_torus_mesh(double major_radius, double minor_radius, std::size_t target_tets);
+
+/// @brief Size of a ProceduralScene.
+struct ProceduralSceneOptions {
+    /// Tets of both objects together (half each, within about 10%); 100 to 20'000'000.
+    std::size_t total_tets = 100000;
+    /// Number of frames of the motion; at least 1.
+    int frames = 120;
+};
+
+/// @brief Two deforming tori that approach, pass through each other and separate again.
+///
+/// Both objects share one rest mesh: a torus around the local z axis with major radius 1 and minor
+/// radius 0.4. Object 0 lies flat (ring in the xy plane), object 1 stands upright (ring in the xz plane),
+/// so their tubes cross like chain links. They start on the x axis with disjoint bounding boxes, move
+/// towards each other until their centres coincide at the middle of the sequence, where the tubes cross
+/// each other at two places, and move apart again along the same path, ending as they started.
+/// The frame of deepest interpenetration is (num_frames() - 1) / 2 (both middle frames for an even count).
+///
+/// On top of that rigid motion every vertex moves every frame: each torus spins about its own axis,
+/// twists (a rotation about its axis that grows with the height above the ring plane) and wobbles
+/// (its centre line waves along the axis by 5% of the minor radius). Both deformations preserve volume
+/// and are mild enough that no tet inverts.
+class ProceduralScene {
+public:
+    /// @brief Builds the rest mesh. Throws kdet::Error for total_tets outside [100, 20'000'000] or frames < 1.
+    explicit ProceduralScene(const ProceduralSceneOptions& options = {});
+
+    /// @brief Number of objects: 2.
+    std::size_t num_objects() const;
+    /// @brief Number of frames of the motion.
+    int num_frames() const;
+    /// @brief The undeformed torus of `object` in its local frame (the same mesh for both objects).
+    /// Throws kdet::Error for an object index out of range.
+    const TetMesh& rest_mesh(std::size_t object) const;
+
+    /// @brief Vertex positions of `object` at `frame` (0-based) as x y z floats; `out` is resized.
+    /// Parallel with OpenMP; deterministic (bit-identical for any thread count).
+    /// Throws kdet::Error for an object or frame out of range.
+    void positions(std::size_t object, int frame, std::vector<float>& out) const;
+    /// @brief The same motion in double (for writing files); the float overload rounds these values.
+    void positions(std::size_t object, int frame, std::vector<double>& out) const;
+
+private:
+    template <typename Real>
+    void write_positions(std::size_t object, int frame, std::vector<Real>& out) const;
+
+    ProceduralSceneOptions options_;
+    TetMesh torus_;
+    double start_separation_ = 0.0; ///< distance of the two centres at frame 0
+};
+
+/// @brief Bends a straight bar so that, for angles above 2*pi, its two ends pass through each other.
+///
+/// `bar` is a straight bar along x (for example make_box_mesh(20, 2, 2, h)). The bar is wrapped around
+/// an axis parallel to y, above the bar, keeping its centre line's length: the centre line becomes a
+/// circular arc of `angle` radians (negative bends the other way). At |angle| = 2*pi the end faces meet;
+/// beyond it the end regions overlap, which gives a mesh with many self-collision pairs.
+/// `out_positions` (x y z per vertex) is resized; the tets of `bar` apply unchanged.
+/// Throws kdet::Error for an empty or zero-length bar, or when the bar is thicker (along z) than the
+/// bend radius allows (tets would turn inside out).
+void fold_bar(const TetMesh& bar, double angle, std::vector<double>& out_positions);
+
+} // namespace kdet
