@@ -1,0 +1,77 @@
+#pragma once
+/// @file tet_intersect.hpp
+/// @brief The tetrahedron-tetrahedron tests of the narrow phase, callable from host and device code.
+///
+/// Common contract of every test:
+/// - closed sets: tets that only touch (a shared vertex, edge or face, a vertex on a face) intersect;
+/// - a pure, deterministic function of the 8 float points (the pipeline passes the lower id first);
+/// - all tolerances are relative to the longest edge of the pair, never absolute: each test moves the
+///   pair to a frame with origin at a[0] and longest edge 1;
+/// - a separation is reported only when proven by a gap above 32 float epsilons (relative), so an
+///   intersecting pair is never missed; pairs closer than that count as intersecting;
+/// - no exceptions, no allocation, no static state.
+
+#include <kdet/options.hpp>
+
+#include "geometry/gjk.hpp"
+#include "geometry/gpr.hpp"
+#include "geometry/sat.hpp"
+
+namespace kdet {
+
+/// @brief Separating axis test over the 44 axes (4 + 4 face normals, 36 edge cross products).
+/// Edge pairs within sqrt(eps) of parallel are skipped (they add no usable axis); the default test.
+KDET_HD inline bool tets_intersect_sat(const vec3 a[4], const vec3 b[4]) {
+    return narrow::sat_intersect(a, b, true);
+}
+
+/// @brief Face normals only (8 axes). Conservative: never misses an intersecting pair, but may report
+/// pairs that only an edge-edge axis separates.
+KDET_HD inline bool tets_intersect_sat_no_edges(const vec3 a[4], const vec3 b[4]) {
+    return narrow::sat_intersect(a, b, false);
+}
+
+/// @brief 44-axis SAT that also returns the minimum translation vector (MTV).
+///
+/// Convention: translating the SECOND tet b by depth * direction separates the pair (up to touching).
+/// direction is a unit vector along the axis of least overlap, oriented from the projections (b moves
+/// the shorter way out), never from centroids; depth >= 0 is that overlap in input units, 0 for
+/// touching pairs. Face axes win near-ties (within the tolerance) over edge axes, so the direction
+/// is stable under small motions. depth and direction are written only when the function returns
+/// true; for degenerate pairs with no usable axis (parallel segments, points) they are 0 and (0,0,0).
+KDET_HD inline bool tets_intersect_sat_mtv(const vec3 a[4], const vec3 b[4], float& depth, vec3& direction) {
+    return narrow::sat_mtv_intersect(a, b, depth, direction);
+}
+
+/// @brief GJK on the Minkowski difference with the signed-volumes distance sub-algorithm (Montanari
+/// et al. 2017), in the unit-size frame, with capped iterations; a separation is certified by the
+/// projection gap along the final search direction.
+KDET_HD inline bool tets_intersect_gjk(const vec3 a[4], const vec3 b[4]) { return narrow::gjk_intersect(a, b); }
+
+/// @brief Face-plane test in the style of Ganovelli, Ponchio and Rocchini (2002): the 16 + 16
+/// vertex-to-face-plane distances decide the face axes, and the edge axes are decided from the same
+/// distances, two faces at a time. Each face normal is oriented against the opposite vertex, so the
+/// vertex order does not matter. Rare pairs that it cannot decide within the tolerance go to the SAT.
+KDET_HD inline bool tets_intersect_fast(const vec3 a[4], const vec3 b[4]) { return narrow::gpr_intersect(a, b); }
+
+/// @brief Runs the test selected by `test`.
+KDET_HD inline bool tets_intersect(NarrowPhase test, const vec3 a[4], const vec3 b[4]) {
+    switch (test) {
+    case NarrowPhase::sat_no_edges:
+        return tets_intersect_sat_no_edges(a, b);
+    case NarrowPhase::sat_mtv: {
+        float depth;
+        vec3 direction;
+        return tets_intersect_sat_mtv(a, b, depth, direction);
+    }
+    case NarrowPhase::gjk:
+        return tets_intersect_gjk(a, b);
+    case NarrowPhase::fast:
+        return tets_intersect_fast(a, b);
+    case NarrowPhase::sat:
+        break;
+    }
+    return tets_intersect_sat(a, b);
+}
+
+} // namespace kdet

@@ -1,0 +1,119 @@
+#pragma once
+/// @file tet_pair.hpp
+/// @brief Pieces shared by the tetrahedron-tetrahedron tests: the pair moved to a local frame of unit
+/// size, the relative tolerances, face normals, edge cross products and projections onto an axis.
+///
+/// Every test first translates both tets by the first tet's vertex 0 and divides by the longest edge
+/// of the pair. Then all lengths are about 1 wherever the tets can touch, and one set of tolerances
+/// fits tets of any size and position.
+
+#include <cmath>
+
+#include "geometry/vec3.hpp"
+
+namespace kdet::narrow {
+
+/// @brief Machine epsilon of float (FLT_EPSILON).
+constexpr float k_float_eps = 1.1920929e-7f;
+
+/// @brief Two edges (or the two edges of a face) whose angle has a sine below sqrt(eps) give no
+/// usable axis: their cross product is mostly rounding. Skipping them is safe, since exactly parallel
+/// edges add no face to the Minkowski difference.
+constexpr float k_parallel_sine = 3.4526698e-4f;
+
+/// @brief A gap along an axis proves separation only above this, in units of the longest edge.
+/// While the tets intersect, every point lies within 2 of the origin, so rounding of the frame change
+/// and of the projections moves a gap by at most about 10 eps; 32 eps keeps a margin of 3.
+constexpr float k_gap_tolerance = 32.0f * k_float_eps;
+
+/// @brief A value larger than any overlap in the unit frame.
+constexpr float k_huge = 3.0e38f;
+
+/// @brief Both tets in the local frame: origin at a[0], longest edge of the pair 1.
+struct LocalPair {
+    vec3 a[4];
+    vec3 b[4];
+    vec3 edge_a[6]; ///< edges in the order (0,1) (0,2) (0,3) (1,2) (1,3) (2,3)
+    vec3 edge_b[6];
+    float length2_a[6]; ///< squared edge lengths in the local frame
+    float length2_b[6];
+    float scale; ///< longest edge in input units: multiply local lengths by it to get input lengths
+};
+
+/// @brief First and second vertex of edge k (0..5) of a tet, in the order of LocalPair.
+KDET_HD inline int edge_first(int k) { return k < 3 ? 0 : (k < 5 ? 1 : 2); }
+KDET_HD inline int edge_second(int k) { return k < 3 ? k + 1 : (k < 5 ? k - 1 : 3); }
+
+/// @brief Fills p with the pair in the local frame. Returns false when every edge of both tets has
+/// zero length (two points), where no frame of unit size exists.
+KDET_HD inline bool make_local_pair(const vec3 a[4], const vec3 b[4], LocalPair& p) {
+    const vec3 origin = a[0];
+    for (int i = 0; i < 4; ++i) {
+        p.a[i] = a[i] - origin;
+        p.b[i] = b[i] - origin;
+    }
+    float longest2 = 0.0f;
+    for (int k = 0; k < 6; ++k) {
+        p.edge_a[k] = p.a[edge_second(k)] - p.a[edge_first(k)];
+        p.edge_b[k] = p.b[edge_second(k)] - p.b[edge_first(k)];
+        longest2 = max_f(longest2, max_f(length_squared(p.edge_a[k]), length_squared(p.edge_b[k])));
+    }
+    if (!(longest2 > 0.0f)) return false;
+    p.scale = sqrtf(longest2);
+    const float inverse = 1.0f / p.scale;
+    for (int i = 0; i < 4; ++i) {
+        p.a[i] = p.a[i] * inverse;
+        p.b[i] = p.b[i] * inverse;
+    }
+    for (int k = 0; k < 6; ++k) {
+        p.edge_a[k] = p.edge_a[k] * inverse;
+        p.edge_b[k] = p.edge_b[k] * inverse;
+        p.length2_a[k] = length_squared(p.edge_a[k]);
+        p.length2_b[k] = length_squared(p.edge_b[k]);
+    }
+    return true;
+}
+
+/// @brief The answer for two tets that are single points: closed sets meet only if the points do.
+KDET_HD inline bool points_coincide(vec3 a, vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+/// @brief Unit vector along cross(e, f), or false when the sine of their angle is below
+/// k_parallel_sine (this includes zero-length edges). e_length2 and f_length2 are |e|^2 and |f|^2.
+KDET_HD inline bool unit_cross(vec3 e, float e_length2, vec3 f, float f_length2, vec3& n) {
+    const vec3 c = cross(e, f);
+    const float c_length2 = length_squared(c);
+    if (c_length2 <= k_parallel_sine * k_parallel_sine * e_length2 * f_length2) return false;
+    n = c * (1.0f / sqrtf(c_length2));
+    return true;
+}
+
+/// @brief Unit normal of face k (the face opposite vertex k) of tet v, either orientation, or false
+/// for a degenerate face. The cross product uses the two edges at the vertex opposite the longest
+/// edge: their angle is the largest of the triangle, which keeps the rounding smallest.
+KDET_HD inline bool unit_face_normal(const vec3 v[4], int k, vec3& n) {
+    const vec3 p0 = v[(k + 1) & 3], p1 = v[(k + 2) & 3], p2 = v[(k + 3) & 3];
+    const vec3 e01 = p1 - p0, e02 = p2 - p0, e12 = p2 - p1;
+    const float l01 = length_squared(e01), l02 = length_squared(e02), l12 = length_squared(e12);
+    if (l12 >= l01 && l12 >= l02) return unit_cross(e01, l01, e02, l02, n);
+    if (l02 >= l01) return unit_cross(e01, l01, e12, l12, n);
+    return unit_cross(e02, l02, e12, l12, n);
+}
+
+/// @brief Closed interval of the projections of a tet's vertices onto an axis.
+struct Interval {
+    float lo, hi;
+};
+
+KDET_HD inline Interval project(const vec3 v[4], vec3 axis) {
+    const float d0 = dot(v[0], axis), d1 = dot(v[1], axis), d2 = dot(v[2], axis), d3 = dot(v[3], axis);
+    return Interval{min_f(min_f(d0, d1), min_f(d2, d3)), max_f(max_f(d0, d1), max_f(d2, d3))};
+}
+
+/// @brief Largest gap between the projections of the two tets onto a unit axis, in the local frame:
+/// positive when the axis separates them, minus the overlap otherwise.
+KDET_HD inline float projection_gap(const LocalPair& p, vec3 axis) {
+    const Interval ia = project(p.a, axis), ib = project(p.b, axis);
+    return max_f(ib.lo - ia.hi, ia.lo - ib.hi);
+}
+
+} // namespace kdet::narrow
