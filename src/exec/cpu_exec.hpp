@@ -1,0 +1,89 @@
+#pragma once
+/// @file cpu_exec.hpp
+/// @brief The CPU execution layer: OpenMP loops over the same per-element functors the CUDA layer launches.
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <string>
+
+namespace kdet {
+
+/// @brief Growable array that keeps its memory between frames; contents are not preserved on growth.
+template <class T>
+class HostBuffer {
+public:
+    /// @brief Makes room for n elements; discards the old contents when it has to reallocate.
+    void resize_discard(std::size_t n) {
+        if (n > capacity_) {
+            data_.reset(new T[n]);
+            capacity_ = n;
+        }
+        size_ = n;
+    }
+    T* data() { return data_.get(); }
+    const T* data() const { return data_.get(); }
+    std::size_t size() const { return size_; }
+    std::size_t capacity_bytes() const { return capacity_ * sizeof(T); }
+
+private:
+    std::unique_ptr<T[]> data_;
+    std::size_t size_ = 0;
+    std::size_t capacity_ = 0;
+};
+
+/// @brief Times one stage in milliseconds of wall-clock time.
+class CpuStageTimer {
+public:
+    void start() { begin_ = std::chrono::steady_clock::now(); }
+    double stop_ms() {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin_).count();
+    }
+
+private:
+    std::chrono::steady_clock::time_point begin_{};
+};
+
+class CpuExec {
+public:
+    template <class T>
+    using buffer = HostBuffer<T>;
+    using stage_timer = CpuStageTimer;
+
+    /// @brief threads = 0 keeps OpenMP's default; block_size only matters on the GPU.
+    CpuExec(int threads, int block_size);
+
+    /// @brief Runs f(i) for every i in [0, n) on all threads.
+    template <class F>
+    void for_each(std::uint64_t n, const F& f) const {
+        const auto count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads_) if (count > 512)
+        for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
+    }
+
+    /// @brief Sorts keys[0, n) ascending and removes repeats; returns the unique count.
+    std::size_t sort_unique(std::uint64_t* keys, std::size_t n) const;
+
+    /// @brief out[i] = sum of in[0, i); returns the total. in and out may alias.
+    std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const;
+
+    template <class T>
+    void upload(T* device, const T* host, std::size_t n) const {
+        if (n) std::memcpy(device, host, n * sizeof(T));
+    }
+    template <class T>
+    void download(T* host, const T* device, std::size_t n) const {
+        if (n) std::memcpy(host, device, n * sizeof(T));
+    }
+    void synchronize() const {}
+
+    int threads() const { return threads_; }
+    std::string device_name() const;
+
+private:
+    int threads_;
+};
+
+} // namespace kdet

@@ -1,0 +1,80 @@
+#pragma once
+/// @file enclosing_sphere.hpp
+/// @brief Diameter of the minimum enclosing sphere of a tetrahedron: the size that picks its grid layer.
+///
+/// The minimum sphere is one of 11 candidates: the 6 edge spheres, the 4 face circumspheres and the
+/// tet's circumsphere. We keep the smallest candidate that contains all four vertices, then set the
+/// radius to the farthest vertex so the result always encloses the tet, whatever the rounding.
+
+#include "geometry/vec3.hpp"
+
+namespace kdet {
+
+namespace sphere_detail {
+
+struct Candidate {
+    vec3 center;
+    float radius_squared;
+    bool valid;
+};
+
+KDET_HD inline float farthest_squared(const vec3 p[4], vec3 center) {
+    float r2 = 0.0f;
+    for (int k = 0; k < 4; ++k) r2 = max_f(r2, length_squared(p[k] - center));
+    return r2;
+}
+
+KDET_HD inline void consider(const vec3 p[4], vec3 center, float radius_squared, float scale_squared, Candidate& best) {
+    // Relative slack: a candidate that encloses the points up to rounding counts as enclosing.
+    const float slack = 1e-5f * scale_squared;
+    if (!(radius_squared < best.radius_squared)) return;
+    for (int k = 0; k < 4; ++k)
+        if (length_squared(p[k] - center) > radius_squared + slack) return;
+    best = Candidate{center, radius_squared, true};
+}
+
+} // namespace sphere_detail
+
+/// @brief Diameter of the smallest sphere enclosing the four points (never smaller than the true one
+/// by more than rounding, never larger than the longest-edge bound sqrt(3) * true diameter).
+KDET_HD inline float enclosing_sphere_diameter(const vec3 v[4]) {
+    using sphere_detail::consider;
+    // A local frame keeps the formulas accurate far from the origin.
+    const vec3 p[4] = {make_vec3(0.0f, 0.0f, 0.0f), v[1] - v[0], v[2] - v[0], v[3] - v[0]};
+    float scale_squared = 0.0f;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) scale_squared = max_f(scale_squared, length_squared(p[i] - p[j]));
+
+    sphere_detail::Candidate best{make_vec3(0.0f, 0.0f, 0.0f), 3.4e38f, false};
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+            consider(p, (p[i] + p[j]) * 0.5f, 0.25f * length_squared(p[i] - p[j]), scale_squared, best);
+
+    const int faces[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+    for (const auto& f : faces) {
+        const vec3 a = p[f[0]];
+        const vec3 u = p[f[1]] - a;
+        const vec3 w = p[f[2]] - a;
+        const vec3 n = cross(u, w);
+        const float n2 = length_squared(n);
+        if (n2 <= 0.0f) continue;
+        const vec3 offset = cross(length_squared(u) * w - length_squared(w) * u, n) / (2.0f * n2);
+        consider(p, a + offset, length_squared(offset), scale_squared, best);
+    }
+
+    const vec3 u = p[1], w = p[2], t = p[3];
+    const float det = dot(u, cross(w, t));
+    if (det != 0.0f) {
+        const vec3 offset =
+            (length_squared(u) * cross(w, t) + length_squared(w) * cross(t, u) + length_squared(t) * cross(u, w)) /
+            (2.0f * det);
+        consider(p, offset, length_squared(offset), scale_squared, best);
+    }
+
+    vec3 center = best.center;
+    if (!best.valid) center = (p[0] + p[1] + p[2] + p[3]) * 0.25f; // only for non-finite input
+    const float radius = sqrtf(sphere_detail::farthest_squared(p, center));
+    return 2.0f * radius * (1.0f + 4.0f * 1.1920929e-7f);
+}
+
+} // namespace kdet

@@ -1,0 +1,127 @@
+#pragma once
+/// @file bucket_table.hpp
+/// @brief The hash table that stores the grid: fixed-capacity buckets, rehash probing on misses,
+/// overflow buckets chained per cell, and a frame stamp so the table never needs clearing.
+///
+/// A bucket's `state` is stamp*2 while a thread is writing its header and stamp*2+1 once it is ready;
+/// any other stamp means the bucket is empty this frame. Overflow buckets come from a pool after the
+/// main slots. When probing or the pool runs out, the insert reports it and the host grows and reruns.
+
+#include "exec/atomic.hpp"
+#include "grid/grid_math.hpp"
+
+#include <cstdint>
+
+namespace kdet {
+
+constexpr std::uint32_t no_bucket = 0xffffffffu;
+
+/// @brief Bits of GridView::failure.
+enum GridFailure : std::uint32_t { grid_table_full = 1u, grid_overflow_pool_full = 2u };
+
+struct BucketHeader {
+    std::uint32_t state;
+    std::uint32_t count; ///< ids appended so far; may exceed the capacity, readers clamp
+    std::uint32_t next;  ///< overflow bucket for the same cell, or no_bucket
+    std::uint32_t unused;
+    std::uint64_t key;
+};
+
+/// @brief A plain view of the table's buffers, passed by value into per-element code.
+struct GridView {
+    BucketHeader* headers;          ///< slot_count main buckets, then overflow_capacity pool buckets
+    std::uint32_t* ids;             ///< bucket_capacity ids per bucket
+    std::uint32_t* overflow_used;   ///< pool buckets handed out this frame
+    std::uint32_t* failure;         ///< GridFailure bits
+    std::uint32_t slot_count;       ///< 2^slot_bits
+    std::uint32_t slot_bits;
+    std::uint32_t bucket_capacity;
+    std::uint32_t overflow_capacity;
+    std::uint32_t stamp;            ///< this frame's stamp, >= 1
+    std::uint32_t max_probes;
+    HashFunction hash;
+};
+
+/// @brief Finds or claims the main bucket of `cell`; no_bucket when max_probes slots are taken by other cells.
+KDET_HD inline std::uint32_t claim_bucket(const GridView& g, CellCoord cell) {
+    const std::uint64_t key = cell_key(cell);
+    const std::uint32_t writing = g.stamp * 2u;
+    const std::uint32_t ready = writing + 1u;
+    for (std::uint32_t probe = 0; probe < g.max_probes; ++probe) {
+        const std::uint32_t slot = table_slot(hash_cell(g.hash, cell, probe), g.slot_bits);
+        BucketHeader& h = g.headers[slot];
+        std::uint32_t state = atomic_load_acquire(&h.state);
+        if ((state >> 1) != g.stamp && atomic_compare_exchange(&h.state, state, writing)) {
+            h.key = key;
+            h.count = 0;
+            h.next = no_bucket;
+            atomic_store_release(&h.state, ready);
+            return slot;
+        }
+        // Claimed this frame by someone (maybe just now): wait until its key is visible.
+        while (state != ready) state = atomic_load_acquire(&h.state);
+        if (h.key == key) return slot;
+    }
+    atomic_fetch_or(g.failure, static_cast<std::uint32_t>(grid_table_full));
+    return no_bucket;
+}
+
+/// @brief Appends `id` to the chain that starts at `bucket`, chaining pool buckets when full.
+KDET_HD inline bool append_to_chain(const GridView& g, std::uint32_t bucket, std::uint32_t id) {
+    for (;;) {
+        BucketHeader& h = g.headers[bucket];
+        const std::uint32_t index = atomic_fetch_add(&h.count, 1u);
+        if (index < g.bucket_capacity) {
+            g.ids[static_cast<std::uint64_t>(bucket) * g.bucket_capacity + index] = id;
+            return true;
+        }
+        std::uint32_t next = atomic_load_acquire(&h.next);
+        if (next == no_bucket) {
+            const std::uint32_t taken = atomic_fetch_add(g.overflow_used, 1u);
+            if (taken >= g.overflow_capacity) {
+                atomic_fetch_or(g.failure, static_cast<std::uint32_t>(grid_overflow_pool_full));
+                return false;
+            }
+            const std::uint32_t fresh = g.slot_count + taken;
+            BucketHeader& f = g.headers[fresh];
+            f.key = h.key;
+            f.count = 0;
+            f.next = no_bucket;
+            f.state = g.stamp * 2u + 1u;
+            // Losing the race leaves `fresh` unused for this frame; the winner's bucket is followed.
+            if (atomic_compare_exchange(&h.next, next, fresh)) next = fresh;
+        }
+        bucket = next;
+    }
+}
+
+/// @brief Inserts `id` into `cell`; false (with a failure bit set) when the table must grow.
+KDET_HD inline bool grid_insert(const GridView& g, CellCoord cell, std::uint32_t id) {
+    const std::uint32_t bucket = claim_bucket(g, cell);
+    return bucket != no_bucket && append_to_chain(g, bucket, id);
+}
+
+/// @brief Main bucket of `cell` after populating, or no_bucket when the cell is empty.
+KDET_HD inline std::uint32_t grid_find(const GridView& g, CellCoord cell) {
+    const std::uint64_t key = cell_key(cell);
+    for (std::uint32_t probe = 0; probe < g.max_probes; ++probe) {
+        const std::uint32_t slot = table_slot(hash_cell(g.hash, cell, probe), g.slot_bits);
+        const BucketHeader& h = g.headers[slot];
+        if ((h.state >> 1) != g.stamp) return no_bucket;
+        if (h.key == key) return slot;
+    }
+    return no_bucket;
+}
+
+/// @brief Calls visit(id) for every id stored in `cell`.
+template <class Visitor>
+KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, Visitor& visit) {
+    for (std::uint32_t bucket = grid_find(g, cell); bucket != no_bucket; bucket = g.headers[bucket].next) {
+        const std::uint32_t stored = g.headers[bucket].count;
+        const std::uint32_t n = stored < g.bucket_capacity ? stored : g.bucket_capacity;
+        const std::uint32_t* ids = g.ids + static_cast<std::uint64_t>(bucket) * g.bucket_capacity;
+        for (std::uint32_t k = 0; k < n; ++k) visit(ids[k]);
+    }
+}
+
+} // namespace kdet

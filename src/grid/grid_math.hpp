@@ -1,0 +1,84 @@
+#pragma once
+/// @file grid_math.hpp
+/// @brief Layer choice, cell ranges and cell keys of the hierarchical grid.
+///
+/// Layer l has cell size c_l = c0 * 2^l. A tetrahedron of size d (diameter of its minimum enclosing
+/// sphere) lives on the layer with c_(l-1) < d <= c_l, so its box spans at most two cells per axis.
+/// Correctness never depends on these sizes: a pair whose boxes overlap always shares a cell on the
+/// higher of its two layers, because both boxes contain the lower corner of their intersection and
+/// every cell index comes from the same monotone function of a coordinate.
+
+#include "geometry/vec3.hpp"
+#include "grid/hash.hpp"
+
+#include <cstdint>
+
+namespace kdet {
+
+/// @brief Most layers the grid uses; sizes beyond c0 * 2^(max_grid_layers-1) share the top layer.
+constexpr int max_grid_layers = 32;
+
+/// @brief Bits kept per cell coordinate in a key; farther cells alias, which costs only extra candidates.
+constexpr int cell_coordinate_bits = 19;
+
+/// @brief The frame's grid geometry, chosen from the scene (see choose_grid_params).
+struct GridParams {
+    vec3 origin;        ///< lower corner of the region that is gridded
+    float cell_size0;   ///< c0: the smallest tet size among the gridded tets
+    float inv_cell_size0;
+    int layer_count;    ///< layers 0 .. layer_count-1
+};
+
+/// @brief Layer of a tetrahedron of size `diameter`: the smallest l with diameter <= c0 * 2^l.
+KDET_HD inline int layer_of(const GridParams& grid, float diameter) {
+    int layer = 0;
+    float cell = grid.cell_size0;
+    while (diameter > cell && layer < grid.layer_count - 1) {
+        cell *= 2.0f;
+        ++layer;
+    }
+    return layer;
+}
+
+/// @brief Cell index along one axis on `layer`; monotone in x, clamped, and safe for NaN.
+KDET_HD inline std::uint32_t cell_index(const GridParams& grid, float x, float origin, int layer) {
+    // Scaling by a power of two keeps the map monotone, which the completeness argument needs.
+    float scaled = (x - origin) * grid.inv_cell_size0;
+    for (int l = 0; l < layer; ++l) scaled *= 0.5f;
+    const float limit = 1073741824.0f; // 2^30: stays exact and inside uint32
+    if (!(scaled >= 0.0f)) scaled = 0.0f;
+    if (scaled > limit) scaled = limit;
+    return static_cast<std::uint32_t>(scaled);
+}
+
+/// @brief Inclusive range of cells a box overlaps on one layer.
+struct CellRange {
+    std::uint32_t lo[3];
+    std::uint32_t hi[3];
+};
+
+KDET_HD inline CellRange cell_range(const GridParams& grid, const Aabb& box, int layer) {
+    CellRange r;
+    r.lo[0] = cell_index(grid, box.lo.x, grid.origin.x, layer);
+    r.lo[1] = cell_index(grid, box.lo.y, grid.origin.y, layer);
+    r.lo[2] = cell_index(grid, box.lo.z, grid.origin.z, layer);
+    r.hi[0] = cell_index(grid, box.hi.x, grid.origin.x, layer);
+    r.hi[1] = cell_index(grid, box.hi.y, grid.origin.y, layer);
+    r.hi[2] = cell_index(grid, box.hi.z, grid.origin.z, layer);
+    return r;
+}
+
+/// @brief The cell coordinates as hashed and stored: wrapped to cell_coordinate_bits.
+KDET_HD inline CellCoord make_cell(std::uint32_t x, std::uint32_t y, std::uint32_t z, int layer) {
+    const std::uint32_t mask = (1u << cell_coordinate_bits) - 1u;
+    return CellCoord{x & mask, y & mask, z & mask, static_cast<std::uint32_t>(layer)};
+}
+
+/// @brief 64-bit key that identifies a (wrapped) cell in the table; never 0 so 0 can mean "none".
+KDET_HD inline std::uint64_t cell_key(CellCoord c) {
+    return (static_cast<std::uint64_t>(c.layer + 1) << (3 * cell_coordinate_bits)) |
+           (static_cast<std::uint64_t>(c.x) << (2 * cell_coordinate_bits)) |
+           (static_cast<std::uint64_t>(c.y) << cell_coordinate_bits) | static_cast<std::uint64_t>(c.z);
+}
+
+} // namespace kdet

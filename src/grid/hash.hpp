@@ -1,0 +1,98 @@
+#pragma once
+/// @file hash.hpp
+/// @brief The four grid hash functions of the thesis (section 4.4), adapted to integer cell keys.
+/// Each maps a cell (x, y, z, layer) and a probe number to a 32-bit hash; table_slot maps that to a
+/// slot of the power-of-two table. The probe number enters the hash, so a miss rehashes as in the thesis.
+
+#include <kdet/config.hpp>
+#include <kdet/options.hpp>
+
+#include <cstdint>
+
+namespace kdet {
+
+/// @brief Integer coordinates of one grid cell; coordinates are wrapped to 19 bits.
+struct CellCoord {
+    std::uint32_t x, y, z, layer;
+};
+
+namespace hash_detail {
+
+/// Odd multiplier that makes successive probes of the arithmetic hashes visit every slot.
+constexpr std::uint32_t probe_stride = 2654435761u;
+
+KDET_HD inline std::uint32_t djb2_word(std::uint32_t hash, std::uint32_t word) {
+    for (int byte = 0; byte < 4; ++byte) hash = hash * 33u + ((word >> (8 * byte)) & 0xffu);
+    return hash;
+}
+
+KDET_HD inline std::uint32_t fnv1a_word(std::uint32_t hash, std::uint32_t word) {
+    for (int byte = 0; byte < 4; ++byte) hash = (hash ^ ((word >> (8 * byte)) & 0xffu)) * 16777619u;
+    return hash;
+}
+
+/// Spreads the low 10 bits of v so that two zero bits separate each of them.
+KDET_HD inline std::uint32_t spread_bits_3(std::uint32_t v) {
+    v &= 0x3ffu;
+    v = (v | (v << 16)) & 0x030000ffu;
+    v = (v | (v << 8)) & 0x0300f00fu;
+    v = (v | (v << 4)) & 0x030c30c3u;
+    v = (v | (v << 2)) & 0x09249249u;
+    return v;
+}
+
+} // namespace hash_detail
+
+/// @brief DJB2 over the bytes of the cell key, then of the probe number.
+KDET_HD inline std::uint32_t hash_djb2(CellCoord c, std::uint32_t probe) {
+    std::uint32_t h = 5381u;
+    h = hash_detail::djb2_word(h, c.x);
+    h = hash_detail::djb2_word(h, c.y);
+    h = hash_detail::djb2_word(h, c.z);
+    h = hash_detail::djb2_word(h, c.layer);
+    return hash_detail::djb2_word(h, probe);
+}
+
+/// @brief FNV-1a (32-bit) over the bytes of the cell key, then of the probe number.
+KDET_HD inline std::uint32_t hash_fnv1a(CellCoord c, std::uint32_t probe) {
+    std::uint32_t h = 2166136261u;
+    h = hash_detail::fnv1a_word(h, c.x);
+    h = hash_detail::fnv1a_word(h, c.y);
+    h = hash_detail::fnv1a_word(h, c.z);
+    h = hash_detail::fnv1a_word(h, c.layer);
+    return hash_detail::fnv1a_word(h, probe);
+}
+
+/// @brief Teschner et al.'s three-prime hash, with the layer term of Eitz and Lixu.
+KDET_HD inline std::uint32_t hash_simple(CellCoord c, std::uint32_t probe) {
+    const std::uint32_t h = (c.x * 73856093u) ^ (c.y * 19349663u) ^ (c.z * 83492791u) ^ (c.layer * 67867979u);
+    return h + probe * hash_detail::probe_stride;
+}
+
+/// @brief Morton code of the low 10 bits of each coordinate, mixed with the layer.
+KDET_HD inline std::uint32_t hash_morton(CellCoord c, std::uint32_t probe) {
+    const std::uint32_t code = hash_detail::spread_bits_3(c.x) | (hash_detail::spread_bits_3(c.y) << 1) |
+                               (hash_detail::spread_bits_3(c.z) << 2);
+    // The high coordinate bits that the 30-bit code drops still reach the hash through the xor.
+    const std::uint32_t high = ((c.x >> 10) * 73856093u) ^ ((c.y >> 10) * 19349663u) ^ ((c.z >> 10) * 83492791u);
+    return (code ^ high ^ (c.layer * 67867979u)) + probe * hash_detail::probe_stride;
+}
+
+/// @brief Dispatches to the selected hash function.
+KDET_HD inline std::uint32_t hash_cell(HashFunction function, CellCoord c, std::uint32_t probe) {
+    switch (function) {
+    case HashFunction::fnv1a: return hash_fnv1a(c, probe);
+    case HashFunction::simple: return hash_simple(c, probe);
+    case HashFunction::morton: return hash_morton(c, probe);
+    case HashFunction::djb2:
+    default: return hash_djb2(c, probe);
+    }
+}
+
+/// @brief Slot of a hash in a table of 2^slot_bits slots. Fibonacci hashing keeps the product's high
+/// bits, so hashes whose low bits vary little (DJB2 on small cell coordinates) still spread evenly.
+KDET_HD inline std::uint32_t table_slot(std::uint32_t hash, std::uint32_t slot_bits) {
+    return slot_bits == 0 ? 0u : (hash * 2654435769u) >> (32u - slot_bits);
+}
+
+} // namespace kdet

@@ -1,0 +1,189 @@
+// Grid building blocks: hash functions, layer choice, cell ranges and the bucket table.
+
+#include "exec/cpu_exec.hpp"
+#include "geometry/enclosing_sphere.hpp"
+#include "grid/bucket_table.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+#include <vector>
+
+namespace kdet {
+namespace {
+
+struct HashCase {
+    CellCoord cell;
+    std::uint32_t probe;
+    std::uint32_t djb2, fnv1a, simple, morton; // from an independent Python implementation
+};
+
+TEST(Hash, MatchesIndependentReferenceValues) {
+    const HashCase cases[] = {
+        {{0, 0, 0, 0}, 0, 2781706629u, 3120489557u, 0u, 0u},
+        {{1, 2, 3, 4}, 0, 3460325199u, 659969745u, 418111338u, 271471897u},
+        {{1, 2, 3, 4}, 5, 3460504884u, 400233476u, 805388255u, 658748814u},
+        {{524287, 1000, 77, 31}, 2, 4230547747u, 2168485597u, 1509067783u, 3960095325u},
+    };
+    for (const HashCase& c : cases) {
+        EXPECT_EQ(hash_cell(HashFunction::djb2, c.cell, c.probe), c.djb2);
+        EXPECT_EQ(hash_cell(HashFunction::fnv1a, c.cell, c.probe), c.fnv1a);
+        EXPECT_EQ(hash_cell(HashFunction::simple, c.cell, c.probe), c.simple);
+        EXPECT_EQ(hash_cell(HashFunction::morton, c.cell, c.probe), c.morton);
+    }
+}
+
+class HashSpread : public ::testing::TestWithParam<HashFunction> {};
+
+TEST_P(HashSpread, SpreadsABlockOfCellsOverTheTable) {
+    // 32^3 neighbouring cells on two layers into 2^17 slots: a decent hash fills most of the
+    // expected slots and never piles many cells onto one.
+    const std::uint32_t bits = 17, slots = 1u << bits;
+    std::vector<std::uint32_t> load(slots, 0);
+    std::uint32_t cells = 0;
+    for (std::uint32_t layer = 0; layer < 2; ++layer)
+        for (std::uint32_t x = 0; x < 32; ++x)
+            for (std::uint32_t y = 0; y < 32; ++y)
+                for (std::uint32_t z = 0; z < 32; ++z, ++cells)
+                    ++load[table_slot(hash_cell(GetParam(), make_cell(x + 1000, y, z, static_cast<int>(layer)), 0), bits)];
+    const auto used = static_cast<double>(std::count_if(load.begin(), load.end(), [](std::uint32_t l) { return l > 0; }));
+    const double expected_used = slots * (1.0 - std::exp(-static_cast<double>(cells) / slots));
+    EXPECT_GT(used, 0.8 * expected_used);
+    EXPECT_LE(*std::max_element(load.begin(), load.end()), 12u);
+}
+
+TEST_P(HashSpread, ProbesVisitDifferentSlots) {
+    std::set<std::uint32_t> slots;
+    for (std::uint32_t probe = 0; probe < 16; ++probe)
+        slots.insert(table_slot(hash_cell(GetParam(), CellCoord{5, 6, 7, 1}, probe), 10));
+    EXPECT_GE(slots.size(), 14u);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllHashes, HashSpread,
+                         ::testing::Values(HashFunction::djb2, HashFunction::fnv1a, HashFunction::simple,
+                                           HashFunction::morton));
+
+TEST(Layer, PicksTheSmallestLayerWhoseCellHoldsTheSize) {
+    const GridParams g{{0, 0, 0}, 0.5f, 2.0f, 6};
+    EXPECT_EQ(layer_of(g, 0.1f), 0);
+    EXPECT_EQ(layer_of(g, 0.5f), 0);
+    EXPECT_EQ(layer_of(g, 0.5001f), 1);
+    EXPECT_EQ(layer_of(g, 1.0f), 1);
+    EXPECT_EQ(layer_of(g, 7.9f), 4);
+    EXPECT_EQ(layer_of(g, 1000.0f), 5); // beyond the top layer: clamped
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> size(0.01f, 15.0f);
+    for (int i = 0; i < 10000; ++i) {
+        const float d = size(rng);
+        const int l = layer_of(g, d);
+        EXPECT_LE(d, std::ldexp(0.5f, l));
+        if (l > 0) {
+            EXPECT_GT(d, std::ldexp(0.5f, l - 1));
+        }
+    }
+}
+
+TEST(CellRange, CoversTheBoxAndSpansAtMostTwoCellsOnTheTetsLayer) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    const GridParams g{{-10, -10, -10}, 0.01f, 100.0f, 12};
+    for (int i = 0; i < 20000; ++i) {
+        const float s = 0.01f * std::pow(100.0f, unit(rng));
+        const vec3 c{20 * unit(rng) - 10, 20 * unit(rng) - 10, 20 * unit(rng) - 10};
+        vec3 v[4];
+        for (auto& p : v) p = c + vec3{s * unit(rng), s * unit(rng), s * unit(rng)};
+        const Aabb box = tet_box(v);
+        const int layer = layer_of(g, enclosing_sphere_diameter(v));
+        const CellRange r = cell_range(g, box, layer);
+        const float cell = std::ldexp(0.01f, layer);
+        for (int a = 0; a < 3; ++a) {
+            ASSERT_LE(r.hi[a] - r.lo[a], 1u);
+            ASSERT_LE(static_cast<float>(r.lo[a]) * cell, component(box.lo, a) - component(g.origin, a) + 1e-4f);
+            ASSERT_GE(static_cast<float>(r.hi[a] + 1) * cell, component(box.hi, a) - component(g.origin, a) - 1e-4f);
+        }
+    }
+}
+
+TEST(CellRange, ClampsNonFiniteAndFarCoordinates) {
+    const GridParams g{{0, 0, 0}, 1e-3f, 1e3f, 4};
+    EXPECT_EQ(cell_index(g, std::nanf(""), 0.0f, 0), 0u);
+    EXPECT_EQ(cell_index(g, -5.0f, 0.0f, 0), 0u);
+    EXPECT_EQ(cell_index(g, 1e30f, 0.0f, 0), 1u << 30);
+    EXPECT_EQ(cell_index(g, 2.5f, 0.0f, 1), 1250u);
+}
+
+/// A table on the CPU execution layer with the given geometry.
+struct TestTable {
+    std::vector<BucketHeader> headers;
+    std::vector<std::uint32_t> ids;
+    std::uint32_t overflow_used = 0, failure = 0;
+    GridView view{};
+    TestTable(std::uint32_t slots, std::uint32_t capacity, std::uint32_t pool, std::uint32_t probes, HashFunction hash)
+        : headers(slots + pool, BucketHeader{}), ids(static_cast<std::size_t>(slots + pool) * capacity) {
+        std::uint32_t bits = 0;
+        while ((1u << bits) < slots) ++bits;
+        view = GridView{headers.data(), ids.data(), &overflow_used, &failure, slots, bits, capacity, pool, 1, probes, hash};
+    }
+    void next_frame() {
+        ++view.stamp;
+        overflow_used = failure = 0;
+    }
+    std::multiset<std::uint32_t> contents(CellCoord cell) const {
+        std::multiset<std::uint32_t> found;
+        auto collect = [&](std::uint32_t id) { found.insert(id); };
+        grid_for_each_in_cell(view, cell, collect);
+        return found;
+    }
+};
+
+TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
+    TestTable table(64, 4, 4096, 32, HashFunction::fnv1a);
+    const CpuExec exec(2, 128);
+    const std::uint32_t ids = 5000, cells = 7;
+    exec.for_each(ids, [&](std::uint64_t i) {
+        grid_insert(table.view, CellCoord{static_cast<std::uint32_t>(i % cells), 1, 2, 0}, static_cast<std::uint32_t>(i));
+    });
+    ASSERT_EQ(table.failure, 0u);
+    EXPECT_GT(table.overflow_used, 1000u);
+    for (std::uint32_t c = 0; c < cells; ++c) {
+        std::multiset<std::uint32_t> expected;
+        for (std::uint32_t i = c; i < ids; i += cells) expected.insert(i);
+        EXPECT_EQ(table.contents(CellCoord{c, 1, 2, 0}), expected) << "cell " << c;
+    }
+    EXPECT_TRUE(table.contents(CellCoord{99, 1, 2, 0}).empty());
+}
+
+TEST(BucketTable, ReportsAFullTableAndAnExhaustedPool) {
+    TestTable full(4, 8, 16, 4, HashFunction::djb2);
+    for (std::uint32_t c = 0; c < 16; ++c) grid_insert(full.view, CellCoord{c, 0, 0, 0}, c);
+    EXPECT_TRUE(full.failure & grid_table_full);
+
+    TestTable pool(16, 2, 1, 8, HashFunction::djb2);
+    for (std::uint32_t i = 0; i < 10; ++i) grid_insert(pool.view, CellCoord{3, 3, 3, 0}, i);
+    EXPECT_TRUE(pool.failure & grid_overflow_pool_full);
+}
+
+TEST(BucketTable, ANewStampEmptiesTheTableWithoutClearing) {
+    TestTable table(32, 4, 8, 8, HashFunction::morton);
+    grid_insert(table.view, CellCoord{1, 2, 3, 0}, 42);
+    EXPECT_EQ(table.contents(CellCoord{1, 2, 3, 0}).count(42), 1u);
+    table.next_frame();
+    EXPECT_TRUE(table.contents(CellCoord{1, 2, 3, 0}).empty());
+    grid_insert(table.view, CellCoord{1, 2, 3, 0}, 7);
+    EXPECT_EQ(table.contents(CellCoord{1, 2, 3, 0}), std::multiset<std::uint32_t>{7});
+}
+
+TEST(CellKey, DistinguishesLayersAndCoordinates) {
+    std::set<std::uint64_t> keys;
+    for (int layer = 0; layer < 3; ++layer)
+        for (std::uint32_t x = 0; x < 4; ++x)
+            for (std::uint32_t y = 0; y < 4; ++y)
+                for (std::uint32_t z = 0; z < 4; ++z) keys.insert(cell_key(make_cell(x, y, z, layer)));
+    EXPECT_EQ(keys.size(), 3u * 64u);
+    EXPECT_EQ(keys.count(0), 0u);
+}
+
+} // namespace
+} // namespace kdet
