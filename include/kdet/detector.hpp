@@ -1,0 +1,80 @@
+#pragma once
+/// @file detector.hpp
+/// @brief Finding colliding tetrahedra: a Detector for frame-by-frame use, collide() for one-off use.
+
+#include <kdet/mesh.hpp>
+#include <kdet/options.hpp>
+#include <kdet/results.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace kdet {
+
+using ObjectId = std::uint32_t;
+
+/// @brief Keeps objects and buffers between frames. Typical use:
+/// add objects once, then each frame set_positions() for the objects that moved and detect().
+///
+/// Semantics: two tets collide when their closed sets share a point. Within one object, tets that
+/// share a vertex index are adjacent and never reported. Positions are stored as float32.
+/// By default every pair of different objects is checked and self-collision is off.
+class Detector {
+public:
+    explicit Detector(const DetectorOptions& options = {});
+    ~Detector();
+    Detector(Detector&&) noexcept;
+    Detector& operator=(Detector&&) noexcept;
+    Detector(const Detector&) = delete;
+    Detector& operator=(const Detector&) = delete;
+
+    /// @brief Adds an object; tets are 4 vertex indices (0-based) each. Throws kdet::Error on an
+    /// out-of-range index or a non-finite coordinate.
+    ObjectId add_object(const float* positions, std::size_t vertex_count, const std::uint32_t* tets,
+                        std::size_t tet_count);
+    ObjectId add_object(const double* positions, std::size_t vertex_count, const std::uint32_t* tets,
+                        std::size_t tet_count);
+    ObjectId add_object(const TetMesh& mesh);
+
+    /// @brief Replaces an object's vertex positions (x y z per vertex, same count as when added).
+    void set_positions(ObjectId object, const float* positions, std::size_t vertex_count);
+    void set_positions(ObjectId object, const double* positions, std::size_t vertex_count);
+
+    /// @brief Switches self-collision of one object (off by default).
+    void set_self_collision(ObjectId object, bool enabled);
+    /// @brief Switches collision between two different objects (on by default).
+    void set_pair_collision(ObjectId a, ObjectId b, bool enabled);
+
+    /// @brief Runs one detection; the result stays valid until the next call.
+    const FrameResult& detect();
+
+    std::size_t object_count() const;
+    std::size_t tet_count(ObjectId object) const;
+    /// @brief Bytes held by the detector's buffers (device memory on the CUDA backend).
+    std::size_t memory_bytes() const;
+    /// @brief The CPU model or GPU name the detector runs on.
+    std::string device_name() const;
+    const DetectorOptions& options() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// @brief A pair of tet indices (in file order) of a one-off query.
+using IndexPair = std::pair<std::uint32_t, std::uint32_t>;
+
+/// @brief All colliding pairs (i in a, j in b), sorted ascending.
+std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const DetectorOptions& options = {});
+
+/// @brief All colliding pairs i < j inside one mesh (self-collision), sorted ascending.
+std::vector<IndexPair> collide_self(const TetMesh& mesh, const DetectorOptions& options = {});
+
+/// @brief The version string, with the git commit it was built from when known.
+std::string version();
+
+} // namespace kdet

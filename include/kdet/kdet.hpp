@@ -1,0 +1,12 @@
+#pragma once
+/// @file kdet.hpp
+/// @brief Everything of kdet's public API.
+
+#include <kdet/config.hpp>
+#include <kdet/detector.hpp>
+#include <kdet/error.hpp>
+#include <kdet/io.hpp>
+#include <kdet/mesh.hpp>
+#include <kdet/options.hpp>
+#include <kdet/results.hpp>
+#include <kdet/scenes.hpp>

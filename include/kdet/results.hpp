@@ -1,0 +1,62 @@
+#pragma once
+/// @file results.hpp
+/// @brief What a detection returns: unique pairs, per-tet flags, counts, stage times, memory.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace kdet {
+
+/// @brief One colliding pair; (object_a, tet_a) < (object_b, tet_b) in lexicographic order.
+struct TetPair {
+    std::uint32_t object_a, tet_a, object_b, tet_b;
+    friend bool operator==(const TetPair& x, const TetPair& y) {
+        return x.object_a == y.object_a && x.tet_a == y.tet_a && x.object_b == y.object_b && x.tet_b == y.tet_b;
+    }
+    friend bool operator<(const TetPair& x, const TetPair& y) {
+        if (x.object_a != y.object_a) return x.object_a < y.object_a;
+        if (x.tet_a != y.tet_a) return x.tet_a < y.tet_a;
+        if (x.object_b != y.object_b) return x.object_b < y.object_b;
+        return x.tet_b < y.tet_b;
+    }
+};
+
+/// @brief Contact of a colliding pair from the 44-axis SAT: translating tet b by depth * direction
+/// separates the pair (direction is a unit vector).
+struct Contact {
+    float depth;
+    float direction[3];
+};
+
+/// @brief Milliseconds spent in each stage of one detection.
+struct StageTimes {
+    double bounding_boxes = 0;  ///< per-tet boxes and sizes, object boxes and their overlap
+    double populate_grid = 0;
+    double find_candidates = 0; ///< for kdet_no_pairs this includes its inline narrow phase
+    double sort_unique = 0;
+    double narrow_phase = 0;    ///< includes compacting the colliding pairs
+    double total = 0;           ///< the whole detect() call, results copied out included
+};
+
+/// @brief Sizes of one detection.
+struct FrameCounts {
+    std::uint64_t candidates = 0;        ///< candidate pairs written, duplicates included
+    std::uint64_t unique_candidates = 0; ///< after sort+unique: the narrow phase runs once on each
+    std::uint64_t colliding_pairs = 0;
+    std::uint64_t colliding_tets = 0;    ///< tets flagged as colliding, all objects together
+    std::uint32_t buffer_regrows = 0;    ///< times a buffer grew and its stage reran this frame
+};
+
+/// @brief Result of one detection. For Method::kdet_no_pairs, `pairs` stays empty and only the
+/// flags are meaningful (that method never builds pairs).
+struct FrameResult {
+    std::vector<TetPair> pairs;                  ///< sorted ascending, unique
+    std::vector<Contact> contacts;               ///< parallel to pairs when contacts are enabled
+    std::vector<std::vector<std::uint8_t>> colliding; ///< [object][tet] = 1 if the tet collides
+    FrameCounts counts;
+    StageTimes times;
+    std::size_t memory_bytes = 0;                ///< bytes held by the detector's buffers
+};
+
+} // namespace kdet

@@ -1,0 +1,197 @@
+#include "pipeline/pipeline_base.hpp"
+
+#include <kdet/detector.hpp>
+#include <kdet/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace kdet {
+
+struct Detector::Impl {
+    DetectorOptions options;
+    std::unique_ptr<PipelineBase> pipeline;
+    SceneTopology topology;
+    std::vector<std::uint32_t> object_vertex_begin{0};
+    std::vector<std::uint8_t> pair_enabled; // [objects * objects]
+    bool topology_changed = false;
+    std::vector<vec3> positions;            // host copy, float32 as the pipeline stores them
+    std::vector<std::uint8_t> positions_dirty; // per object: changed since the last upload
+    FrameResult result;
+
+    std::size_t objects() const { return object_vertex_begin.size() - 1; }
+
+    void check_object(ObjectId object) const {
+        if (object >= objects())
+            throw Error("object id " + std::to_string(object) + " out of range (" + std::to_string(objects()) +
+                        " objects)");
+    }
+
+    template <class Scalar>
+    void store_positions(ObjectId object, const Scalar* xyz, std::size_t vertex_count) {
+        const std::uint32_t first = object_vertex_begin[object];
+        const std::size_t expected = object_vertex_begin[object + 1] - first;
+        if (vertex_count != expected)
+            throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
+                        " vertices, expected " + std::to_string(expected));
+        for (std::size_t v = 0; v < vertex_count; ++v) {
+            const auto x = static_cast<float>(xyz[3 * v]), y = static_cast<float>(xyz[3 * v + 1]),
+                       z = static_cast<float>(xyz[3 * v + 2]);
+            // Out-of-range doubles become infinite floats, so this also catches values beyond float range.
+            if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
+                throw Error("object " + std::to_string(object) + ": vertex " + std::to_string(v) +
+                            " has a non-finite coordinate (or one beyond float range)");
+            positions[first + v] = vec3{x, y, z};
+        }
+        positions_dirty[object] = 1;
+    }
+
+    template <class Scalar>
+    ObjectId add(const Scalar* xyz, std::size_t vertex_count, const std::uint32_t* tets, std::size_t tet_count) {
+        const std::uint64_t total_tets = topology.tets.size() + tet_count;
+        const std::uint64_t total_vertices = std::uint64_t{object_vertex_begin.back()} + vertex_count;
+        if (total_tets >= 0xffffffffull || total_vertices >= 0xffffffffull)
+            throw Error("too many tetrahedra or vertices for 32-bit ids");
+        const ObjectId id = static_cast<ObjectId>(objects());
+        for (std::size_t t = 0; t < tet_count; ++t)
+            for (int k = 0; k < 4; ++k)
+                if (tets[4 * t + k] >= vertex_count)
+                    throw Error("object " + std::to_string(id) + ": tet " + std::to_string(t) + " has vertex index " +
+                                std::to_string(tets[4 * t + k]) + " out of range [0, " +
+                                std::to_string(vertex_count) + ")");
+        const std::uint32_t base = object_vertex_begin.back();
+        for (std::size_t t = 0; t < tet_count; ++t) {
+            TetIndices tet;
+            for (int k = 0; k < 4; ++k) tet.v[k] = base + tets[4 * t + k];
+            topology.tets.push_back(tet);
+            topology.tet_object.push_back(id);
+        }
+        if (topology.object_tet_begin.empty()) topology.object_tet_begin.push_back(0);
+        topology.object_tet_begin.push_back(static_cast<std::uint32_t>(topology.tets.size()));
+        object_vertex_begin.push_back(base + static_cast<std::uint32_t>(vertex_count));
+        topology.vertex_count = object_vertex_begin.back();
+        positions.resize(topology.vertex_count);
+        positions_dirty.push_back(1);
+
+        const std::size_t n = objects();
+        std::vector<std::uint8_t> enabled(n * n, 0);
+        for (std::size_t a = 0; a < n; ++a)
+            for (std::size_t b = 0; b < n; ++b)
+                enabled[a * n + b] = (a < n - 1 && b < n - 1) ? pair_enabled[a * (n - 1) + b] : (a != b ? 1 : 0);
+        pair_enabled.swap(enabled);
+        topology_changed = true;
+        store_positions(id, xyz, vertex_count);
+        return id;
+    }
+};
+
+Detector::Detector(const DetectorOptions& options) : impl_(std::make_unique<Impl>()) {
+    impl_->options = options;
+    if (options.block_size < 1 || options.block_size > 1024)
+        throw Error("block size " + std::to_string(options.block_size) + " out of range [1, 1024]");
+    if (options.bucket_capacity < 1) throw Error("bucket capacity must be at least 1");
+    impl_->pipeline = options.backend == Backend::cuda ? make_cuda_pipeline(options) : make_cpu_pipeline(options);
+}
+
+Detector::~Detector() = default;
+Detector::Detector(Detector&&) noexcept = default;
+Detector& Detector::operator=(Detector&&) noexcept = default;
+
+ObjectId Detector::add_object(const float* positions, std::size_t vertex_count, const std::uint32_t* tets,
+                              std::size_t tet_count) {
+    return impl_->add(positions, vertex_count, tets, tet_count);
+}
+ObjectId Detector::add_object(const double* positions, std::size_t vertex_count, const std::uint32_t* tets,
+                              std::size_t tet_count) {
+    return impl_->add(positions, vertex_count, tets, tet_count);
+}
+ObjectId Detector::add_object(const TetMesh& mesh) {
+    return impl_->add(mesh.positions.data(), mesh.num_vertices(), mesh.tets.data(), mesh.num_tets());
+}
+
+void Detector::set_positions(ObjectId object, const float* positions, std::size_t vertex_count) {
+    impl_->check_object(object);
+    impl_->store_positions(object, positions, vertex_count);
+}
+void Detector::set_positions(ObjectId object, const double* positions, std::size_t vertex_count) {
+    impl_->check_object(object);
+    impl_->store_positions(object, positions, vertex_count);
+}
+
+void Detector::set_self_collision(ObjectId object, bool enabled) {
+    impl_->check_object(object);
+    impl_->pair_enabled[object * impl_->objects() + object] = enabled ? 1 : 0;
+}
+
+void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
+    impl_->check_object(a);
+    impl_->check_object(b);
+    if (a == b) throw Error("set_pair_collision needs two different objects; use set_self_collision");
+    impl_->pair_enabled[a * impl_->objects() + b] = impl_->pair_enabled[b * impl_->objects() + a] = enabled ? 1 : 0;
+}
+
+const FrameResult& Detector::detect() {
+    Impl& d = *impl_;
+    if (d.topology_changed) {
+        d.pipeline->set_topology(d.topology);
+        std::fill(d.positions_dirty.begin(), d.positions_dirty.end(), 1); // the pipeline's buffers are new
+        d.topology_changed = false;
+    }
+    for (std::size_t o = 0; o < d.objects(); ++o) {
+        if (!d.positions_dirty[o]) continue;
+        const std::uint32_t first = d.object_vertex_begin[o];
+        d.pipeline->set_positions(first, d.positions.data() + first, d.object_vertex_begin[o + 1] - first);
+        d.positions_dirty[o] = 0;
+    }
+    if (d.objects() == 0) {
+        d.result = FrameResult{};
+        return d.result;
+    }
+    d.pipeline->detect(d.pair_enabled, d.result);
+    return d.result;
+}
+
+std::size_t Detector::object_count() const { return impl_->objects(); }
+std::size_t Detector::tet_count(ObjectId object) const {
+    impl_->check_object(object);
+    return impl_->topology.object_tet_begin[object + 1] - impl_->topology.object_tet_begin[object];
+}
+std::size_t Detector::memory_bytes() const { return impl_->pipeline->memory_bytes(); }
+std::string Detector::device_name() const { return impl_->pipeline->device_name(); }
+const DetectorOptions& Detector::options() const { return impl_->options; }
+
+namespace {
+
+std::vector<IndexPair> to_index_pairs(const FrameResult& result) {
+    std::vector<IndexPair> pairs;
+    pairs.reserve(result.pairs.size());
+    for (const TetPair& p : result.pairs) pairs.emplace_back(p.tet_a, p.tet_b);
+    return pairs;
+}
+
+} // namespace
+
+std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const DetectorOptions& options) {
+    Detector detector(options);
+    detector.add_object(a);
+    detector.add_object(b);
+    return to_index_pairs(detector.detect());
+}
+
+std::vector<IndexPair> collide_self(const TetMesh& mesh, const DetectorOptions& options) {
+    Detector detector(options);
+    const ObjectId id = detector.add_object(mesh);
+    detector.set_self_collision(id, true);
+    return to_index_pairs(detector.detect());
+}
+
+std::string version() {
+#ifdef KDET_GIT_COMMIT
+    const std::string commit = KDET_GIT_COMMIT;
+    if (!commit.empty()) return std::string(KDET_VERSION_STRING) + " (" + commit + ")";
+#endif
+    return KDET_VERSION_STRING;
+}
+
+} // namespace kdet

@@ -1,0 +1,385 @@
+#pragma once
+/// @file kernels.hpp
+/// @brief Every per-element step of the pipeline, written once as a functor that the CPU layer runs
+/// in an OpenMP loop and the CUDA layer runs as a kernel. Views hold raw pointers and counts only.
+
+#include "geometry/enclosing_sphere.hpp"
+#include "geometry/tet_intersect.hpp"
+#include "grid/bucket_table.hpp"
+
+#include <kdet/results.hpp>
+
+#include <cstdint>
+
+namespace kdet {
+
+struct TetIndices {
+    std::uint32_t v[4]; ///< global vertex ids (object offsets applied)
+};
+
+/// @brief Per-tet data recomputed every frame.
+struct TetInfo {
+    Aabb box;
+    float diameter;     ///< of the minimum enclosing sphere
+    std::int32_t layer; ///< grid layer, or -1 when the tet cannot collide with anything enabled
+};
+
+/// @brief Box and size range of one object, as order-preserving integers so threads can merge them atomically.
+struct ObjectStats {
+    std::uint32_t lo[3], hi[3];
+    std::uint32_t min_diameter, max_diameter;
+};
+
+/// @brief All objects' geometry, concatenated; tets of one object are contiguous.
+struct SceneView {
+    const vec3* positions;
+    const TetIndices* tets;
+    const std::uint32_t* tet_object;
+    TetInfo* info;
+    const std::uint8_t* pair_active; ///< [object_count * object_count]; diagonal = self-collision
+    const Aabb* object_boxes;
+    std::uint32_t tet_count;
+    std::uint32_t object_count;
+};
+
+KDET_HD inline void load_tet(const SceneView& s, std::uint32_t t, vec3 out[4]) {
+    const TetIndices tet = s.tets[t];
+    for (int k = 0; k < 4; ++k) out[k] = s.positions[tet.v[k]];
+}
+
+KDET_HD inline bool share_vertex(const TetIndices& a, const TetIndices& b) {
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+            if (a.v[i] == b.v[j]) return true;
+    return false;
+}
+
+KDET_HD inline bool pair_is_active(const SceneView& s, std::uint32_t object_a, std::uint32_t object_b) {
+    return s.pair_active[static_cast<std::uint64_t>(object_a) * s.object_count + object_b] != 0;
+}
+
+/// @brief Sort key of a pair of global tet ids; the lower id goes first.
+KDET_HD inline std::uint64_t pair_key(std::uint32_t t, std::uint32_t u) {
+    const std::uint32_t lo = t < u ? t : u, hi = t < u ? u : t;
+    return (static_cast<std::uint64_t>(lo) << 32) | hi;
+}
+KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
+KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
+
+/// @brief The predicate every method applies to a pair that may collide: adjacency, boxes, narrow phase.
+/// The lower global id always goes first so every method sees the same floating-point computation.
+KDET_HD inline bool tets_collide(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u) {
+    const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
+    if (s.tet_object[first] == s.tet_object[second] && share_vertex(s.tets[first], s.tets[second])) return false;
+    if (!boxes_overlap(s.info[first].box, s.info[second].box)) return false;
+    vec3 a[4], b[4];
+    load_tet(s, first, a);
+    load_tet(s, second, b);
+    return tets_intersect(test, a, b);
+}
+
+/// @brief Stage 1: box and size of each tet.
+struct TetBoundsKernel {
+    SceneView scene;
+    KDET_HD void operator()(std::uint64_t t) const {
+        vec3 v[4];
+        load_tet(scene, static_cast<std::uint32_t>(t), v);
+        scene.info[t] = TetInfo{tet_box(v), enclosing_sphere_diameter(v), -1};
+    }
+};
+
+/// @brief Stage 1: merges tet boxes and sizes into their objects' stats, one chunk of tets per item
+/// so that threads rarely contend on the same object.
+struct ObjectStatsKernel {
+    SceneView scene;
+    ObjectStats* stats;
+    std::uint32_t chunk;
+
+    KDET_HD static void flush(ObjectStats& target, const Aabb& box, float dmin, float dmax) {
+        atomic_min(&target.lo[0], float_to_ordered(box.lo.x));
+        atomic_min(&target.lo[1], float_to_ordered(box.lo.y));
+        atomic_min(&target.lo[2], float_to_ordered(box.lo.z));
+        atomic_max(&target.hi[0], float_to_ordered(box.hi.x));
+        atomic_max(&target.hi[1], float_to_ordered(box.hi.y));
+        atomic_max(&target.hi[2], float_to_ordered(box.hi.z));
+        atomic_min(&target.min_diameter, float_to_ordered(dmin));
+        atomic_max(&target.max_diameter, float_to_ordered(dmax));
+    }
+
+    KDET_HD void operator()(std::uint64_t c) const {
+        const std::uint64_t begin = c * chunk;
+        const std::uint64_t end = begin + chunk < scene.tet_count ? begin + chunk : scene.tet_count;
+        std::uint32_t object = scene.tet_object[begin];
+        Aabb box = scene.info[begin].box;
+        float dmin = scene.info[begin].diameter, dmax = dmin;
+        for (std::uint64_t t = begin + 1; t < end; ++t) {
+            const TetInfo& info = scene.info[t];
+            if (scene.tet_object[t] != object) {
+                flush(stats[object], box, dmin, dmax);
+                object = scene.tet_object[t];
+                box = info.box;
+                dmin = dmax = info.diameter;
+                continue;
+            }
+            box = Aabb{min_v(box.lo, info.box.lo), max_v(box.hi, info.box.hi)};
+            dmin = min_f(dmin, info.diameter);
+            dmax = max_f(dmax, info.diameter);
+        }
+        flush(stats[object], box, dmin, dmax);
+    }
+};
+
+/// @brief Stage 2: picks each relevant tet's layer and inserts it into every cell its box overlaps.
+/// A tet is relevant when its object's self-collision is on, or when its box overlaps another object
+/// it is checked against (inter-object culling: only tets in the overlap region enter the grid).
+struct PopulateKernel {
+    SceneView scene;
+    GridView grid;
+    GridParams params;
+    std::uint32_t* layer_mask;
+
+    KDET_HD bool relevant(std::uint32_t object, const Aabb& box) const {
+        if (pair_is_active(scene, object, object)) return true;
+        for (std::uint32_t other = 0; other < scene.object_count; ++other)
+            if (other != object && pair_is_active(scene, object, other) && boxes_overlap(box, scene.object_boxes[other]))
+                return true;
+        return false;
+    }
+
+    KDET_HD void operator()(std::uint64_t t) const {
+        TetInfo& info = scene.info[t];
+        if (!relevant(scene.tet_object[t], info.box)) {
+            info.layer = -1;
+            return;
+        }
+        const int layer = layer_of(params, info.diameter);
+        info.layer = layer;
+        const std::uint32_t bit = 1u << layer;
+        if (!(atomic_load_acquire(layer_mask) & bit)) atomic_fetch_or(layer_mask, bit);
+        const CellRange r = cell_range(params, info.box, layer);
+        for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+            for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
+                    if (!grid_insert(grid, make_cell(x, y, z, layer), static_cast<std::uint32_t>(t))) return;
+    }
+};
+
+/// @brief Calls visit(u) for every tet u that tet t must test: u is stored in a cell that t's box
+/// overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
+/// higher id, so each direction of a pair is found by one tet only), the objects are checked against
+/// each other, and the boxes overlap. Adjacency and the narrow phase are left to the caller.
+template <class Visitor>
+struct LargerNeighbourFilter {
+    const SceneView* scene;
+    std::uint32_t t;
+    std::uint32_t object;
+    int layer;
+    Aabb box;
+    Visitor* visit;
+
+    KDET_HD void operator()(std::uint32_t u) const {
+        const TetInfo& other = scene->info[u];
+        if (other.layer == layer && u <= t) return;
+        if (!pair_is_active(*scene, object, scene->tet_object[u])) return;
+        if (!boxes_overlap(box, other.box)) return;
+        (*visit)(u);
+    }
+};
+
+template <class Visitor>
+KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const GridView& grid, const GridParams& params,
+                                             std::uint32_t layer_mask, std::uint32_t t, Visitor& visit) {
+    const TetInfo self = scene.info[t];
+    if (self.layer < 0) return;
+    LargerNeighbourFilter<Visitor> filter{&scene, t, scene.tet_object[t], self.layer, self.box, &visit};
+    for (int layer = self.layer; layer < params.layer_count; ++layer) {
+        if (!((layer_mask >> layer) & 1u)) continue;
+        const CellRange r = cell_range(params, self.box, layer);
+        for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+            for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
+                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), filter);
+    }
+}
+
+/// @brief Appends to a buffer of `capacity` keys; the counter keeps counting past it so the host
+/// learns the size it needs, grows the buffer and reruns the stage.
+struct KeyAppender {
+    std::uint64_t* keys;
+    std::uint64_t capacity;
+    unsigned long long* count;
+    KDET_HD void push(std::uint64_t key) const {
+        const unsigned long long index = atomic_fetch_add(count, 1ull);
+        if (index < capacity) keys[index] = key;
+    }
+};
+
+/// @brief Stage 3 (kdet): writes candidate pairs, duplicates included.
+struct FindCandidatesKernel {
+    SceneView scene;
+    GridView grid;
+    GridParams params;
+    std::uint32_t layer_mask;
+    KeyAppender out;
+
+    struct Emit {
+        const SceneView* scene;
+        const KeyAppender* out;
+        std::uint32_t t;
+        TetIndices tet;
+        std::uint32_t object;
+        KDET_HD void operator()(std::uint32_t u) const {
+            if (scene->tet_object[u] == object && share_vertex(tet, scene->tets[u])) return;
+            out->push(pair_key(t, u));
+        }
+    };
+
+    KDET_HD void operator()(std::uint64_t i) const {
+        const auto t = static_cast<std::uint32_t>(i);
+        Emit emit{&scene, &out, t, scene.tets[t], scene.tet_object[t]};
+        for_each_larger_neighbour(scene, grid, params, layer_mask, t, emit);
+    }
+};
+
+/// @brief The thesis's old method (algorithm 4.2): test inline and only flag colliding tets,
+/// skipping a pair when both tets are already flagged.
+struct NoPairsKernel {
+    SceneView scene;
+    GridView grid;
+    GridParams params;
+    std::uint32_t layer_mask;
+    NarrowPhase test;
+    std::uint32_t* colliding;
+    unsigned long long* tests_run;
+
+    struct TestAndFlag {
+        const NoPairsKernel* kernel;
+        std::uint32_t t;
+        unsigned long long tests;
+        KDET_HD void operator()(std::uint32_t u) {
+            std::uint32_t* flags = kernel->colliding;
+            if (atomic_load_acquire(&flags[t]) && atomic_load_acquire(&flags[u])) return;
+            ++tests;
+            if (tets_collide(kernel->scene, kernel->test, t, u)) {
+                atomic_store_relaxed(&flags[t], 1u);
+                atomic_store_relaxed(&flags[u], 1u);
+            }
+        }
+    };
+
+    KDET_HD void operator()(std::uint64_t i) const {
+        TestAndFlag visit{this, static_cast<std::uint32_t>(i), 0};
+        for_each_larger_neighbour(scene, grid, params, layer_mask, visit.t, visit);
+        if (visit.tests) atomic_fetch_add(tests_run, visit.tests);
+    }
+};
+
+/// @brief Brute force, one work item per tet: tests it against every later tet it may collide with.
+struct BruteForceLoopKernel {
+    SceneView scene;
+    NarrowPhase test;
+    const std::uint32_t* object_tet_begin; ///< [object_count + 1]
+    KeyAppender out;
+
+    KDET_HD void operator()(std::uint64_t i) const {
+        const auto t = static_cast<std::uint32_t>(i);
+        const std::uint32_t object = scene.tet_object[t];
+        for (std::uint32_t other = object; other < scene.object_count; ++other) {
+            if (!pair_is_active(scene, object, other)) continue;
+            const std::uint32_t begin = other == object ? t + 1 : object_tet_begin[other];
+            for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u)
+                if (tets_collide(scene, test, t, u)) out.push(pair_key(t, u));
+        }
+    }
+};
+
+/// @brief Brute force, one work item per pair. Work is laid out in blocks, one per active object
+/// pair; a self block enumerates i < j row by row.
+struct BruteForcePairsKernel {
+    SceneView scene;
+    NarrowPhase test;
+    const std::uint32_t* object_tet_begin; ///< [object_count + 1]
+    const std::uint64_t* block_begin;      ///< [block_count + 1] work offsets
+    const std::uint32_t* block_objects;    ///< [2 * block_count]
+    std::uint32_t block_count;
+    KeyAppender out;
+
+    KDET_HD void operator()(std::uint64_t work) const {
+        std::uint32_t b = 0;
+        while (b + 1 < block_count && block_begin[b + 1] <= work) ++b;
+        const std::uint64_t r = work - block_begin[b];
+        const std::uint32_t oa = block_objects[2 * b], ob = block_objects[2 * b + 1];
+        std::uint64_t i, j;
+        if (oa == ob) {
+            const std::uint64_t n = object_tet_begin[oa + 1] - object_tet_begin[oa];
+            // Row i holds n-1-i pairs; invert the row offsets with a square root, then fix rounding.
+            const double m = 2.0 * static_cast<double>(n) - 1.0;
+            double guess = (m - sqrt(m * m - 8.0 * static_cast<double>(r))) * 0.5;
+            i = guess > 0.0 ? static_cast<std::uint64_t>(guess) : 0;
+            auto row_start = [n](std::uint64_t row) { return row * (2 * n - row - 1) / 2; };
+            while (i > 0 && row_start(i) > r) --i;
+            while (row_start(i + 1) <= r) ++i;
+            j = i + 1 + (r - row_start(i));
+        } else {
+            const std::uint64_t nb = object_tet_begin[ob + 1] - object_tet_begin[ob];
+            i = r / nb;
+            j = r % nb;
+        }
+        const auto t = static_cast<std::uint32_t>(object_tet_begin[oa] + i);
+        const auto u = static_cast<std::uint32_t>(object_tet_begin[ob] + j);
+        if (tets_collide(scene, test, t, u)) out.push(pair_key(t, u));
+    }
+};
+
+/// @brief Stage 5: runs the narrow phase once per unique candidate and flags colliding tets.
+struct NarrowPhaseKernel {
+    SceneView scene;
+    NarrowPhase test;
+    const std::uint64_t* keys;
+    std::uint32_t* hit;
+    Contact* contacts; ///< null when contacts are off
+    std::uint32_t* colliding;
+
+    KDET_HD void operator()(std::uint64_t k) const {
+        const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
+        vec3 a[4], b[4];
+        load_tet(scene, t, a);
+        load_tet(scene, u, b);
+        const bool collides = tets_intersect(test, a, b);
+        hit[k] = collides ? 1u : 0u;
+        if (!collides) return;
+        atomic_store_relaxed(&colliding[t], 1u);
+        atomic_store_relaxed(&colliding[u], 1u);
+        if (contacts) {
+            float depth = 0.0f;
+            vec3 direction{0.0f, 0.0f, 0.0f};
+            tets_intersect_sat_mtv(a, b, depth, direction);
+            contacts[k] = Contact{depth, {direction.x, direction.y, direction.z}};
+        }
+    }
+};
+
+/// @brief Stage 5: moves the colliding pairs (and contacts) to the front, keeping their sorted order.
+struct CompactKernel {
+    const std::uint64_t* keys;
+    const std::uint32_t* hit;
+    const std::uint32_t* position;
+    const Contact* contacts;
+    std::uint64_t* out_keys;
+    Contact* out_contacts;
+    KDET_HD void operator()(std::uint64_t k) const {
+        if (!hit[k]) return;
+        out_keys[position[k]] = keys[k];
+        if (contacts) out_contacts[position[k]] = contacts[k];
+    }
+};
+
+/// @brief Sets every element of a buffer to one value.
+template <class T>
+struct FillKernel {
+    T* data;
+    T value;
+    KDET_HD void operator()(std::uint64_t i) const { data[i] = value; }
+};
+
+} // namespace kdet

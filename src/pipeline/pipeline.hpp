@@ -1,0 +1,409 @@
+#pragma once
+/// @file pipeline.hpp
+/// @brief The per-frame pipeline, written once over an execution layer (CpuExec or CudaExec).
+/// The host part only sizes buffers, reads back a few counters and decides when to grow and rerun.
+
+#include "pipeline/pipeline_base.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace kdet {
+
+/// @brief Frame-to-frame state kept on the host side of a pipeline.
+struct FrameCounters {
+    unsigned long long candidates;
+    unsigned long long tests_run;
+    std::uint32_t grid_failure;
+    std::uint32_t overflow_used;
+    std::uint32_t layer_mask;
+    std::uint32_t unused;
+};
+
+template <class Exec>
+class Pipeline final : public PipelineBase {
+    template <class T>
+    using buffer = typename Exec::template buffer<T>;
+
+public:
+    explicit Pipeline(const DetectorOptions& options)
+        : exec_(options.threads, options.block_size), options_(options) {}
+
+    void set_topology(const SceneTopology& topology) override {
+        topology_ = topology;
+        const std::size_t tets = topology.tets.size();
+        tets_.resize_discard(tets);
+        exec_.upload(tets_.data(), topology.tets.data(), tets);
+        tet_object_.resize_discard(tets);
+        exec_.upload(tet_object_.data(), topology.tet_object.data(), tets);
+        object_tet_begin_.resize_discard(topology.object_tet_begin.size());
+        exec_.upload(object_tet_begin_.data(), topology.object_tet_begin.data(), topology.object_tet_begin.size());
+        positions_.resize_discard(topology.vertex_count);
+        info_.resize_discard(tets);
+        colliding_.resize_discard(tets);
+        const std::size_t objects = topology.object_tet_begin.size() - 1;
+        stats_.resize_discard(objects);
+        object_boxes_.resize_discard(objects);
+        pair_active_.resize_discard(objects * objects);
+    }
+
+    void set_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
+        exec_.upload(positions_.data() + first, positions, count);
+    }
+
+    std::size_t memory_bytes() const override {
+        return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
+               positions_.capacity_bytes() + info_.capacity_bytes() + colliding_.capacity_bytes() +
+               stats_.capacity_bytes() + object_boxes_.capacity_bytes() + pair_active_.capacity_bytes() +
+               headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
+               candidates_.capacity_bytes() + hit_.capacity_bytes() + position_.capacity_bytes() +
+               contacts_.capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
+               blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes();
+    }
+
+    std::string device_name() const override { return exec_.device_name(); }
+
+    void detect(const std::vector<std::uint8_t>& pair_enabled, FrameResult& result) override;
+
+private:
+    SceneView scene_view() {
+        return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), pair_active_.data(),
+                         object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
+                         static_cast<std::uint32_t>(stats_.size())};
+    }
+    template <class T>
+    void fill(buffer<T>& b, T value) {
+        exec_.for_each(b.size(), FillKernel<T>{b.data(), value});
+    }
+    FrameCounters read_counters() {
+        FrameCounters c;
+        exec_.download(&c, counters_.data(), 1);
+        return c;
+    }
+    void reset_counters() {
+        const FrameCounters zero{};
+        counters_.resize_discard(1);
+        exec_.upload(counters_.data(), &zero, 1);
+    }
+
+    bool compute_bounds_and_culling(const std::vector<std::uint8_t>& pair_enabled);
+    GridView populate(FrameCounts& counts);
+    void find_candidates(const GridView& grid, FrameCounts& counts);
+    void brute_force(FrameCounts& counts);
+    void narrow_phase_and_compact(std::size_t unique, FrameResult& result);
+    KeyAppender candidate_appender() {
+        return KeyAppender{candidates_.data(), candidates_.size(), &counters_.data()->candidates};
+    }
+    void ensure_candidate_capacity(std::size_t relevant_tets);
+
+    Exec exec_;
+    DetectorOptions options_;
+    SceneTopology topology_;
+    GridParams params_{};
+    std::uint32_t stamp_ = 0;
+    std::size_t relevant_estimate_ = 0;
+
+    buffer<TetIndices> tets_;
+    buffer<std::uint32_t> tet_object_;
+    buffer<std::uint32_t> object_tet_begin_;
+    buffer<vec3> positions_;
+    buffer<TetInfo> info_;
+    buffer<std::uint32_t> colliding_;
+    buffer<ObjectStats> stats_;
+    buffer<Aabb> object_boxes_;
+    buffer<std::uint8_t> pair_active_;
+    buffer<BucketHeader> headers_;
+    buffer<std::uint32_t> ids_;
+    buffer<FrameCounters> counters_;
+    buffer<std::uint64_t> candidates_;
+    buffer<std::uint32_t> hit_;
+    buffer<std::uint32_t> position_;
+    buffer<Contact> contacts_;
+    buffer<std::uint64_t> out_keys_;
+    buffer<Contact> out_contacts_;
+    buffer<std::uint64_t> blocks_begin_;
+    buffer<std::uint32_t> block_objects_;
+    std::uint32_t slot_count_ = 0;
+    std::uint32_t overflow_capacity_ = 0;
+    std::uint32_t layer_mask_ = 0;
+};
+
+/// @brief Stage 1. Returns false when no enabled pair of objects can collide this frame.
+template <class Exec>
+bool Pipeline<Exec>::compute_bounds_and_culling(const std::vector<std::uint8_t>& pair_enabled) {
+    const std::size_t objects = stats_.size();
+    const std::uint32_t tets = static_cast<std::uint32_t>(tets_.size());
+    SceneView scene = scene_view();
+    exec_.for_each(tets, TetBoundsKernel{scene});
+
+    std::vector<ObjectStats> stats(objects);
+    for (auto& s : stats) {
+        for (int a = 0; a < 3; ++a) {
+            s.lo[a] = float_to_ordered(std::numeric_limits<float>::infinity());
+            s.hi[a] = float_to_ordered(-std::numeric_limits<float>::infinity());
+        }
+        s.min_diameter = float_to_ordered(std::numeric_limits<float>::infinity());
+        s.max_diameter = float_to_ordered(0.0f);
+    }
+    exec_.upload(stats_.data(), stats.data(), objects);
+    constexpr std::uint32_t chunk = 256;
+    exec_.for_each((tets + chunk - 1) / chunk, ObjectStatsKernel{scene, stats_.data(), chunk});
+    exec_.download(stats.data(), stats_.data(), objects);
+
+    std::vector<Aabb> boxes(objects);
+    for (std::size_t o = 0; o < objects; ++o)
+        boxes[o] = Aabb{{ordered_to_float(stats[o].lo[0]), ordered_to_float(stats[o].lo[1]),
+                         ordered_to_float(stats[o].lo[2])},
+                        {ordered_to_float(stats[o].hi[0]), ordered_to_float(stats[o].hi[1]),
+                         ordered_to_float(stats[o].hi[2])}};
+
+    // Object-level culling: a pair of objects is only checked when their boxes overlap.
+    std::vector<std::uint8_t> active(objects * objects, 0);
+    std::vector<bool> involved(objects, false);
+    bool any = false;
+    for (std::size_t a = 0; a < objects; ++a)
+        for (std::size_t b = 0; b < objects; ++b) {
+            const bool empty = topology_.object_tet_begin[a] == topology_.object_tet_begin[a + 1] ||
+                               topology_.object_tet_begin[b] == topology_.object_tet_begin[b + 1];
+            const bool on = !empty && pair_enabled[a * objects + b] && (a == b || boxes_overlap(boxes[a], boxes[b]));
+            active[a * objects + b] = on ? 1 : 0;
+            if (on) involved[a] = involved[b] = any = true;
+        }
+    exec_.upload(pair_active_.data(), active.data(), active.size());
+    exec_.upload(object_boxes_.data(), boxes.data(), objects);
+    if (!any) return false;
+
+    // Grid geometry: c0 is the smallest size among the objects that take part, so the smallest tets
+    // sit on layer 0; enough layers to hold the largest tets, capped at max_grid_layers.
+    vec3 origin{std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
+                std::numeric_limits<float>::infinity()};
+    float dmin = std::numeric_limits<float>::infinity(), dmax = 0.0f;
+    relevant_estimate_ = 0;
+    for (std::size_t o = 0; o < objects; ++o) {
+        if (!involved[o]) continue;
+        origin = min_v(origin, boxes[o].lo);
+        dmin = std::min(dmin, ordered_to_float(stats[o].min_diameter));
+        dmax = std::max(dmax, ordered_to_float(stats[o].max_diameter));
+        relevant_estimate_ += topology_.object_tet_begin[o + 1] - topology_.object_tet_begin[o];
+    }
+    // Zero-size tets (allowed only when the caller asked for degenerate input) must not make c0 zero.
+    const float floor_size = std::max(dmax * 1e-6f, std::numeric_limits<float>::min() * 1e6f);
+    const float c0 = std::max(dmin, floor_size);
+    int layers = 1;
+    while (layers < max_grid_layers && std::ldexp(c0, layers - 1) < dmax) ++layers;
+    params_ = GridParams{origin, c0, 1.0f / c0, layers};
+    return true;
+}
+
+/// @brief Stage 2: fills the hash table; grows it and reruns when probing or the overflow pool fails.
+template <class Exec>
+GridView Pipeline<Exec>::populate(FrameCounts& counts) {
+    const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
+    std::uint32_t wanted_slots = 1024;
+    while (wanted_slots < relevant_estimate_ / 8 && wanted_slots < (1u << 30)) wanted_slots *= 2;
+    slot_count_ = std::max(slot_count_, wanted_slots);
+    overflow_capacity_ = std::max(overflow_capacity_, slot_count_ / 4);
+    for (;;) {
+        const std::size_t buckets = static_cast<std::size_t>(slot_count_) + overflow_capacity_;
+        if (headers_.size() != buckets) {
+            headers_.resize_discard(buckets);
+            ids_.resize_discard(buckets * capacity);
+            fill(headers_, BucketHeader{}); // stamp 0 is never current, so this empties the table
+            stamp_ = 0;
+        }
+        if (++stamp_ >= 0x7fffffffu) { // the stamp is about to wrap: clear once instead
+            fill(headers_, BucketHeader{});
+            stamp_ = 1;
+        }
+        reset_counters();
+        FrameCounters* c = counters_.data();
+        std::uint32_t slot_bits = 0;
+        while ((1u << slot_bits) < slot_count_) ++slot_bits;
+        GridView grid{headers_.data(), ids_.data(), &c->overflow_used, &c->grid_failure, slot_count_, slot_bits,
+                      capacity, overflow_capacity_, stamp_, 64u, options_.hash};
+        exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, params_, &c->layer_mask});
+        const FrameCounters after = read_counters();
+        if (!after.grid_failure) {
+            layer_mask_ = after.layer_mask;
+            return grid;
+        }
+        if (after.grid_failure & grid_table_full) slot_count_ *= 2;
+        if (after.grid_failure & grid_overflow_pool_full) overflow_capacity_ = std::max(overflow_capacity_ * 2, after.overflow_used);
+        ++counts.buffer_regrows;
+    }
+}
+
+template <class Exec>
+void Pipeline<Exec>::ensure_candidate_capacity(std::size_t relevant_tets) {
+    // Linear in the tets (thesis 7.3): k-freeness bounds the larger neighbours of each tet.
+    const std::size_t estimate = options_.initial_candidate_capacity
+                                     ? options_.initial_candidate_capacity
+                                     : std::max<std::size_t>(4096, 16 * relevant_tets);
+    if (candidates_.size() < estimate) candidates_.resize_discard(estimate);
+}
+
+/// @brief Stage 3: candidate pairs with duplicates; grows the buffer to the exact need and reruns.
+template <class Exec>
+void Pipeline<Exec>::find_candidates(const GridView& grid, FrameCounts& counts) {
+    ensure_candidate_capacity(relevant_estimate_);
+    for (;;) {
+        reset_counters();
+        exec_.for_each(tets_.size(), FindCandidatesKernel{scene_view(), grid, params_, layer_mask_, candidate_appender()});
+        const FrameCounters after = read_counters();
+        counts.candidates = after.candidates;
+        if (after.candidates <= candidates_.size()) return;
+        candidates_.resize_discard(after.candidates + after.candidates / 4);
+        ++counts.buffer_regrows;
+    }
+}
+
+/// @brief Both brute-force methods: every pair of enabled objects is tested, colliding pairs appended.
+template <class Exec>
+void Pipeline<Exec>::brute_force(FrameCounts& counts) {
+    const std::size_t objects = stats_.size();
+    std::vector<std::uint8_t> active(objects * objects);
+    exec_.download(active.data(), pair_active_.data(), active.size());
+    std::vector<std::uint64_t> block_begin{0};
+    std::vector<std::uint32_t> block_objects;
+    if (options_.method == Method::brute_force_pairs) {
+        for (std::uint32_t a = 0; a < objects; ++a)
+            for (std::uint32_t b = a; b < objects; ++b) {
+                if (!active[a * objects + b]) continue;
+                const std::uint64_t na = topology_.object_tet_begin[a + 1] - topology_.object_tet_begin[a];
+                const std::uint64_t nb = topology_.object_tet_begin[b + 1] - topology_.object_tet_begin[b];
+                block_begin.push_back(block_begin.back() + (a == b ? na * (na - 1) / 2 : na * nb));
+                block_objects.push_back(a);
+                block_objects.push_back(b);
+            }
+        blocks_begin_.resize_discard(block_begin.size());
+        exec_.upload(blocks_begin_.data(), block_begin.data(), block_begin.size());
+        block_objects_.resize_discard(block_objects.size());
+        exec_.upload(block_objects_.data(), block_objects.data(), block_objects.size());
+    }
+    if (candidates_.size() == 0) candidates_.resize_discard(4096);
+    for (;;) {
+        reset_counters();
+        if (options_.method == Method::brute_force_pairs)
+            exec_.for_each(block_begin.back(),
+                           BruteForcePairsKernel{scene_view(), options_.narrow_phase, object_tet_begin_.data(),
+                                                 blocks_begin_.data(), block_objects_.data(),
+                                                 static_cast<std::uint32_t>(block_objects.size() / 2),
+                                                 candidate_appender()});
+        else
+            exec_.for_each(tets_.size(), BruteForceLoopKernel{scene_view(), options_.narrow_phase,
+                                                              object_tet_begin_.data(), candidate_appender()});
+        const FrameCounters after = read_counters();
+        counts.candidates = after.candidates;
+        if (after.candidates <= candidates_.size()) return;
+        candidates_.resize_discard(after.candidates + after.candidates / 4);
+        ++counts.buffer_regrows;
+    }
+}
+
+/// @brief Stage 5: the narrow phase once per unique candidate, then the colliding pairs in sorted order.
+template <class Exec>
+void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& result) {
+    hit_.resize_discard(unique);
+    position_.resize_discard(unique);
+    Contact* contacts = nullptr;
+    if (options_.contacts) {
+        contacts_.resize_discard(unique);
+        contacts = contacts_.data();
+    }
+    exec_.for_each(unique, NarrowPhaseKernel{scene_view(), options_.narrow_phase, candidates_.data(), hit_.data(),
+                                             contacts, colliding_.data()});
+    const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), unique);
+    out_keys_.resize_discard(colliding);
+    Contact* out_contacts = nullptr;
+    if (contacts) {
+        out_contacts_.resize_discard(colliding);
+        out_contacts = out_contacts_.data();
+    }
+    exec_.for_each(unique, CompactKernel{candidates_.data(), hit_.data(), position_.data(), contacts,
+                                         out_keys_.data(), out_contacts});
+
+    std::vector<std::uint64_t> keys(colliding);
+    exec_.download(keys.data(), out_keys_.data(), colliding);
+    const auto& begin = topology_.object_tet_begin;
+    auto locate = [&](std::uint32_t global, std::uint32_t& object, std::uint32_t& local) {
+        object = static_cast<std::uint32_t>(std::upper_bound(begin.begin(), begin.end(), global) - begin.begin() - 1);
+        local = global - begin[object];
+    };
+    result.pairs.resize(colliding);
+    for (std::size_t k = 0; k < colliding; ++k) {
+        TetPair& p = result.pairs[k];
+        locate(key_first(keys[k]), p.object_a, p.tet_a);
+        locate(key_second(keys[k]), p.object_b, p.tet_b);
+    }
+    result.contacts.resize(contacts ? colliding : 0);
+    if (contacts) exec_.download(result.contacts.data(), out_contacts, colliding);
+    result.counts.colliding_pairs = colliding;
+}
+
+template <class Exec>
+void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, FrameResult& result) {
+    typename Exec::stage_timer total, stage;
+    total.start();
+    result.pairs.clear();
+    result.contacts.clear();
+    result.counts = FrameCounts{};
+    result.times = StageTimes{};
+    FrameCounts& counts = result.counts;
+
+    stage.start();
+    fill(colliding_, 0u);
+    const bool any = tets_.size() > 0 && compute_bounds_and_culling(pair_enabled);
+    result.times.bounding_boxes = stage.stop_ms();
+
+    if (any) {
+        const Method method = options_.method;
+        std::size_t unique = 0;
+        if (method == Method::kdet || method == Method::kdet_no_pairs) {
+            stage.start();
+            const GridView grid = populate(counts);
+            result.times.populate_grid = stage.stop_ms();
+            stage.start();
+            if (method == Method::kdet) {
+                find_candidates(grid, counts);
+            } else {
+                reset_counters();
+                exec_.for_each(tets_.size(), NoPairsKernel{scene_view(), grid, params_, layer_mask_,
+                                                           options_.narrow_phase, colliding_.data(),
+                                                           &counters_.data()->tests_run});
+                counts.candidates = counts.unique_candidates = read_counters().tests_run;
+            }
+            result.times.find_candidates = stage.stop_ms();
+        } else {
+            stage.start();
+            brute_force(counts);
+            result.times.find_candidates = stage.stop_ms();
+        }
+        if (method != Method::kdet_no_pairs) {
+            stage.start();
+            unique = exec_.sort_unique(candidates_.data(), counts.candidates);
+            counts.unique_candidates = unique;
+            result.times.sort_unique = stage.stop_ms();
+            stage.start();
+            narrow_phase_and_compact(unique, result);
+            result.times.narrow_phase = stage.stop_ms();
+        }
+    }
+
+    const std::size_t objects = stats_.size();
+    std::vector<std::uint32_t> flags(tets_.size());
+    exec_.download(flags.data(), colliding_.data(), flags.size());
+    result.colliding.resize(objects);
+    for (std::size_t o = 0; o < objects; ++o) {
+        const std::uint32_t b = topology_.object_tet_begin[o], e = topology_.object_tet_begin[o + 1];
+        result.colliding[o].assign(e - b, 0);
+        for (std::uint32_t t = b; t < e; ++t) {
+            result.colliding[o][t - b] = flags[t] ? 1 : 0;
+            counts.colliding_tets += flags[t] ? 1 : 0;
+        }
+    }
+    result.memory_bytes = memory_bytes();
+    result.times.total = total.stop_ms();
+}
+
+} // namespace kdet

@@ -1,0 +1,40 @@
+#pragma once
+/// @file pipeline_base.hpp
+/// @brief The interface a Detector drives; one implementation per backend, both from pipeline.hpp.
+
+#include "pipeline/kernels.hpp"
+
+#include <kdet/options.hpp>
+#include <kdet/results.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace kdet {
+
+/// @brief Objects as the pipeline sees them: concatenated, with per-object tet ranges.
+struct SceneTopology {
+    std::vector<TetIndices> tets;               ///< global vertex ids
+    std::vector<std::uint32_t> tet_object;
+    std::vector<std::uint32_t> object_tet_begin; ///< [objects + 1]
+    std::uint32_t vertex_count = 0;
+};
+
+class PipelineBase {
+public:
+    virtual ~PipelineBase() = default;
+    /// @brief Replaces all geometry; positions must be set again afterwards.
+    virtual void set_topology(const SceneTopology& topology) = 0;
+    /// @brief Copies `count` positions starting at global vertex `first`.
+    virtual void set_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
+    /// @brief One detection; pair_enabled is [objects * objects], symmetric, diagonal = self-collision.
+    virtual void detect(const std::vector<std::uint8_t>& pair_enabled, FrameResult& result) = 0;
+    virtual std::size_t memory_bytes() const = 0;
+    virtual std::string device_name() const = 0;
+};
+
+std::unique_ptr<PipelineBase> make_cpu_pipeline(const DetectorOptions& options);
+/// @brief Throws kdet::Error when kdet was built without CUDA or no CUDA device is present.
+std::unique_ptr<PipelineBase> make_cuda_pipeline(const DetectorOptions& options);
+
+} // namespace kdet

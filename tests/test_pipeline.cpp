@@ -1,0 +1,250 @@
+// Every method must return exactly the pair set of brute force; the flags of kdet_no_pairs must equal
+// the tets that appear in brute force's pairs.
+
+#include "test_support.hpp"
+
+#include <kdet/detector.hpp>
+#include <kdet/error.hpp>
+#include <kdet/scenes.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+namespace kdet {
+namespace {
+
+using test::load_model;
+using test::moved;
+using test::random_soup;
+
+struct Outcome {
+    std::vector<TetPair> pairs;
+    std::vector<std::vector<std::uint8_t>> colliding;
+    FrameCounts counts;
+};
+
+Outcome run(const std::vector<TetMesh>& meshes, bool self, DetectorOptions options) {
+    Detector detector(options);
+    for (const TetMesh& m : meshes) detector.set_self_collision(detector.add_object(m), self);
+    const FrameResult& r = detector.detect();
+    return Outcome{r.pairs, r.colliding, r.counts};
+}
+
+DetectorOptions with_method(Method method) {
+    DetectorOptions o;
+    o.method = method;
+    return o;
+}
+
+/// Flags implied by a pair list.
+std::vector<std::vector<std::uint8_t>> flags_of(const std::vector<TetPair>& pairs,
+                                                const std::vector<std::vector<std::uint8_t>>& shape) {
+    auto flags = shape;
+    for (auto& f : flags) std::fill(f.begin(), f.end(), 0);
+    for (const TetPair& p : pairs) flags[p.object_a][p.tet_a] = flags[p.object_b][p.tet_b] = 1;
+    return flags;
+}
+
+void expect_same_as_brute_force(const std::vector<TetMesh>& meshes, bool self, std::size_t min_pairs) {
+    const Outcome oracle = run(meshes, self, with_method(Method::brute_force_loop));
+    ASSERT_GE(oracle.pairs.size(), min_pairs);
+    ASSERT_TRUE(std::is_sorted(oracle.pairs.begin(), oracle.pairs.end()));
+    ASSERT_EQ(std::adjacent_find(oracle.pairs.begin(), oracle.pairs.end()), oracle.pairs.end());
+    for (const TetPair& p : oracle.pairs) {
+        ASSERT_TRUE(p.object_a < p.object_b || (p.object_a == p.object_b && p.tet_a < p.tet_b));
+        ASSERT_TRUE(self || p.object_a != p.object_b);
+    }
+    for (HashFunction hash : {HashFunction::djb2, HashFunction::fnv1a, HashFunction::simple, HashFunction::morton}) {
+        DetectorOptions o = with_method(Method::kdet);
+        o.hash = hash;
+        EXPECT_EQ(run(meshes, self, o).pairs, oracle.pairs) << "kdet with hash " << to_string(hash);
+    }
+    const Outcome no_pairs = run(meshes, self, with_method(Method::kdet_no_pairs));
+    EXPECT_TRUE(no_pairs.pairs.empty());
+    EXPECT_EQ(no_pairs.colliding, flags_of(oracle.pairs, oracle.colliding));
+    EXPECT_EQ(oracle.colliding, flags_of(oracle.pairs, oracle.colliding));
+}
+
+TEST(Pipeline, RandomSoupsSpanningThreeDecadesMatchBruteForce) {
+    for (unsigned seed : {1u, 2u, 3u}) {
+        const TetMesh a = random_soup(1500, 10.0, 3.0, seed);
+        const TetMesh b = random_soup(1500, 10.0, 3.0, seed + 100);
+        expect_same_as_brute_force({a, b}, false, 20);
+        EXPECT_EQ(run({a, b}, false, with_method(Method::brute_force_pairs)).pairs,
+                  run({a, b}, false, with_method(Method::brute_force_loop)).pairs);
+    }
+}
+
+TEST(Pipeline, RandomSoupSelfCollisionMatchesBruteForce) {
+    const TetMesh soup = random_soup(3000, 10.0, 3.0, 7);
+    expect_same_as_brute_force({soup}, true, 20);
+    EXPECT_EQ(run({soup}, true, with_method(Method::brute_force_pairs)).pairs,
+              run({soup}, true, with_method(Method::brute_force_loop)).pairs);
+}
+
+TEST(Pipeline, ThreeObjectsWithSelfCollisionMatchBruteForce) {
+    expect_same_as_brute_force({random_soup(800, 5.0, 2.0, 11), random_soup(900, 5.0, 2.0, 12),
+                                random_soup(700, 5.0, 2.0, 13)},
+                               true, 20);
+}
+
+class RealMesh : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(RealMesh, OverlappingCopyMatchesBruteForce) {
+    const TetMesh mesh = load_model(GetParam());
+    const double e = test::extent_of(mesh);
+    expect_same_as_brute_force({mesh, moved(mesh, 0.3, 0.1 * e, 0.05 * e, 0.02 * e)}, false, 100);
+}
+
+TEST_P(RealMesh, UndeformedMeshHasNoSelfCollision) {
+    const TetMesh mesh = load_model(GetParam());
+    for (Method m : {Method::kdet, Method::brute_force_loop}) {
+        const Outcome r = run({mesh}, true, with_method(m));
+        EXPECT_TRUE(r.pairs.empty()) << to_string(m) << " found " << r.pairs.size() << " pairs";
+        EXPECT_EQ(r.counts.colliding_tets, 0u);
+    }
+    EXPECT_GT(run({mesh}, true, with_method(Method::kdet)).counts.candidates, 0u); // the grid did find neighbours
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, RealMesh, ::testing::Values("bunny.mesh", "hand.mesh", "octopus-low.mesh"));
+
+TEST(Pipeline, FoldedBarSelfCollidesLikeBruteForce) {
+    const TetMesh bar = make_box_mesh(60, 4, 4, 0.1);
+    TetMesh folded = bar;
+    fold_bar(bar, 2.0 * 3.14159265358979 * 1.15, folded.positions);
+    expect_same_as_brute_force({folded}, true, 50);
+    TetMesh gently = bar;
+    fold_bar(bar, 3.14159265358979, gently.positions);
+    EXPECT_TRUE(run({gently}, true, with_method(Method::kdet)).pairs.empty());
+}
+
+TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
+    const TetMesh a = random_soup(2000, 4.0, 2.0, 21), b = random_soup(2000, 4.0, 2.0, 22);
+    const Outcome reference = run({a, b}, true, with_method(Method::kdet));
+    ASSERT_GT(reference.pairs.size(), 50u);
+    DetectorOptions tiny = with_method(Method::kdet);
+    tiny.initial_candidate_capacity = 1;
+    tiny.bucket_capacity = 1; // every cell with two tets chains overflow buckets
+    const Outcome small = run({a, b}, true, tiny);
+    EXPECT_EQ(small.pairs, reference.pairs);
+    EXPECT_GT(small.counts.buffer_regrows, 0u);
+    DetectorOptions tiny_brute = with_method(Method::brute_force_pairs);
+    tiny_brute.initial_candidate_capacity = 1;
+    EXPECT_EQ(run({a, b}, true, tiny_brute).pairs, reference.pairs);
+}
+
+TEST(Pipeline, ThreadCountDoesNotChangeTheAnswer) {
+    const TetMesh a = random_soup(3000, 6.0, 2.0, 31), b = random_soup(3000, 6.0, 2.0, 32);
+    DetectorOptions one = with_method(Method::kdet), two = one;
+    one.threads = 1;
+    two.threads = 2;
+    const Outcome r1 = run({a, b}, true, one), r2 = run({a, b}, true, two);
+    EXPECT_EQ(r1.pairs, r2.pairs);
+    EXPECT_EQ(r1.counts.unique_candidates, r2.counts.unique_candidates);
+}
+
+TEST(Detector, FrameByFrameMatchesOneOffQueries) {
+    ProceduralSceneOptions scene_options;
+    scene_options.total_tets = 4000;
+    scene_options.frames = 9;
+    const ProceduralScene scene(scene_options);
+    Detector detector;
+    for (std::size_t o = 0; o < 2; ++o) detector.add_object(scene.rest_mesh(o));
+    std::size_t frames_with_pairs = 0;
+    for (int f = 0; f < scene.num_frames(); ++f) {
+        std::vector<TetMesh> posed(2);
+        std::vector<float> xyz;
+        for (std::size_t o = 0; o < 2; ++o) {
+            scene.positions(o, f, xyz);
+            detector.set_positions(static_cast<ObjectId>(o), xyz.data(), xyz.size() / 3);
+            posed[o].tets = scene.rest_mesh(o).tets;
+            posed[o].positions.assign(xyz.begin(), xyz.end());
+        }
+        const std::vector<TetPair> pairs = detector.detect().pairs;
+        EXPECT_EQ(pairs, run(posed, false, with_method(Method::brute_force_loop)).pairs) << "frame " << f;
+        frames_with_pairs += pairs.empty() ? 0 : 1;
+    }
+    EXPECT_GE(frames_with_pairs, 3u);
+}
+
+TEST(Detector, PairAndSelfTogglesAreHonoured) {
+    const TetMesh a = random_soup(600, 3.0, 1.0, 41), b = random_soup(600, 3.0, 1.0, 42),
+                  c = random_soup(600, 3.0, 1.0, 43);
+    Detector detector;
+    const ObjectId ia = detector.add_object(a), ib = detector.add_object(b), ic = detector.add_object(c);
+    detector.set_pair_collision(ia, ib, false);
+    detector.set_self_collision(ic, true);
+    std::set<std::pair<std::uint32_t, std::uint32_t>> kinds;
+    for (const TetPair& p : detector.detect().pairs) kinds.insert({p.object_a, p.object_b});
+    EXPECT_EQ(kinds.count({ia, ib}), 0u);
+    EXPECT_EQ(kinds.count({ia, ia}), 0u);
+    EXPECT_EQ(kinds.count({ib, ib}), 0u);
+    EXPECT_EQ(kinds.count({ia, ic}), 1u);
+    EXPECT_EQ(kinds.count({ib, ic}), 1u);
+    EXPECT_EQ(kinds.count({ic, ic}), 1u);
+}
+
+TEST(Detector, SeparatedObjectsSkipEverythingAfterTheBoxCheck) {
+    const TetMesh a = random_soup(500, 1.0, 1.0, 51);
+    Detector detector;
+    detector.add_object(a);
+    detector.add_object(moved(a, 0.0, 5.0, 0.0, 0.0));
+    const FrameResult& r = detector.detect();
+    EXPECT_TRUE(r.pairs.empty());
+    EXPECT_EQ(r.counts.candidates, 0u);
+    EXPECT_EQ(r.times.populate_grid, 0.0);
+}
+
+TEST(Detector, OneOffFunctionsReturnFileOrderIndices) {
+    const TetMesh a = random_soup(400, 2.0, 1.0, 61), b = random_soup(400, 2.0, 1.0, 62);
+    const auto pairs = collide(a, b);
+    const Outcome reference = run({a, b}, false, with_method(Method::brute_force_loop));
+    ASSERT_EQ(pairs.size(), reference.pairs.size());
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+        EXPECT_EQ(pairs[k].first, reference.pairs[k].tet_a);
+        EXPECT_EQ(pairs[k].second, reference.pairs[k].tet_b);
+    }
+    const auto self_pairs = collide_self(a);
+    for (const auto& p : self_pairs) EXPECT_LT(p.first, p.second);
+    EXPECT_EQ(self_pairs.size(), run({a}, true, with_method(Method::brute_force_loop)).pairs.size());
+}
+
+TEST(Detector, RejectsBadInputWithClearErrors) {
+    Detector detector;
+    const std::vector<float> xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const std::vector<std::uint32_t> bad = {0, 1, 2, 4};
+    EXPECT_THROW(detector.add_object(xyz.data(), 4, bad.data(), 1), Error);
+    std::vector<float> nan_xyz = xyz;
+    nan_xyz[4] = std::nanf("");
+    const std::vector<std::uint32_t> tet = {0, 1, 2, 3};
+    EXPECT_THROW(detector.add_object(nan_xyz.data(), 4, tet.data(), 1), Error);
+    const ObjectId id = detector.add_object(xyz.data(), 4, tet.data(), 1);
+    EXPECT_THROW(detector.set_positions(id, xyz.data(), 3), Error);
+    EXPECT_THROW(detector.set_positions(id + 1, xyz.data(), 4), Error);
+    EXPECT_THROW(detector.set_pair_collision(id, id, true), Error);
+    DetectorOptions cuda;
+    cuda.backend = Backend::cuda;
+#if !defined(KDET_HAS_CUDA)
+    EXPECT_THROW(Detector{cuda}, Error);
+#endif
+}
+
+TEST(Detector, ReportsMemoryAndStageTimes) {
+    const TetMesh a = random_soup(2000, 3.0, 1.0, 71), b = random_soup(2000, 3.0, 1.0, 72);
+    Detector detector;
+    detector.add_object(a);
+    detector.add_object(b);
+    const FrameResult& r = detector.detect();
+    EXPECT_GT(r.memory_bytes, 4000u * sizeof(float) * 12);
+    EXPECT_EQ(r.memory_bytes, detector.memory_bytes());
+    EXPECT_GT(r.times.total, 0.0);
+    EXPECT_GE(r.times.total, r.times.populate_grid + r.times.find_candidates);
+    EXPECT_GT(r.counts.candidates, 0u);
+    EXPECT_GE(r.counts.candidates, r.counts.unique_candidates);
+    EXPECT_GE(r.counts.unique_candidates, r.counts.colliding_pairs);
+}
+
+} // namespace
+} // namespace kdet
