@@ -1,0 +1,157 @@
+#include "commands.hpp"
+
+#include <kdet/detector.hpp>
+#include <kdet/error.hpp>
+#include <kdet/io.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace kdet::cli {
+
+namespace {
+
+const char* collide_help = R"(usage: kdet collide A [B] [options]
+
+Reports the colliding tetrahedron pairs between meshes A and B, or inside A with --self.
+A and B are TetGen meshes (name, name.node or name.ele) or MEDIT .mesh files.
+Tetrahedra of one mesh that share a vertex are adjacent and never reported.
+
+options:
+  --self               self-collision of A (give one mesh)
+  --pairs FILE         write 'i j' per line: 0-based tet indices in file order, sorted
+  --json               print one JSON object instead of text
+  --allow-degenerate   accept zero-volume tetrahedra (rejected by default)
+)";
+
+std::string json_number(double value) {
+    std::ostringstream out;
+    out.precision(6);
+    out << std::fixed << value;
+    return out.str();
+}
+
+void write_pairs(const std::string& path, const FrameResult& result) {
+    std::ofstream out(path);
+    if (!out) throw Error(path + ": cannot open file for writing");
+    for (const TetPair& p : result.pairs) out << p.tet_a << ' ' << p.tet_b << '\n';
+    out.flush();
+    if (!out) throw Error(path + ": write failed");
+}
+
+} // namespace
+
+void add_detector_options(ArgParser& parser, DetectorOptions& options) {
+    parser.option("--method", "method", [&](const std::string& v) {
+        if (!parse(v, options.method))
+            throw UsageError("invalid value '" + v + "' for --method: expected " +
+                             join_choices({"kdet", "kdet_no_pairs", "brute_force_loop", "brute_force_pairs"}));
+    });
+    parser.option("--test", "test", [&](const std::string& v) {
+        if (!parse(v, options.narrow_phase))
+            throw UsageError("invalid value '" + v + "' for --test: expected " +
+                             join_choices({"sat", "sat_no_edges", "sat_mtv", "gjk", "fast"}));
+    });
+    parser.option("--hash", "hash", [&](const std::string& v) {
+        if (!parse(v, options.hash))
+            throw UsageError("invalid value '" + v + "' for --hash: expected " +
+                             join_choices({"djb2", "fnv-1a", "simple", "morton"}));
+    });
+    parser.option("--backend", "backend", [&](const std::string& v) {
+        if (!parse(v, options.backend))
+            throw UsageError("invalid value '" + v + "' for --backend: expected " + join_choices({"cpu", "cuda"}));
+    });
+    parser.option("--threads", "N",
+                  [&](const std::string& v) { options.threads = static_cast<int>(parse_integer("--threads", v, 1, 1024)); });
+    parser.option("--block-size", "N", [&](const std::string& v) {
+        options.block_size = static_cast<int>(parse_integer("--block-size", v, 1, 1024));
+    });
+}
+
+const char* detector_options_help() {
+    return R"(  --method M           kdet (default), kdet_no_pairs, brute_force_loop, brute_force_pairs
+  --test T             narrow phase: sat (default), sat_no_edges, sat_mtv, gjk, fast
+  --hash H             grid hash: djb2 (default), fnv-1a, simple, morton
+  --backend B          cpu (default) or cuda
+  --threads N          CPU threads (default: all)
+  --block-size N       CUDA threads per block (default 128)
+)";
+}
+
+int run_collide(int argc, char** argv) {
+    DetectorOptions options;
+    std::vector<std::string> meshes;
+    bool self = false, json = false, help = false;
+    std::string pairs_path;
+    ReadOptions read_options;
+
+    ArgParser parser("collide");
+    parser.positionals(2, meshes);
+    parser.flag("--self", [&] { self = true; });
+    parser.flag("--json", [&] { json = true; });
+    parser.flag("--allow-degenerate", [&] { read_options.allow_degenerate = true; });
+    parser.flag("--help", [&] { help = true; });
+    parser.option("--pairs", "FILE", [&](const std::string& v) { pairs_path = v; });
+    add_detector_options(parser, options);
+    parser.parse(argc, argv, 2);
+    if (help) {
+        std::cout << collide_help << detector_options_help();
+        return exit_ok;
+    }
+    if (meshes.empty()) throw UsageError("collide: missing mesh A (see 'kdet collide --help')");
+    if (self && meshes.size() == 2) throw UsageError("collide: --self takes one mesh, got two");
+    if (!self && meshes.size() == 1) throw UsageError("collide: one mesh given: add mesh B, or --self for self-collision");
+    if (options.method == Method::kdet_no_pairs && !pairs_path.empty())
+        throw UsageError("collide: --pairs needs a method that builds pairs; kdet_no_pairs only flags tets");
+
+    const TetMesh a = read_tet_mesh(meshes[0], read_options);
+    const TetMesh b = self ? TetMesh{} : read_tet_mesh(meshes[1], read_options);
+
+    Detector detector(options);
+    const ObjectId id_a = detector.add_object(a);
+    if (self) {
+        detector.set_self_collision(id_a, true);
+    } else {
+        detector.add_object(b);
+    }
+    const FrameResult& result = detector.detect();
+    if (!pairs_path.empty()) write_pairs(pairs_path, result);
+
+    const FrameCounts& c = result.counts;
+    const StageTimes& t = result.times;
+    if (json) {
+        std::cout << "{\"mesh_a\": \"" << meshes[0] << "\", \"tets_a\": " << a.num_tets();
+        if (!self) std::cout << ", \"mesh_b\": \"" << meshes[1] << "\", \"tets_b\": " << b.num_tets();
+        std::cout << ", \"self\": " << (self ? "true" : "false") << ", \"method\": \"" << to_string(options.method)
+                  << "\", \"test\": \"" << to_string(options.narrow_phase) << "\", \"hash\": \""
+                  << to_string(options.hash) << "\", \"backend\": \"" << to_string(options.backend)
+                  << "\", \"candidates\": " << c.candidates << ", \"unique_candidates\": " << c.unique_candidates
+                  << ", \"colliding_pairs\": " << c.colliding_pairs << ", \"colliding_tets\": " << c.colliding_tets
+                  << ", \"buffer_regrows\": " << c.buffer_regrows << ", \"times_ms\": {\"bounding_boxes\": "
+                  << json_number(t.bounding_boxes) << ", \"populate_grid\": " << json_number(t.populate_grid)
+                  << ", \"find_candidates\": " << json_number(t.find_candidates)
+                  << ", \"sort_unique\": " << json_number(t.sort_unique)
+                  << ", \"narrow_phase\": " << json_number(t.narrow_phase) << "}, \"total_ms\": "
+                  << json_number(t.total) << ", \"memory_bytes\": " << result.memory_bytes << "}\n";
+        return exit_ok;
+    }
+    std::printf("meshes            %s (%zu tets)", meshes[0].c_str(), a.num_tets());
+    if (!self) std::printf(" x %s (%zu tets)", meshes[1].c_str(), b.num_tets());
+    std::printf("%s\n", self ? ", self-collision" : "");
+    std::printf("method            %s, test %s, hash %s, backend %s\n", to_string(options.method),
+                to_string(options.narrow_phase), to_string(options.hash), to_string(options.backend));
+    std::printf("candidates        %llu (unique %llu)\n", static_cast<unsigned long long>(c.candidates),
+                static_cast<unsigned long long>(c.unique_candidates));
+    if (options.method != Method::kdet_no_pairs)
+        std::printf("colliding pairs   %llu\n", static_cast<unsigned long long>(c.colliding_pairs));
+    std::printf("colliding tets    %llu\n", static_cast<unsigned long long>(c.colliding_tets));
+    std::printf("times (ms)        boxes %.3f, populate %.3f, candidates %.3f, sort+unique %.3f, narrow %.3f\n",
+                t.bounding_boxes, t.populate_grid, t.find_candidates, t.sort_unique, t.narrow_phase);
+    std::printf("total             %.3f ms\n", t.total);
+    std::printf("memory            %zu bytes\n", result.memory_bytes);
+    return exit_ok;
+}
+
+} // namespace kdet::cli

@@ -1,0 +1,59 @@
+#include "commands.hpp"
+
+#include <kdet/detector.hpp>
+#include <kdet/error.hpp>
+
+#include <cstring>
+#include <iostream>
+#include <new>
+
+namespace {
+
+const char* usage = R"(usage: kdet <command> [arguments]
+
+Finds every colliding pair of tetrahedra between tetrahedral meshes and inside one mesh.
+
+commands:
+  collide A [B] [options]   colliding pairs between two meshes, or inside one with --self
+  bench [options]           runs the built-in procedural scene frame by frame
+
+  kdet <command> --help     options of a command
+  kdet --version
+)";
+
+} // namespace
+
+int main(int argc, char** argv) {
+    using namespace kdet::cli;
+    if (argc < 2) {
+        std::cerr << usage;
+        return exit_usage;
+    }
+    const std::string command = argv[1];
+    try {
+        if (command == "collide") return run_collide(argc, argv);
+        if (command == "bench") return run_bench(argc, argv);
+        if (command == "--help" || command == "-h" || command == "help") {
+            std::cout << usage;
+            return exit_ok;
+        }
+        if (command == "--version") {
+            std::cout << "kdet " << kdet::version() << "\n";
+            return exit_ok;
+        }
+        std::cerr << "kdet: unknown command '" << command << "' (commands: collide, bench; see 'kdet --help')\n";
+        return exit_usage;
+    } catch (const UsageError& e) {
+        std::cerr << "kdet " << e.what() << "\n";
+        return exit_usage;
+    } catch (const kdet::Error& e) {
+        std::cerr << "kdet: error: " << e.what() << "\n";
+        return exit_failure;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "kdet: error: out of memory\n";
+        return exit_failure;
+    } catch (const std::exception& e) {
+        std::cerr << "kdet: error: " << e.what() << "\n";
+        return exit_failure;
+    }
+}
