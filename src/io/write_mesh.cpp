@@ -62,34 +62,34 @@ void check_writable(const TetMesh& mesh, const std::string& path) {
     validate_tet_mesh(mesh, path, accept_degenerate);
 }
 
+/// @brief Writes a TetGen file: @p comment, the header "<count><header_rest>", then one line per entry
+/// that starts with the entry's 0-based number.
+template <typename WriteEntry>
+void write_tetgen_file(const std::string& path, std::string_view comment, std::size_t count,
+                       std::string_view header_rest, WriteEntry&& write_entry) {
+    OutputFile out(path);
+    out.text(comment);
+    out.number(count);
+    out.text(header_rest);
+    for (std::size_t i = 0; i < count; ++i) {
+        out.number(i);
+        out.text(" ");
+        write_entry(out, i);
+        out.text("\n");
+    }
+    out.close();
+}
+
 } // namespace
 
 void write_tetgen(const TetMesh& mesh, const std::string& stem) {
     check_writable(mesh, stem);
-
-    OutputFile node(stem + ".node");
-    node.text("# <#points> <dimension> <#attributes> <#boundary markers>, then <index> <x> <y> <z>\n");
-    node.number(mesh.num_vertices());
-    node.text(" 3 0 0\n");
-    for (std::size_t v = 0; v < mesh.num_vertices(); ++v) {
-        node.number(v);
-        node.text(" ");
-        write_coordinates(node, mesh, v);
-        node.text("\n");
-    }
-    node.close();
-
-    OutputFile ele(stem + ".ele");
-    ele.text("# <#tetrahedra> <nodes per tetrahedron> <#attributes>, then <index> <4 point indices>\n");
-    ele.number(mesh.num_tets());
-    ele.text(" 4 0\n");
-    for (std::size_t t = 0; t < mesh.num_tets(); ++t) {
-        ele.number(t);
-        ele.text(" ");
-        write_corners(ele, mesh, t, 0);
-        ele.text("\n");
-    }
-    ele.close();
+    write_tetgen_file(
+        stem + ".node", "# <#points> <dimension> <#attributes> <#boundary markers>, then <index> <x> <y> <z>\n",
+        mesh.num_vertices(), " 3 0 0\n", [&mesh](OutputFile& out, std::size_t v) { write_coordinates(out, mesh, v); });
+    write_tetgen_file(
+        stem + ".ele", "# <#tetrahedra> <nodes per tetrahedron> <#attributes>, then <index> <4 point indices>\n",
+        mesh.num_tets(), " 4 0\n", [&mesh](OutputFile& out, std::size_t t) { write_corners(out, mesh, t, 0); });
 }
 
 void write_medit(const TetMesh& mesh, const std::string& path) {
