@@ -224,11 +224,6 @@ TEST(Detector, RejectsBadInputWithClearErrors) {
     EXPECT_THROW(detector.set_positions(id, xyz.data(), 3), Error);
     EXPECT_THROW(detector.set_positions(id + 1, xyz.data(), 4), Error);
     EXPECT_THROW(detector.set_pair_collision(id, id, true), Error);
-    DetectorOptions cuda;
-    cuda.backend = Backend::cuda;
-#if !defined(KDET_HAS_CUDA)
-    EXPECT_THROW(Detector{cuda}, Error);
-#endif
 }
 
 TEST(Detector, ReportsMemoryAndStageTimes) {

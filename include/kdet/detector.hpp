@@ -74,6 +74,9 @@ std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const Detecto
 /// @brief All colliding pairs i < j inside one mesh (self-collision), sorted ascending.
 std::vector<IndexPair> collide_self(const TetMesh& mesh, const DetectorOptions& options = {});
 
+/// @brief True when the CUDA backend can run here; otherwise `reason` (if given) says why not.
+bool cuda_available(std::string* reason = nullptr);
+
 /// @brief The version string, with the git commit it was built from when known.
 std::string version();
 

@@ -66,7 +66,7 @@ public:
     /// @brief Sorts keys[0, n) ascending and removes repeats; returns the unique count.
     std::size_t sort_unique(std::uint64_t* keys, std::size_t n) const;
 
-    /// @brief out[i] = sum of in[0, i); returns the total. in and out may alias.
+    /// @brief out[i] = sum of in[0, i); returns the total.
     std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const;
 
     template <class T>

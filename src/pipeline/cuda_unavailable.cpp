@@ -11,5 +11,10 @@ std::unique_ptr<PipelineBase> make_cuda_pipeline(const DetectorOptions&) {
                 "on a machine with nvcc)");
 }
 
+bool cuda_available(std::string* reason) {
+    if (reason) *reason = "kdet was built without CUDA";
+    return false;
+}
+
 } // namespace kdet
 #endif
