@@ -26,6 +26,23 @@ options:
   --allow-degenerate   accept zero-volume tetrahedra (rejected by default)
 )";
 
+std::string json_string(const std::string& text) {
+    std::string out = "\"";
+    for (const char c : text) {
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += c;
+        } else if (static_cast<unsigned char>(c) < 0x20) {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
+            out += escaped;
+        } else {
+            out += c;
+        }
+    }
+    return out + "\"";
+}
+
 std::string json_number(double value) {
     std::ostringstream out;
     out.precision(6);
@@ -122,8 +139,8 @@ int run_collide(int argc, char** argv) {
     const FrameCounts& c = result.counts;
     const StageTimes& t = result.times;
     if (json) {
-        std::cout << "{\"mesh_a\": \"" << meshes[0] << "\", \"tets_a\": " << a.num_tets();
-        if (!self) std::cout << ", \"mesh_b\": \"" << meshes[1] << "\", \"tets_b\": " << b.num_tets();
+        std::cout << "{\"mesh_a\": " << json_string(meshes[0]) << ", \"tets_a\": " << a.num_tets();
+        if (!self) std::cout << ", \"mesh_b\": " << json_string(meshes[1]) << ", \"tets_b\": " << b.num_tets();
         std::cout << ", \"self\": " << (self ? "true" : "false") << ", \"method\": \"" << to_string(options.method)
                   << "\", \"test\": \"" << to_string(options.narrow_phase) << "\", \"hash\": \""
                   << to_string(options.hash) << "\", \"backend\": \"" << to_string(options.backend)

@@ -1,0 +1,145 @@
+// The kdet command as a user runs it: outputs, the pairs file, and one-line errors with exit codes.
+
+#include "test_support.hpp"
+
+#include <kdet/detector.hpp>
+#include <kdet/io.hpp>
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace kdet {
+namespace {
+
+#ifdef KDET_CLI_PATH
+
+struct Outcome {
+    int exit_code;
+    std::string out; // stdout and stderr together
+};
+
+Outcome kdet_cli(const std::string& arguments) {
+    const std::string command = std::string(KDET_CLI_PATH) + " " + arguments + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    std::string out;
+    std::array<char, 4096> chunk{};
+    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe)) out += chunk.data();
+    const int status = pclose(pipe);
+    return Outcome{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::filesystem::path temp_dir() {
+    const auto dir = std::filesystem::temp_directory_path() / ("kdet_cli_test_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+std::size_t line_count(const std::string& text) {
+    return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+TEST(Cli, CollideWritesExactlyTheLibrarysPairs) {
+    test::use_default_data_dir();
+    const TetMesh bunny = read_tet_mesh(data_path("bunny.mesh"));
+    const TetMesh shifted = test::moved(bunny, 0.2, 0.1 * test::extent_of(bunny), 0.0, 0.0);
+    const auto dir = temp_dir();
+    write_tetgen(shifted, (dir / "shifted").string());
+    const auto expected = collide(bunny, shifted);
+    ASSERT_GT(expected.size(), 100u);
+
+    for (const char* spelling : {"shifted", "shifted.node", "shifted.ele"}) {
+        const auto pairs_file = dir / "pairs.txt";
+        const Outcome r = kdet_cli("collide " + data_path("bunny.mesh") + " " + (dir / spelling).string() +
+                                   " --pairs " + pairs_file.string());
+        ASSERT_EQ(r.exit_code, 0) << r.out;
+        EXPECT_NE(r.out.find("colliding pairs   " + std::to_string(expected.size())), std::string::npos) << r.out;
+        std::ifstream in(pairs_file);
+        std::vector<IndexPair> written;
+        std::uint32_t i, j;
+        while (in >> i >> j) written.emplace_back(i, j);
+        EXPECT_EQ(written, expected) << spelling;
+    }
+}
+
+TEST(Cli, SelfCollisionJsonHasCountsTimesAndMemory) {
+    test::use_default_data_dir();
+    const Outcome r = kdet_cli("collide " + data_path("octopus-low.mesh") + " --self --json --threads 1");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    EXPECT_EQ(line_count(r.out), 1u) << r.out;
+    for (const char* key : {"\"candidates\": ", "\"unique_candidates\": ", "\"colliding_pairs\": 0",
+                            "\"times_ms\": {\"bounding_boxes\": ", "\"narrow_phase\": ", "\"total_ms\": ",
+                            "\"memory_bytes\": "})
+        EXPECT_NE(r.out.find(key), std::string::npos) << key << " missing in " << r.out;
+}
+
+TEST(Cli, BenchRunsTheBuiltInSceneWithoutData) {
+    const Outcome r = kdet_cli("bench --tets 3000 --frames 9 -s yes");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    EXPECT_NE(r.out.find("scene procedural"), std::string::npos);
+    EXPECT_NE(r.out.find("summary: median"), std::string::npos);
+    EXPECT_GE(line_count(r.out), 9u + 3u);
+}
+
+struct BadCall {
+    const char* arguments;
+    int exit_code;
+    const char* message; ///< must appear in the single line of output
+};
+
+TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
+    test::use_default_data_dir();
+    const auto dir = temp_dir();
+    {
+        std::ofstream bad(dir / "bad.mesh");
+        bad << "MeshVersionFormatted 1\nDimension 3\nVertices\n2\n0 0 0 0\n1 nope 0 0\n";
+    }
+    const std::string bunny = data_path("bunny.mesh");
+    const std::string bad_mesh = (dir / "bad.mesh").string();
+    const BadCall calls[] = {
+        {"collide --frobnicate", 2, "unknown option '--frobnicate'"},
+        {"collide a.mesh b.mesh --method fastest", 2, "invalid value 'fastest' for --method"},
+        {"collide a.mesh b.mesh --threads 0", 2, "--threads"},
+        {"collide a.mesh b.mesh --threads", 2, "'--threads' needs a value"},
+        {"collide a.mesh --self b.mesh", 2, "--self takes one mesh"},
+        {"collide a.mesh", 2, "one mesh given"},
+        {"collide", 2, "missing mesh A"},
+        {"collide /nonexistent/x.mesh --self", 1, "/nonexistent/x.mesh: cannot open file"},
+        {"collide BAD --self", 1, "bad.mesh:6: "},
+        {"collide BUNNY BUNNY --hash md5", 2, "invalid value 'md5' for --hash"},
+        {"bench -c nope", 2, "invalid value 'nope' for -c"},
+        {"bench -s maybe", 2, "invalid value 'maybe' for -s"},
+        {"bench --tets 5", 2, "--tets"},
+        {"bench armadillos", 2, "unknown scene 'armadillos'"},
+        {"frobnicate", 2, "unknown command 'frobnicate'"},
+    };
+    for (const BadCall& call : calls) {
+        std::string arguments = call.arguments;
+        for (auto [name, value] : {std::pair{"BAD", bad_mesh}, std::pair{"BUNNY", bunny}})
+            for (auto at = arguments.find(name); at != std::string::npos; at = arguments.find(name))
+                arguments.replace(at, std::string(name).size(), value);
+        const Outcome r = kdet_cli(arguments);
+        EXPECT_EQ(r.exit_code, call.exit_code) << arguments << " -> " << r.out;
+        EXPECT_EQ(line_count(r.out), 1u) << arguments << " -> " << r.out;
+        EXPECT_NE(r.out.find(call.message), std::string::npos) << arguments << " -> " << r.out;
+    }
+}
+
+TEST(Cli, HelpAndVersion) {
+    EXPECT_EQ(kdet_cli("--version").exit_code, 0);
+    const Outcome help = kdet_cli("collide --help");
+    EXPECT_EQ(help.exit_code, 0);
+    EXPECT_NE(help.out.find("--pairs FILE"), std::string::npos);
+    EXPECT_EQ(kdet_cli("bench --help").exit_code, 0);
+}
+
+#endif
+
+} // namespace
+} // namespace kdet
