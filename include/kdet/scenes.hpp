@@ -5,6 +5,7 @@
 #include <kdet/mesh.hpp>
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace kdet {
@@ -27,6 +28,22 @@ TetMesh make_box_mesh(int nx, int ny, int nz, double cell_size);
 /// Throws kdet::Error unless 0 < minor_radius < major_radius and target_tets > 0.
 TetMesh make_torus_mesh(double major_radius, double minor_radius, std::size_t target_tets);
 
+/// @brief An animated benchmark scene: objects with fixed tet meshes whose vertices move every frame.
+/// The bench tool and the tests drive every scene through this interface.
+class Scene {
+public:
+    virtual ~Scene() = default;
+    /// @brief Short name, as given on the command line.
+    virtual std::string name() const = 0;
+    virtual std::size_t num_objects() const = 0;
+    virtual int num_frames() const = 0;
+    /// @brief The tets (and rest positions) of `object`; the tets never change between frames.
+    virtual const TetMesh& rest_mesh(std::size_t object) const = 0;
+    /// @brief Vertex positions of `object` at `frame` (0-based) as x y z; `out` is resized.
+    virtual void positions(std::size_t object, int frame, std::vector<float>& out) const = 0;
+    virtual void positions(std::size_t object, int frame, std::vector<double>& out) const = 0;
+};
+
 /// @brief Size of a ProceduralScene.
 struct ProceduralSceneOptions {
     /// Tets of both objects together (half each, within about 10%); 100 to 20'000'000.
@@ -48,25 +65,27 @@ struct ProceduralSceneOptions {
 /// twists (a rotation about its axis that grows with the height above the ring plane) and wobbles
 /// (its centre line waves along the axis by 5% of the minor radius). Both deformations preserve volume
 /// and are mild enough that no tet inverts.
-class ProceduralScene {
+class ProceduralScene final : public Scene {
 public:
     /// @brief Builds the rest mesh. Throws kdet::Error for total_tets outside [100, 20'000'000] or frames < 1.
     explicit ProceduralScene(const ProceduralSceneOptions& options = {});
 
+    /// @brief "procedural".
+    std::string name() const override;
     /// @brief Number of objects: 2.
-    std::size_t num_objects() const;
+    std::size_t num_objects() const override;
     /// @brief Number of frames of the motion.
-    int num_frames() const;
+    int num_frames() const override;
     /// @brief The undeformed torus of `object` in its local frame (the same mesh for both objects).
     /// Throws kdet::Error for an object index out of range.
-    const TetMesh& rest_mesh(std::size_t object) const;
+    const TetMesh& rest_mesh(std::size_t object) const override;
 
     /// @brief Vertex positions of `object` at `frame` (0-based) as x y z floats; `out` is resized.
     /// Parallel with OpenMP; deterministic (bit-identical for any thread count).
     /// Throws kdet::Error for an object or frame out of range.
-    void positions(std::size_t object, int frame, std::vector<float>& out) const;
+    void positions(std::size_t object, int frame, std::vector<float>& out) const override;
     /// @brief The same motion in double (for writing files); the float overload rounds these values.
-    void positions(std::size_t object, int frame, std::vector<double>& out) const;
+    void positions(std::size_t object, int frame, std::vector<double>& out) const override;
 
 private:
     template <typename Real>

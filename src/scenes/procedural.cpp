@@ -82,6 +82,8 @@ ProceduralScene::ProceduralScene(const ProceduralSceneOptions& options) : option
     start_separation_ = 2.0 * max_distance_from_axis + kStartGap;
 }
 
+std::string ProceduralScene::name() const { return "procedural"; }
+
 std::size_t ProceduralScene::num_objects() const { return kNumObjects; }
 
 int ProceduralScene::num_frames() const { return options_.frames; }
