@@ -116,7 +116,7 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
         {"bench -c nope", 2, "invalid value 'nope' for -c"},
         {"bench -s maybe", 2, "invalid value 'maybe' for -s"},
         {"bench --tets 5", 2, "--tets"},
-        {"bench armadillos", 2, "unknown scene 'armadillos'"},
+        {"bench nosuchscene", 2, "unknown scene 'nosuchscene'"},
         {"frobnicate", 2, "unknown command 'frobnicate'"},
     };
     for (const BadCall& call : calls) {

@@ -1,6 +1,7 @@
 #include "commands.hpp"
 
 #include <kdet/detector.hpp>
+#include <kdet/error.hpp>
 #include <kdet/scenes.hpp>
 
 #include <algorithm>
@@ -33,13 +34,14 @@ options:
 
 int run_bench(int argc, char** argv) {
     DetectorOptions options;
-    ProceduralSceneOptions scene_options;
+    SceneRequest request;
+    ProceduralSceneOptions& scene_options = request.procedural;
     int runs = 1;
     bool self = false, quiet = false, help = false;
-    std::vector<std::string> scene_names;
+    std::vector<std::string> scene_arguments;
 
     ArgParser parser("bench");
-    parser.positionals(1, scene_names);
+    parser.positionals(1, scene_arguments);
     parser.flag("--help", [&] { help = true; });
     parser.flag("--quiet", [&] { quiet = true; });
     parser.option("--tets", "N", [&](const std::string& v) {
@@ -72,10 +74,13 @@ int run_bench(int argc, char** argv) {
         std::cout << bench_help << detector_options_help();
         return exit_ok;
     }
-    if (!scene_names.empty() && scene_names[0] != "procedural")
-        throw UsageError("bench: unknown scene '" + scene_names[0] + "': expected procedural");
-
-    const ProceduralScene scene(scene_options);
+    std::unique_ptr<Scene> opened;
+    try {
+        opened = open_scene(scene_arguments.empty() ? "procedural" : scene_arguments[0], request);
+    } catch (const Error& e) {
+        throw UsageError(std::string("bench: ") + e.what());
+    }
+    const Scene& scene = *opened;
     Detector detector(options);
     for (std::size_t o = 0; o < scene.num_objects(); ++o) {
         const ObjectId id = detector.add_object(scene.rest_mesh(o));
@@ -100,9 +105,9 @@ int run_bench(int argc, char** argv) {
 
     std::size_t tets = 0;
     for (std::size_t o = 0; o < scene.num_objects(); ++o) tets += scene.rest_mesh(o).num_tets();
-    std::printf("scene procedural: %zu objects, %zu tets, %d frames, %d run(s); method %s, test %s, hash %s, self %s, "
+    std::printf("scene %s: %zu objects, %zu tets, %d frames, %d run(s); method %s, test %s, hash %s, self %s, "
                 "backend %s on %s\n",
-                scene.num_objects(), tets, frames, runs, to_string(options.method), to_string(options.narrow_phase),
+                scene.name().c_str(), scene.num_objects(), tets, frames, runs, to_string(options.method), to_string(options.narrow_phase),
                 to_string(options.hash), self ? "yes" : "no", to_string(options.backend), detector.device_name().c_str());
     if (!quiet) {
         std::printf("%6s %12s %14s %14s %12s %12s\n", "frame", "time_ms", "candidates", "unique", "pairs", "tets");

@@ -5,6 +5,7 @@
 #include <kdet/mesh.hpp>
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,19 @@ private:
     TetMesh torus_;
     double start_separation_ = 0.0; ///< distance of the two centres at frame 0
 };
+
+/// @brief What open_scene needs besides the name.
+struct SceneRequest {
+    int resolution = 1;                     ///< 1-4, for the thesis scenes
+    ProceduralSceneOptions procedural;      ///< size of the "procedural" scene
+};
+
+/// @brief Opens a scene by name. Known names: "procedural" (built in, needs no data).
+/// Throws kdet::Error naming the known scenes for an unknown name.
+std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& request = {});
+
+/// @brief Names open_scene accepts, for help texts and error messages.
+std::vector<std::string> scene_names();
 
 /// @brief Bends a straight bar so that, for angles above 2*pi, its two ends pass through each other.
 ///
