@@ -82,6 +82,9 @@ void add_detector_options(ArgParser& parser, DetectorOptions& options) {
     });
     parser.option("--threads", "N",
                   [&](const std::string& v) { options.threads = static_cast<int>(parse_integer("--threads", v, 1, 1024)); });
+    parser.option("--bucket-capacity", "N", [&](const std::string& v) {
+        options.bucket_capacity = static_cast<std::uint32_t>(parse_integer("--bucket-capacity", v, 1, 4096));
+    });
     parser.option("--block-size", "N", [&](const std::string& v) {
         options.block_size = static_cast<int>(parse_integer("--block-size", v, 1, 1024));
     });
@@ -94,6 +97,7 @@ const char* detector_options_help() {
   --backend B          cpu (default) or cuda
   --threads N          CPU threads (default: all)
   --block-size N       CUDA threads per block (default 128)
+  --bucket-capacity N  tet ids per grid bucket before an overflow bucket is chained (default 32)
 )";
 }
 

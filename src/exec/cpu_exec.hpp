@@ -79,6 +79,9 @@ public:
     }
     void synchronize() const {}
 
+    /// @brief Bytes of scratch memory the layer keeps (none on the CPU).
+    std::size_t scratch_bytes() const { return 0; }
+
     int threads() const { return threads_; }
     std::string device_name() const;
 

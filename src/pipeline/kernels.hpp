@@ -173,15 +173,15 @@ struct LargerNeighbourFilter {
     const SceneView* scene;
     std::uint32_t t;
     std::uint32_t object;
-    int layer;
+    bool same_layer; ///< visiting t's own layer: every id there is on t's layer
     Aabb box;
     Visitor* visit;
 
     KDET_HD void operator()(std::uint32_t u) const {
-        const TetInfo& other = scene->info[u];
-        if (other.layer == layer && u <= t) return;
+        // A cell holds only tets of its own layer, so the tie-break needs no load of u's data.
+        if (same_layer && u <= t) return;
         if (!pair_is_active(*scene, object, scene->tet_object[u])) return;
-        if (!boxes_overlap(box, other.box)) return;
+        if (!boxes_overlap(box, scene->info[u].box)) return;
         (*visit)(u);
     }
 };
@@ -191,9 +191,10 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
                                              std::uint32_t layer_mask, std::uint32_t t, Visitor& visit) {
     const TetInfo self = scene.info[t];
     if (self.layer < 0) return;
-    LargerNeighbourFilter<Visitor> filter{&scene, t, scene.tet_object[t], self.layer, self.box, &visit};
+    LargerNeighbourFilter<Visitor> filter{&scene, t, scene.tet_object[t], true, self.box, &visit};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
+        filter.same_layer = layer == self.layer;
         const CellRange r = cell_range(params, self.box, layer);
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)

@@ -59,7 +59,7 @@ public:
                headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + hit_.capacity_bytes() + position_.capacity_bytes() +
                contacts_.capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
-               blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes();
+               blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes() + exec_.scratch_bytes();
     }
 
     std::string device_name() const override { return exec_.device_name(); }
