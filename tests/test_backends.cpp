@@ -9,6 +9,10 @@
 
 #include <gtest/gtest.h>
 
+#if defined(KDET_HAS_CUDA)
+#include <cuda_runtime.h>
+#endif
+
 namespace kdet {
 namespace {
 
@@ -92,6 +96,42 @@ TEST_F(CudaBackend, ProceduralSceneFramesMatchTheCpu) {
         EXPECT_EQ(cuda.detect().pairs, cpu.detect().pairs) << "frame " << f;
     }
 }
+
+#if defined(KDET_HAS_CUDA)
+TEST_F(CudaBackend, DevicePositionsAndDeviceResultsNeverPassThroughTheHost) {
+    const TetMesh a = test::random_soup(3000, 5.0, 2.0, 97), b = test::random_soup(3000, 5.0, 2.0, 98);
+    DetectorOptions o;
+    o.backend = Backend::cuda;
+    o.results_to_host = false;
+    Detector detector(o);
+    const ObjectId ia = detector.add_object(a), ib = detector.add_object(b);
+    detector.set_self_collision(ia, true);
+    detector.detect(); // uploads the topology
+    const std::vector<float> xyz(b.positions.begin(), b.positions.end());
+    float* device_xyz = nullptr;
+    ASSERT_EQ(cudaMalloc(reinterpret_cast<void**>(&device_xyz), xyz.size() * sizeof(float)), cudaSuccess);
+    ASSERT_EQ(cudaMemcpy(device_xyz, xyz.data(), xyz.size() * sizeof(float), cudaMemcpyHostToDevice), cudaSuccess);
+    detector.set_positions_on_device(ib, device_xyz, b.num_vertices());
+    cudaFree(device_xyz);
+    detector.detect();
+    const DeviceResults dr = detector.device_results();
+    std::vector<std::uint64_t> keys(dr.pair_count);
+    ASSERT_EQ(cudaMemcpy(keys.data(), dr.pair_keys, keys.size() * sizeof(std::uint64_t), cudaMemcpyDeviceToHost),
+              cudaSuccess);
+    const FrameResult cpu = detect_on(Backend::cpu, {a, b}, false, DetectorOptions{});
+    Detector cpu_self;
+    cpu_self.set_self_collision(cpu_self.add_object(a), true);
+    cpu_self.add_object(b);
+    const FrameResult& expected = cpu_self.detect();
+    ASSERT_EQ(keys.size(), expected.pairs.size());
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+        const TetPair& p = expected.pairs[k];
+        EXPECT_EQ(keys[k], (std::uint64_t{detector.first_tet(p.object_a) + p.tet_a} << 32) |
+                               (detector.first_tet(p.object_b) + p.tet_b));
+    }
+    (void)cpu;
+}
+#endif
 
 TEST(CudaAvailability, AnUnavailableBackendIsAClearErrorNotASilentFallback) {
     std::string reason;

@@ -44,6 +44,12 @@ public:
     void set_positions(ObjectId object, const float* positions, std::size_t vertex_count);
     void set_positions(ObjectId object, const double* positions, std::size_t vertex_count);
 
+    /// @brief Replaces an object's positions from memory of the detector's backend (a CUDA device
+    /// pointer for Backend::cuda, a host pointer for Backend::cpu), e.g. a simulation's own buffer;
+    /// nothing passes through the host. x y z float per vertex. Throws kdet::Error on a non-finite
+    /// coordinate.
+    void set_positions_on_device(ObjectId object, const float* positions, std::size_t vertex_count);
+
     /// @brief Switches self-collision of one object (off by default).
     void set_self_collision(ObjectId object, bool enabled);
     /// @brief Switches collision between two different objects (on by default).
@@ -51,6 +57,11 @@ public:
 
     /// @brief Runs one detection; the result stays valid until the next call.
     const FrameResult& detect();
+
+    /// @brief The last detection's pairs, flags and contacts in the backend's memory.
+    DeviceResults device_results() const;
+    /// @brief Global id of the first tet of `object` (see DeviceResults).
+    std::uint32_t first_tet(ObjectId object) const;
 
     std::size_t object_count() const;
     std::size_t tet_count(ObjectId object) const;

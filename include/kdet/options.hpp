@@ -60,6 +60,9 @@ struct DetectorOptions {
     std::size_t initial_candidate_capacity = 0;
     /// Return depth and direction per colliding pair (computed with the 44-axis SAT).
     bool contacts = false;
+    /// Copy pairs, flags and contacts into FrameResult. Off: they stay in the backend's memory
+    /// (Detector::device_results()) and FrameResult carries counts, times and memory only.
+    bool results_to_host = true;
 };
 
 } // namespace kdet

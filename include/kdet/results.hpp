@@ -29,6 +29,17 @@ struct Contact {
     float direction[3];
 };
 
+/// @brief A detection's results where the backend keeps them: GPU memory for Backend::cuda, host
+/// memory for Backend::cpu. Valid until the next detect(). Tets are numbered globally: object o's
+/// tet i is Detector::first_tet(o) + i.
+struct DeviceResults {
+    const std::uint64_t* pair_keys = nullptr; ///< (global_a << 32) | global_b with global_a < global_b, sorted
+    std::size_t pair_count = 0;
+    const std::uint32_t* colliding = nullptr; ///< per global tet: nonzero when it collides
+    std::size_t tet_count = 0;
+    const Contact* contacts = nullptr;        ///< parallel to pair_keys when contacts are on, else null
+};
+
 /// @brief Milliseconds spent in each stage of one detection.
 struct StageTimes {
     double bounding_boxes = 0;  ///< per-tet boxes and sizes, object boxes and their overlap

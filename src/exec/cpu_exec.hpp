@@ -77,6 +77,11 @@ public:
     void download(T* host, const T* device, std::size_t n) const {
         if (n) std::memcpy(host, device, n * sizeof(T));
     }
+    /// @brief Copies within the backend's memory.
+    template <class T>
+    void copy(T* destination, const T* source, std::size_t n) const {
+        if (n) std::memmove(destination, source, n * sizeof(T));
+    }
     void synchronize() const {}
 
     /// @brief Bytes of scratch memory the layer keeps (none on the CPU).

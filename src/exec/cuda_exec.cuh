@@ -138,6 +138,11 @@ public:
     void download(T* host, const T* device, std::size_t n) const {
         if (n) cuda_check(cudaMemcpy(host, device, n * sizeof(T), cudaMemcpyDeviceToHost), "download");
     }
+    /// @brief Copies within device memory.
+    template <class T>
+    void copy(T* destination, const T* source, std::size_t n) const {
+        if (n) cuda_check(cudaMemcpy(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice), "device copy");
+    }
     void synchronize() const { cuda_check(cudaDeviceSynchronize(), "synchronize"); }
 
     std::string device_name() const {

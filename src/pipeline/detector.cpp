@@ -18,9 +18,24 @@ struct Detector::Impl {
     bool topology_changed = false;
     std::vector<vec3> positions;            // host copy, float32 as the pipeline stores them
     std::vector<std::uint8_t> positions_dirty; // per object: changed since the last upload
+    // Per object: positions were last given on the device, so only the pipeline holds them.
+    std::vector<std::uint8_t> positions_on_device;
     FrameResult result;
 
     std::size_t objects() const { return object_vertex_begin.size() - 1; }
+
+    /// Gives the pipeline the new topology; positions that only the pipeline holds are fetched first.
+    void rebuild_pipeline() {
+        for (std::size_t o = 0; o < objects(); ++o) {
+            if (!positions_on_device[o]) continue;
+            const std::uint32_t first = object_vertex_begin[o];
+            pipeline->get_positions(first, positions.data() + first, object_vertex_begin[o + 1] - first);
+            positions_on_device[o] = 0;
+        }
+        pipeline->set_topology(topology);
+        std::fill(positions_dirty.begin(), positions_dirty.end(), 1); // the pipeline's buffers are new
+        topology_changed = false;
+    }
 
     void check_object(ObjectId object) const {
         if (object >= objects())
@@ -45,6 +60,7 @@ struct Detector::Impl {
             positions[first + v] = vec3{x, y, z};
         }
         positions_dirty[object] = 1;
+        positions_on_device[object] = 0;
     }
 
     template <class Scalar>
@@ -73,6 +89,7 @@ struct Detector::Impl {
         topology.vertex_count = object_vertex_begin.back();
         positions.resize(topology.vertex_count);
         positions_dirty.push_back(1);
+        positions_on_device.push_back(0);
 
         const std::size_t n = objects();
         std::vector<std::uint8_t> enabled(n * n, 0);
@@ -119,6 +136,21 @@ void Detector::set_positions(ObjectId object, const double* positions, std::size
     impl_->store_positions(object, positions, vertex_count);
 }
 
+void Detector::set_positions_on_device(ObjectId object, const float* positions, std::size_t vertex_count) {
+    Impl& d = *impl_;
+    d.check_object(object);
+    const std::uint32_t first = d.object_vertex_begin[object];
+    const std::size_t expected = d.object_vertex_begin[object + 1] - first;
+    if (vertex_count != expected)
+        throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
+                    " vertices, expected " + std::to_string(expected));
+    if (d.topology_changed) d.rebuild_pipeline();
+    d.pipeline->set_positions_on_device(first, reinterpret_cast<const vec3*>(positions),
+                                        static_cast<std::uint32_t>(vertex_count));
+    d.positions_dirty[object] = 0;
+    d.positions_on_device[object] = 1;
+}
+
 void Detector::set_self_collision(ObjectId object, bool enabled) {
     impl_->check_object(object);
     impl_->pair_enabled[object * impl_->objects() + object] = enabled ? 1 : 0;
@@ -133,11 +165,7 @@ void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
 
 const FrameResult& Detector::detect() {
     Impl& d = *impl_;
-    if (d.topology_changed) {
-        d.pipeline->set_topology(d.topology);
-        std::fill(d.positions_dirty.begin(), d.positions_dirty.end(), 1); // the pipeline's buffers are new
-        d.topology_changed = false;
-    }
+    if (d.topology_changed) d.rebuild_pipeline();
     for (std::size_t o = 0; o < d.objects(); ++o) {
         if (!d.positions_dirty[o]) continue;
         const std::uint32_t first = d.object_vertex_begin[o];
@@ -150,6 +178,13 @@ const FrameResult& Detector::detect() {
     }
     d.pipeline->detect(d.pair_enabled, d.result);
     return d.result;
+}
+
+DeviceResults Detector::device_results() const { return impl_->pipeline->device_results(); }
+
+std::uint32_t Detector::first_tet(ObjectId object) const {
+    impl_->check_object(object);
+    return impl_->topology.object_tet_begin[object];
 }
 
 std::size_t Detector::object_count() const { return impl_->objects(); }

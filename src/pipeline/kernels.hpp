@@ -375,6 +375,17 @@ struct CompactKernel {
     }
 };
 
+/// @brief Flags a non-finite coordinate among positions handed over in the backend's memory.
+struct FiniteCheckKernel {
+    const vec3* positions;
+    std::uint32_t* found;
+    KDET_HD void operator()(std::uint64_t v) const {
+        const vec3 p = positions[v];
+        // x - x is 0 for finite x and NaN for NaN and infinities.
+        if (!(p.x - p.x == 0.0f && p.y - p.y == 0.0f && p.z - p.z == 0.0f)) atomic_store_relaxed(found, 1u);
+    }
+};
+
 /// @brief Sets every element of a buffer to one value.
 template <class T>
 struct FillKernel {

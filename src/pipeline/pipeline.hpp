@@ -5,6 +5,8 @@
 
 #include "pipeline/pipeline_base.hpp"
 
+#include <kdet/error.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -18,7 +20,7 @@ struct FrameCounters {
     std::uint32_t grid_failure;
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
-    std::uint32_t unused;
+    std::uint32_t non_finite;
 };
 
 template <class Exec>
@@ -50,6 +52,22 @@ public:
 
     void set_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
         exec_.upload(positions_.data() + first, positions, count);
+    }
+
+    void set_positions_on_device(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
+        exec_.copy(positions_.data() + first, positions, count);
+        reset_counters();
+        exec_.for_each(count, FiniteCheckKernel{positions_.data() + first, &counters_.data()->non_finite});
+        if (read_counters().non_finite) throw Error("positions given on the device hold a non-finite coordinate");
+    }
+
+    void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count) override {
+        exec_.download(positions, positions_.data() + first, count);
+    }
+
+    DeviceResults device_results() override {
+        return DeviceResults{out_keys_.data(), colliding_count_, colliding_.data(), colliding_.size(),
+                             options_.contacts ? out_contacts_.data() : nullptr};
     }
 
     std::size_t memory_bytes() const override {
@@ -92,6 +110,7 @@ private:
     void find_candidates(const GridView& grid, FrameCounts& counts);
     void brute_force(FrameCounts& counts);
     void narrow_phase_and_compact(std::size_t unique, FrameResult& result);
+    void count_and_copy_flags(FrameResult& result);
     KeyAppender candidate_appender() {
         return KeyAppender{candidates_.data(), candidates_.size(), &counters_.data()->candidates};
     }
@@ -127,6 +146,7 @@ private:
     std::uint32_t slot_count_ = 0;
     std::uint32_t overflow_capacity_ = 0;
     std::uint32_t layer_mask_ = 0;
+    std::size_t colliding_count_ = 0; ///< pairs in out_keys_ after the last detection
 };
 
 /// @brief Stage 1. Returns false when no enabled pair of objects can collide this frame.
@@ -323,6 +343,9 @@ void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& r
     exec_.for_each(unique, CompactKernel{candidates_.data(), hit_.data(), position_.data(), contacts,
                                          out_keys_.data(), out_contacts});
 
+    colliding_count_ = colliding;
+    result.counts.colliding_pairs = colliding;
+    if (!options_.results_to_host) return;
     std::vector<std::uint64_t> keys(colliding);
     exec_.download(keys.data(), out_keys_.data(), colliding);
     const auto& begin = topology_.object_tet_begin;
@@ -338,7 +361,25 @@ void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& r
     }
     result.contacts.resize(contacts ? colliding : 0);
     if (contacts) exec_.download(result.contacts.data(), out_contacts, colliding);
-    result.counts.colliding_pairs = colliding;
+}
+
+/// @brief Counts the colliding tets (a scan of the 0/1 flags) and, when results go to the host,
+/// copies the per-tet flags.
+template <class Exec>
+void Pipeline<Exec>::count_and_copy_flags(FrameResult& result) {
+    const std::size_t tets = tets_.size();
+    position_.resize_discard(tets);
+    result.counts.colliding_tets = exec_.exclusive_scan(colliding_.data(), position_.data(), tets);
+    const std::size_t objects = stats_.size();
+    result.colliding.resize(options_.results_to_host ? objects : 0);
+    if (!options_.results_to_host) return;
+    std::vector<std::uint32_t> flags(tets);
+    exec_.download(flags.data(), colliding_.data(), tets);
+    for (std::size_t o = 0; o < objects; ++o) {
+        const std::uint32_t b = topology_.object_tet_begin[o], e = topology_.object_tet_begin[o + 1];
+        result.colliding[o].resize(e - b);
+        for (std::uint32_t t = b; t < e; ++t) result.colliding[o][t - b] = flags[t] ? 1 : 0;
+    }
 }
 
 template <class Exec>
@@ -350,6 +391,7 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
     result.counts = FrameCounts{};
     result.times = StageTimes{};
     FrameCounts& counts = result.counts;
+    colliding_count_ = 0;
 
     stage.start();
     fill(colliding_, 0u);
@@ -390,18 +432,7 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
         }
     }
 
-    const std::size_t objects = stats_.size();
-    std::vector<std::uint32_t> flags(tets_.size());
-    exec_.download(flags.data(), colliding_.data(), flags.size());
-    result.colliding.resize(objects);
-    for (std::size_t o = 0; o < objects; ++o) {
-        const std::uint32_t b = topology_.object_tet_begin[o], e = topology_.object_tet_begin[o + 1];
-        result.colliding[o].assign(e - b, 0);
-        for (std::uint32_t t = b; t < e; ++t) {
-            result.colliding[o][t - b] = flags[t] ? 1 : 0;
-            counts.colliding_tets += flags[t] ? 1 : 0;
-        }
-    }
+    count_and_copy_flags(result);
     result.memory_bytes = memory_bytes();
     result.times.total = total.stop_ms();
 }

@@ -27,8 +27,13 @@ public:
     virtual void set_topology(const SceneTopology& topology) = 0;
     /// @brief Copies `count` positions starting at global vertex `first`.
     virtual void set_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
+    /// @brief Copies `count` positions already in the backend's memory; throws Error on a non-finite value.
+    virtual void set_positions_on_device(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
+    /// @brief Copies `count` positions starting at global vertex `first` back to the host.
+    virtual void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count) = 0;
     /// @brief One detection; pair_enabled is [objects * objects], symmetric, diagonal = self-collision.
     virtual void detect(const std::vector<std::uint8_t>& pair_enabled, FrameResult& result) = 0;
+    virtual DeviceResults device_results() = 0;
     virtual std::size_t memory_bytes() const = 0;
     virtual std::string device_name() const = 0;
 };
