@@ -1,303 +1,22 @@
 /// @file read_mesh.cpp
-/// @brief The TetGen and MEDIT readers and the checks they share with validate_tet_mesh.
+/// @brief The TetGen and MEDIT readers, the reader chosen by extension, and validate_tet_mesh.
+
+#include "io/text_reader.hpp"
 
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 
-#include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <limits>
-#include <sstream>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <vector>
 
 namespace kdet {
 namespace {
 
-// ---------------------------------------------------------------------------------------------
-// Tokens
-
-/// @brief A whitespace-separated word of a file and the line (1-based) it stands on.
-struct Token {
-    std::string_view text;
-    std::size_t line = 0;
-};
-
-/// @brief Quotes file content for an error message: shortened, with unprintable bytes replaced, so
-/// the message stays one readable line whatever the file holds.
-std::string excerpt(std::string_view text) {
-    constexpr std::size_t max_shown = 40;
-    std::string out = "'";
-    for (std::size_t i = 0; i < text.size() && i < max_shown; ++i) {
-        const char c = text[i];
-        out += (c >= ' ' && c <= '~') ? c : '?';
-    }
-    if (text.size() > max_shown) out += "...";
-    return out + "'";
-}
-
-std::string load_file(const std::string& path) {
-    std::error_code ignored;
-    // An ifstream opens a directory on Linux and then reads nothing, which would read as "empty file".
-    if (std::filesystem::is_directory(path, ignored)) throw Error(path + ": cannot open file (it is a directory)");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path + ": cannot open file");
-    std::ostringstream content;
-    content << in.rdbuf();
-    if (in.bad()) throw Error(path + ": cannot read file");
-    return content.str();
-}
-
-/// @brief The text of one input file, cut into tokens on demand; `#` starts a comment that runs to
-/// the end of its line.
-class TextFile {
-public:
-    explicit TextFile(std::string path) : path_(std::move(path)), text_(load_file(path_)) {}
-
-    const std::string& path() const { return path_; }
-
-    /// @brief Throws the one-line "path:line: what" error.
-    [[noreturn]] void fail(std::size_t line, const std::string& what) const {
-        throw Error(path_ + ":" + std::to_string(line) + ": " + what);
-    }
-
-    /// @brief Reads the next token; false at the end of the file.
-    bool next_token(Token& token) {
-        skip_blanks_and_comments();
-        if (position_ == text_.size()) return false;
-        const std::size_t start = position_;
-        while (position_ < text_.size() && !is_blank(text_[position_]) && text_[position_] != '#') ++position_;
-        token = Token{std::string_view(text_).substr(start, position_ - start), line_};
-        last_token_line_ = line_;
-        return true;
-    }
-
-    /// @brief Reads the tokens of the next line that has any; false at the end of the file.
-    bool next_line(std::vector<Token>& tokens) {
-        tokens.clear();
-        Token token;
-        if (!next_token(token)) return false;
-        tokens.push_back(token);
-        for (;;) {
-            const std::size_t saved_position = position_, saved_line = line_, saved_last = last_token_line_;
-            if (!next_token(token)) break;
-            if (token.line != tokens.front().line) {
-                position_ = saved_position;
-                line_ = saved_line;
-                last_token_line_ = saved_last;
-                break;
-            }
-            tokens.push_back(token);
-        }
-        return true;
-    }
-
-    /// @brief True when nothing but blanks and comments is left.
-    bool at_end() {
-        skip_blanks_and_comments();
-        return position_ == text_.size();
-    }
-
-    /// @brief The line of the last token read: where a file that ends too early is reported.
-    std::size_t last_token_line() const { return last_token_line_; }
-
-    /// @brief Bytes not read yet; bounds how many records can still follow.
-    std::size_t remaining_bytes() const { return text_.size() - position_; }
-
-private:
-    static bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
-
-    void skip_blanks_and_comments() {
-        while (position_ < text_.size()) {
-            const char c = text_[position_];
-            if (c == '#') {
-                while (position_ < text_.size() && text_[position_] != '\n') ++position_;
-            } else if (is_blank(c)) {
-                if (c == '\n') ++line_;
-                ++position_;
-            } else {
-                return;
-            }
-        }
-    }
-
-    std::string path_;
-    std::string text_;
-    std::size_t position_ = 0;
-    std::size_t line_ = 1;
-    std::size_t last_token_line_ = 1;
-};
-
-// ---------------------------------------------------------------------------------------------
-// Numbers
-
-/// @brief Start of a number for std::from_chars, which rejects the leading '+' that files may have.
-/// Returns nullptr for "+-", which from_chars would otherwise take as a negative number.
-const char* skip_plus_sign(const char* first, const char* last) {
-    if (first == last || *first != '+') return first;
-    ++first;
-    return (first != last && *first == '-') ? nullptr : first;
-}
-
-/// @brief Parses the whole of @p text as a decimal integer; false when it is not one or does not fit.
-bool parse_integer(std::string_view text, long long& value) {
-    const char* last = text.data() + text.size();
-    const char* first = skip_plus_sign(text.data(), last);
-    if (first == nullptr) return false;
-    const auto [end, error] = std::from_chars(first, last, value);
-    return error == std::errc() && end == last;
-}
-
-enum class NumberParse { ok, not_a_number, out_of_range };
-
-/// @brief Parses the whole of @p text as a double ("1.0abc" is not a number). Accepts "nan" and "inf":
-/// callers that need finite values check them.
-NumberParse parse_double(std::string_view text, double& value) {
-    const char* last = text.data() + text.size();
-    const char* first = skip_plus_sign(text.data(), last);
-    if (first == nullptr) return NumberParse::not_a_number;
-    const auto [end, error] = std::from_chars(first, last, value);
-    if (error == std::errc::result_out_of_range && end == last) return NumberParse::out_of_range;
-    return (error == std::errc() && end == last) ? NumberParse::ok : NumberParse::not_a_number;
-}
-
-long long read_integer(const TextFile& file, const Token& token, const char* what) {
-    long long value = 0;
-    if (!parse_integer(token.text, value))
-        file.fail(token.line, std::string("expected ") + what + ", found " + excerpt(token.text));
-    return value;
-}
-
-/// @brief Reads the number of records or fields a header announces: an integer >= 0.
-std::size_t read_count(const TextFile& file, const Token& token, const char* what) {
-    const long long value = read_integer(file, token, what);
-    if (value < 0) file.fail(token.line, std::string(what) + " must not be negative, found " + excerpt(token.text));
-    static_assert(sizeof(std::size_t) >= sizeof(long long), "every non-negative count fits in size_t");
-    return static_cast<std::size_t>(value);
-}
-
-/// @brief Reads a vertex count, which must leave every 0-based index representable as uint32.
-std::size_t read_vertex_count(const TextFile& file, const Token& token, const char* what) {
-    const std::size_t count = read_count(file, token, what);
-    if (count == 0) file.fail(token.line, "no vertices");
-    if (count > std::numeric_limits<std::uint32_t>::max()) {
-        file.fail(token.line, "too many vertices: " + std::to_string(count) + ", at most " +
-                                  std::to_string(std::numeric_limits<std::uint32_t>::max()));
-    }
-    return count;
-}
-
-/// @brief Reads any number (an attribute or a value of a skipped section); its value is not used.
-void check_number(const TextFile& file, const Token& token) {
-    double unused = 0.0;
-    if (parse_double(token.text, unused) != NumberParse::ok)
-        file.fail(token.line, "expected a number, found " + excerpt(token.text));
-}
-
-double read_coordinate(const TextFile& file, const Token& token) {
-    double value = 0.0;
-    switch (parse_double(token.text, value)) {
-    case NumberParse::not_a_number:
-        file.fail(token.line, "expected a coordinate, found " + excerpt(token.text));
-    case NumberParse::out_of_range:
-        file.fail(token.line, "coordinate " + excerpt(token.text) + " does not fit in a double");
-    case NumberParse::ok:
-        break;
-    }
-    if (!std::isfinite(value)) file.fail(token.line, "coordinate " + excerpt(token.text) + " is not finite");
-    return value;
-}
-
-std::string index_out_of_range(long long index, long long base, std::size_t vertex_count) {
-    if (vertex_count == 0) return "vertex index " + std::to_string(index) + " refers to a mesh without vertices";
-    const long long last = base + static_cast<long long>(vertex_count) - 1;
-    return "vertex index " + std::to_string(index) + " out of range [" + std::to_string(base) + ", " +
-           std::to_string(last) + "]";
-}
-
-/// @brief Reads a tetrahedron corner numbered from @p base and returns it 0-based.
-std::uint32_t read_vertex_index(const TextFile& file, const Token& token, long long base, std::size_t vertex_count) {
-    const long long index = read_integer(file, token, "a vertex index");
-    // index >= base first, so index - base cannot overflow.
-    if (index < base || static_cast<unsigned long long>(index - base) >= vertex_count) {
-        file.fail(token.line, index_out_of_range(index, base, vertex_count));
-    }
-    return static_cast<std::uint32_t>(index - base);
-}
-
-/// @brief How many records to reserve room for: no more than the rest of the file can hold, so an
-/// absurd header count cannot allocate absurd memory. Each field takes at least a digit and a blank.
-std::size_t reservable(std::size_t count, std::size_t fields_per_record, const TextFile& file) {
-    return std::min(count, file.remaining_bytes() / (2 * fields_per_record));
-}
-
-// ---------------------------------------------------------------------------------------------
-// Tetrahedron checks shared by the readers and validate_tet_mesh
-
-std::string short_number(double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.3g", value);
-    return text;
-}
-
-/// @brief Why tetrahedron @p tet of @p mesh has zero volume, or "" when it has volume. Its corners must
-/// be in range; @p base numbers them in the message as the input does.
-///
-/// Zero means |orient3d| <= 1e-12 * L^3 with L the longest edge: relative, so the verdict does not
-/// change with the unit of the coordinates. A repeated corner is degenerate whatever the coordinates.
-std::string degeneracy(const TetMesh& mesh, std::size_t tet, long long base) {
-    const std::uint32_t* corners = &mesh.tets[4 * tet];
-    for (int i = 0; i < 4; ++i) {
-        for (int j = i + 1; j < 4; ++j) {
-            if (corners[i] == corners[j]) {
-                return "degenerate tetrahedron: vertex index " + std::to_string(corners[i] + base) + " repeated";
-            }
-        }
-    }
-    double p[4][3];
-    for (int i = 0; i < 4; ++i) {
-        for (int axis = 0; axis < 3; ++axis) p[i][axis] = mesh.positions[3 * std::size_t{corners[i]} + axis];
-    }
-    double longest_squared = 0.0;
-    for (int i = 0; i < 4; ++i) {
-        for (int j = i + 1; j < 4; ++j) {
-            const double dx = p[j][0] - p[i][0], dy = p[j][1] - p[i][1], dz = p[j][2] - p[i][2];
-            longest_squared = std::max(longest_squared, dx * dx + dy * dy + dz * dz);
-        }
-    }
-    double e[3][3]; // edges from corner 0
-    for (int i = 0; i < 3; ++i) {
-        for (int axis = 0; axis < 3; ++axis) e[i][axis] = p[i + 1][axis] - p[0][axis];
-    }
-    const double orient = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-                          e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                          e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
-    const double longest = std::sqrt(longest_squared);
-    const double tolerance = 1e-12 * longest * longest * longest;
-    if (std::abs(orient) > tolerance) return {};
-    return "degenerate tetrahedron: zero volume (|orient3d| " + short_number(std::abs(orient)) +
-           " <= 1e-12 * longest edge^3 = " + short_number(tolerance) + "; ReadOptions::allow_degenerate accepts it)";
-}
-
-/// @brief Fails at @p line when the tetrahedron just appended to @p mesh is degenerate and not allowed.
-void check_last_tet(const TextFile& file, std::size_t line, const TetMesh& mesh, long long base,
-                    const ReadOptions& options) {
-    if (options.allow_degenerate) return;
-    const std::string problem = degeneracy(mesh, mesh.num_tets() - 1, base);
-    if (!problem.empty()) file.fail(line, problem);
-}
-
-[[noreturn]] void fail_truncated(const TextFile& file, std::size_t line, std::size_t expected, std::size_t found,
-                                 const std::string& what) {
-    file.fail(line, "expected " + std::to_string(expected) + " " + what + ", found " + std::to_string(found));
-}
+using namespace io;
 
 // ---------------------------------------------------------------------------------------------
 // TetGen
@@ -334,14 +53,6 @@ std::size_t read_attribute_count(const TextFile& file, const std::vector<Token>&
         file.fail(header[position].line, "attribute count " + std::to_string(count) + " does not fit in the file");
     }
     return count;
-}
-
-void reject_trailing_data(TextFile& file, std::size_t count, const char* what) {
-    Token extra;
-    if (file.next_token(extra)) {
-        file.fail(extra.line, "more data after the " + std::to_string(count) + " " + what +
-                                  " the header announces: " + excerpt(extra.text));
-    }
 }
 
 /// @brief Reads a .node file into @p positions; returns the index of its first point (0 or 1), the base
@@ -413,7 +124,7 @@ void read_tetgen_tetrahedra(const std::string& path, long long base, const ReadO
             if (k <= 4) mesh.tets.push_back(corner);
         }
         for (std::size_t k = 1 + nodes; k < fields; ++k) check_number(file, record[k]);
-        check_last_tet(file, record.front().line, mesh, base, options);
+        check_last_tet(file, record.front(), mesh, base, options);
     }
     reject_trailing_data(file, count, "tetrahedra");
 }
@@ -525,7 +236,7 @@ void read_medit_tetrahedra(TextFile& file, const Token& keyword, const ReadOptio
         for (std::size_t k = 0; k < 4; ++k)
             mesh.tets.push_back(read_vertex_index(file, record[k], base, mesh.num_vertices()));
         read_integer(file, record[4], "a tetrahedron reference");
-        check_last_tet(file, record.front().line, mesh, base, options);
+        check_last_tet(file, record.front(), mesh, base, options);
     });
 }
 
@@ -590,9 +301,12 @@ TetMesh read_medit(const std::string& path, const ReadOptions& options) {
 TetMesh read_tet_mesh(const std::string& path, const ReadOptions& options) {
     const std::string extension = std::filesystem::path(path).extension().string();
     if (extension == ".mesh") return read_medit(path, options);
+    if (extension == ".msh") return read_gmsh(path, options);
+    if (extension == ".vtk") return read_vtk(path, options);
     if (extension.empty() || extension == ".node" || extension == ".ele") return read_tetgen(path, options);
     throw Error(path + ": unsupported mesh format " + excerpt(extension) +
-                "; supported: .mesh (MEDIT ASCII), .node/.ele or a name without extension (TetGen)");
+                "; supported: .mesh (MEDIT ASCII), .msh (Gmsh 2.2/4.1), .vtk (legacy VTK), .node/.ele or a name "
+                "without extension (TetGen)");
 }
 
 void validate_tet_mesh(const TetMesh& mesh, const std::string& source, const ReadOptions& options) {

@@ -1,66 +1,18 @@
 /// @file write_mesh.cpp
 /// @brief The TetGen and MEDIT writers.
 
-#include <kdet/error.hpp>
+#include "io/output_file.hpp"
+
 #include <kdet/io.hpp>
 
-#include <charconv>
 #include <cstdint>
-#include <fstream>
 #include <string>
 #include <string_view>
 
 namespace kdet {
 namespace {
 
-/// @brief A file being written; numbers go out as the shortest text that reads back exactly.
-class OutputFile {
-public:
-    explicit OutputFile(const std::string& path) : path_(path), out_(path, std::ios::binary) {
-        if (!out_) throw Error(path_ + ": cannot open file for writing");
-    }
-
-    void text(std::string_view text) { out_.write(text.data(), static_cast<std::streamsize>(text.size())); }
-
-    template <typename Number>
-    void number(Number value) {
-        char digits[32]; // enough for any double or 64-bit integer
-        const auto result = std::to_chars(digits, digits + sizeof digits, value);
-        out_.write(digits, result.ptr - digits);
-    }
-
-    /// @brief Closes the file; a failed write (a full disk) surfaces here.
-    void close() {
-        out_.close();
-        if (!out_) throw Error(path_ + ": cannot write file");
-    }
-
-private:
-    std::string path_;
-    std::ofstream out_;
-};
-
-void write_coordinates(OutputFile& out, const TetMesh& mesh, std::size_t vertex) {
-    for (std::size_t axis = 0; axis < 3; ++axis) {
-        if (axis > 0) out.text(" ");
-        out.number(mesh.positions[3 * vertex + axis]);
-    }
-}
-
-void write_corners(OutputFile& out, const TetMesh& mesh, std::size_t tet, std::uint64_t base) {
-    for (std::size_t k = 0; k < 4; ++k) {
-        if (k > 0) out.text(" ");
-        out.number(std::uint64_t{mesh.tets[4 * tet + k]} + base);
-    }
-}
-
-/// @brief Refuses to write what the readers would reject, except degenerate tetrahedra, which the
-/// readers accept on request.
-void check_writable(const TetMesh& mesh, const std::string& path) {
-    ReadOptions accept_degenerate;
-    accept_degenerate.allow_degenerate = true;
-    validate_tet_mesh(mesh, path, accept_degenerate);
-}
+using namespace io;
 
 /// @brief Writes a TetGen file: @p comment, the header "<count><header_rest>", then one line per entry
 /// that starts with the entry's 0-based number.
