@@ -6,8 +6,9 @@
 /// It runs in the pair's unit-size frame, so every tolerance is relative to the longest edge. GJK
 /// only proposes a direction: a separation is reported when the projection gap of the two tets along
 /// that direction (the same certificate as the SAT) exceeds k_gap_tolerance. So the test never misses
-/// an intersecting pair, whatever the rounding inside the iterations; at worst a pair GJK cannot
-/// settle within the iteration cap counts as intersecting.
+/// an intersecting pair, whatever the rounding inside the iterations. When GJK ends at a distance
+/// above the tolerance that its direction cannot certify (rounding, on pairs much closer than their
+/// size), the SAT's axes decide.
 
 #include "geometry/sat.hpp"
 
@@ -190,11 +191,23 @@ KDET_HD inline bool gjk_intersect(const vec3 a[4], const vec3 b[4]) {
         const vec3 next = closest_on_simplex(s);
         if (s.size == 4) return true; // the origin is inside a simplex of A - B
         const float next_vv = length_squared(next);
-        if (!(next_vv < vv)) break; // no progress: keep the best direction found
+        if (!(next_vv < vv)) {
+            // No progress, through rounding. When the distance is small against the tets, nearly
+            // equal distances can come with very different directions, and the new simplex (often a
+            // face of A - B, whose normal is an exact SAT axis) may hold the one that separates.
+            if (direction_separates(p, next)) return false;
+            break;
+        }
         v = next;
         vv = next_vv;
     }
-    return !direction_separates(p, v);
+    if (direction_separates(p, v)) return false;
+    // GJK sees a distance above the tolerance, but its direction does not prove it. When the distance
+    // is small against the tets, the direction of a closest point computed from Minkowski points of
+    // size 1 carries rounding of order eps / distance, which can tip it out of the closest feature's
+    // normal cone; the SAT's axes come from the short edges and decide such rare pairs.
+    MtvState unused{k_huge, vec3{0.0f, 0.0f, 0.0f}};
+    return vv <= k_gap_tolerance * k_gap_tolerance || !sat_separates<false>(p, true, unused);
 }
 
 } // namespace kdet::narrow

@@ -13,55 +13,55 @@
 /// Robustness: each face normal is oriented against its opposite vertex (vertex order does not matter)
 /// and each plane is placed at the tet's own support value, so A lies inside it whatever the rounding.
 /// Every decision has three outcomes with the tolerance k_gap_tolerance. The edge decisions are poorly
-/// conditioned at sharp edges (the combined normal is short when the faces are nearly opposite), so a
-/// pair whose edge decision is uncertain, or a tet too flat to orient, goes to the 44-axis SAT.
+/// conditioned at sharp edges (the combined normal is short when the faces are nearly opposite), so an
+/// edge whose decision is unsure is decided by its 6 SAT edge-edge axes instead, and a pair with a
+/// tet too flat to orient goes to the 44-axis SAT.
 
 #include "geometry/sat.hpp"
 
 namespace kdet::narrow {
 
-/// @brief Outward unit normals of a tet's faces and the other tet's distances to them.
+/// @brief Signed distances of the other tet's vertices to a tet's outward face planes.
 struct FacePlanes {
-    vec3 normal[4];
-    float offset[4];      ///< the tet's own highest projection onto normal[k]
     float distance[4][4]; ///< [face][vertex of the other tet], in local units
 };
 
-/// @brief Builds the outward face planes of tet v. Returns false when a face is degenerate or an
-/// opposite vertex is within the tolerance of its face plane (the orientation is then unsure).
-KDET_HD inline bool outward_planes(const vec3 v[4], FacePlanes& f) {
+/// @brief What building a tet's face planes found.
+enum class FaceOutcome {
+    go_on,     ///< all four planes built, none separates
+    separated, ///< a face plane has the other tet beyond the tolerance
+    flat,      ///< a face is degenerate or an opposite vertex is within the tolerance of its face
+               ///< plane: the orientation is unsure, the pair goes to the SAT
+};
+
+/// @brief Builds the outward face planes of tet `own` and the distances of `other`'s vertices to
+/// them, face by face, stopping at the first face that separates.
+KDET_HD inline FaceOutcome build_face_planes(const vec3 own[4], const vec3 other[4], FacePlanes& f) {
     for (int k = 0; k < 4; ++k) {
         vec3 n;
-        if (!unit_face_normal(v, k, n)) return false;
-        const float d0 = dot(v[(k + 1) & 3], n), d1 = dot(v[(k + 2) & 3], n), d2 = dot(v[(k + 3) & 3], n);
+        float length2;
+        if (!face_axis(own, k, n, length2)) return FaceOutcome::flat;
+        n = unit(n, length2);
+        const float d0 = dot(own[(k + 1) & 3], n), d1 = dot(own[(k + 2) & 3], n), d2 = dot(own[(k + 3) & 3], n);
         const float face_lo = min_f(min_f(d0, d1), d2), face_hi = max_f(max_f(d0, d1), d2);
-        const float apex = dot(v[k], n);
+        const float apex = dot(own[k], n);
+        float offset; // the tet's own highest projection onto the outward normal
         if (apex < face_lo - k_gap_tolerance) {
-            f.normal[k] = n;
-            f.offset[k] = face_hi;
+            offset = face_hi;
         } else if (apex > face_hi + k_gap_tolerance) {
-            f.normal[k] = -n;
-            f.offset[k] = -face_lo;
+            n = -n;
+            offset = -face_lo;
         } else {
-            return false;
+            return FaceOutcome::flat;
         }
+        float nearest = k_huge;
+        for (int j = 0; j < 4; ++j) {
+            f.distance[k][j] = dot(n, other[j]) - offset;
+            nearest = min_f(nearest, f.distance[k][j]);
+        }
+        if (nearest > k_gap_tolerance) return FaceOutcome::separated;
     }
-    return true;
-}
-
-/// @brief Fills f.distance with the signed distances of the vertices w to the planes of f.
-KDET_HD inline void plane_distances(const vec3 w[4], FacePlanes& f) {
-    for (int k = 0; k < 4; ++k)
-        for (int j = 0; j < 4; ++j) f.distance[k][j] = dot(f.normal[k], w[j]) - f.offset[k];
-}
-
-/// @brief True when some face plane has every vertex farther than the tolerance.
-KDET_HD inline bool some_face_separates(const FacePlanes& f) {
-    for (int k = 0; k < 4; ++k) {
-        const float nearest = min_f(min_f(f.distance[k][0], f.distance[k][1]), min_f(f.distance[k][2], f.distance[k][3]));
-        if (nearest > k_gap_tolerance) return true;
-    }
-    return false;
+    return FaceOutcome::go_on;
 }
 
 /// @brief True when some vertex is inside all four planes by more than the tolerance: the tets meet.
@@ -102,20 +102,24 @@ KDET_HD inline bool gpr_intersect(const vec3 a[4], const vec3 b[4]) {
     if (!make_local_pair(a, b, p)) return points_coincide(a[0], b[0]);
     MtvState unused{k_huge, vec3{0.0f, 0.0f, 0.0f}};
     FacePlanes fa, fb;
-    if (!outward_planes(p.a, fa) || !outward_planes(p.b, fb)) return !sat_separates<false>(p, true, unused);
-    plane_distances(p.b, fa);
-    if (some_face_separates(fa)) return false;
+    const FaceOutcome outcome_a = build_face_planes(p.a, p.b, fa);
+    if (outcome_a == FaceOutcome::separated) return false;
+    if (outcome_a == FaceOutcome::flat) return !sat_separates<false>(p, true, unused);
     if (some_vertex_inside(fa)) return true;
-    plane_distances(p.a, fb);
-    if (some_face_separates(fb)) return false;
+    const FaceOutcome outcome_b = build_face_planes(p.b, p.a, fb);
+    if (outcome_b == FaceOutcome::separated) return false;
+    if (outcome_b == FaceOutcome::flat) return !sat_separates<false>(p, true, unused);
     if (some_vertex_inside(fb)) return true;
-    bool unsure = false;
-    for (int i = 0; i < 3; ++i)
-        for (int k = i + 1; k < 4; ++k) { // faces i and k of A share one edge
-            if (wedge_separates(fa.distance[i], fa.distance[k], k_gap_tolerance)) return false;
-            unsure = unsure || wedge_separates(fa.distance[i], fa.distance[k], -k_gap_tolerance);
-        }
-    return !unsure || !sat_separates<false>(p, true, unused);
+    // Faces i and k of A share the edge opposite them: with pairs enumerated like edges,
+    // pair q = (edge_first(q), edge_second(q)) shares edge 5 - q.
+    for (int q = 0; q < 6; ++q) {
+        const float* di = fa.distance[edge_first(q)];
+        const float* dk = fa.distance[edge_second(q)];
+        if (wedge_separates(di, dk, k_gap_tolerance)) return false;
+        // Unsure within the tolerance (a sharp edge amplifies it): decide with the edge's SAT axes.
+        if (wedge_separates(di, dk, -k_gap_tolerance) && edge_axes_separate<false>(p, 5 - q, unused)) return false;
+    }
+    return true;
 }
 
 } // namespace kdet::narrow

@@ -17,18 +17,39 @@ struct MtvState {
     vec3 direction; ///< unit direction that moves the second tet out by `overlap`
 };
 
-/// @brief Tests one unit axis: true when it separates the tets. With track, also keeps the axis of
-/// least overlap; `bias` is how much smaller an overlap must be to replace the current best.
+/// @brief Tests one axis (any length; length2 is its squared length > 0): true when it separates the
+/// tets, i.e. gap > tolerance * |axis|, tested squared so that no square root is needed. With track,
+/// also keeps the axis of least overlap (normalised only when it becomes the best); `bias` is how
+/// much smaller an overlap must be to replace the current best.
 template <bool track>
-KDET_HD inline bool axis_separates(const LocalPair& p, vec3 axis, float bias, MtvState& best) {
+KDET_HD inline bool axis_separates(const LocalPair& p, vec3 axis, float length2, float bias, MtvState& best) {
     const Interval ia = project(p.a, axis), ib = project(p.b, axis);
-    const float up = ia.hi - ib.lo;   // overlap left if the second tet moves along +axis
+    const float up = ia.hi - ib.lo;   // overlap left if the second tet moves along +axis (times |axis|)
     const float down = ib.hi - ia.lo; // overlap left if it moves along -axis
-    if (up < -k_gap_tolerance || down < -k_gap_tolerance) return true;
-    if (track) {
-        const float overlap = min_f(up, down);
-        if (overlap < best.overlap - bias) best = MtvState{overlap, up <= down ? axis : -axis};
+    const float overlap = min_f(up, down);
+    if (overlap < 0.0f && overlap * overlap > k_gap_tolerance * k_gap_tolerance * length2) return true;
+    if constexpr (track) {
+        // Is overlap / |axis| < target? Compared squared, by sign.
+        const float target = best.overlap - bias;
+        const float target2 = target * target * length2, overlap2 = overlap * overlap;
+        const bool better = target > 0.0f ? (overlap < 0.0f || overlap2 < target2) : (overlap < 0.0f && overlap2 > target2);
+        if (better) {
+            const float inverse = 1.0f / sqrtf(length2);
+            best = MtvState{overlap * inverse, (up <= down ? axis : -axis) * inverse};
+        }
     }
+    return false;
+}
+
+/// @brief Tests the 6 axes cross(edge i of A, edge j of B); true as soon as one separates.
+template <bool track>
+KDET_HD inline bool edge_axes_separate(const LocalPair& p, int i, MtvState& best) {
+    vec3 axis;
+    float length2;
+    for (int j = 0; j < 6; ++j)
+        if (edge_axis(p.edge_a[i], p.length2_a[i], p.edge_b[j], p.length2_b[j], axis, length2) &&
+            axis_separates<track>(p, axis, length2, k_gap_tolerance, best))
+            return true;
     return false;
 }
 
@@ -38,16 +59,14 @@ KDET_HD inline bool axis_separates(const LocalPair& p, vec3 axis, float bias, Mt
 template <bool track>
 KDET_HD inline bool sat_separates(const LocalPair& p, bool edges, MtvState& best) {
     vec3 axis;
+    float length2;
     for (int k = 0; k < 4; ++k)
-        if (unit_face_normal(p.a, k, axis) && axis_separates<track>(p, axis, 0.0f, best)) return true;
+        if (face_axis(p.a, k, axis, length2) && axis_separates<track>(p, axis, length2, 0.0f, best)) return true;
     for (int k = 0; k < 4; ++k)
-        if (unit_face_normal(p.b, k, axis) && axis_separates<track>(p, axis, 0.0f, best)) return true;
+        if (face_axis(p.b, k, axis, length2) && axis_separates<track>(p, axis, length2, 0.0f, best)) return true;
     if (!edges) return false;
     for (int i = 0; i < 6; ++i)
-        for (int j = 0; j < 6; ++j)
-            if (unit_cross(p.edge_a[i], p.length2_a[i], p.edge_b[j], p.length2_b[j], axis) &&
-                axis_separates<track>(p, axis, k_gap_tolerance, best))
-                return true;
+        if (edge_axes_separate<track>(p, i, best)) return true;
     return false;
 }
 

@@ -77,27 +77,29 @@ KDET_HD inline bool make_local_pair(const vec3 a[4], const vec3 b[4], LocalPair&
 /// @brief The answer for two tets that are single points: closed sets meet only if the points do.
 KDET_HD inline bool points_coincide(vec3 a, vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
-/// @brief Unit vector along cross(e, f), or false when the sine of their angle is below
+/// @brief cross(e, f) and its squared length, or false when the sine of their angle is below
 /// k_parallel_sine (this includes zero-length edges). e_length2 and f_length2 are |e|^2 and |f|^2.
-KDET_HD inline bool unit_cross(vec3 e, float e_length2, vec3 f, float f_length2, vec3& n) {
-    const vec3 c = cross(e, f);
-    const float c_length2 = length_squared(c);
-    if (c_length2 <= k_parallel_sine * k_parallel_sine * e_length2 * f_length2) return false;
-    n = c * (1.0f / sqrtf(c_length2));
-    return true;
+KDET_HD inline bool edge_axis(vec3 e, float e_length2, vec3 f, float f_length2, vec3& axis, float& length2) {
+    axis = cross(e, f);
+    length2 = length_squared(axis);
+    return length2 > k_parallel_sine * k_parallel_sine * e_length2 * f_length2;
 }
 
-/// @brief Unit normal of face k (the face opposite vertex k) of tet v, either orientation, or false
-/// for a degenerate face. The cross product uses the two edges at the vertex opposite the longest
-/// edge: their angle is the largest of the triangle, which keeps the rounding smallest.
-KDET_HD inline bool unit_face_normal(const vec3 v[4], int k, vec3& n) {
+/// @brief Normal of face k (the face opposite vertex k) of tet v, either orientation, not normalised,
+/// and its squared length; false for a degenerate face. The cross product uses the two edges at the
+/// vertex opposite the longest edge: their angle is the largest of the triangle, which keeps the
+/// rounding smallest.
+KDET_HD inline bool face_axis(const vec3 v[4], int k, vec3& axis, float& length2) {
     const vec3 p0 = v[(k + 1) & 3], p1 = v[(k + 2) & 3], p2 = v[(k + 3) & 3];
     const vec3 e01 = p1 - p0, e02 = p2 - p0, e12 = p2 - p1;
     const float l01 = length_squared(e01), l02 = length_squared(e02), l12 = length_squared(e12);
-    if (l12 >= l01 && l12 >= l02) return unit_cross(e01, l01, e02, l02, n);
-    if (l02 >= l01) return unit_cross(e01, l01, e12, l12, n);
-    return unit_cross(e02, l02, e12, l12, n);
+    if (l12 >= l01 && l12 >= l02) return edge_axis(e01, l01, e02, l02, axis, length2);
+    if (l02 >= l01) return edge_axis(e01, l01, e12, l12, axis, length2);
+    return edge_axis(e02, l02, e12, l12, axis, length2);
 }
+
+/// @brief axis scaled to unit length; length2 is its squared length (nonzero).
+KDET_HD inline vec3 unit(vec3 axis, float length2) { return axis * (1.0f / sqrtf(length2)); }
 
 /// @brief Closed interval of the projections of a tet's vertices onto an axis.
 struct Interval {
