@@ -43,6 +43,10 @@ public:
     /// @brief Vertex positions of `object` at `frame` (0-based) as x y z; `out` is resized.
     virtual void positions(std::size_t object, int frame, std::vector<float>& out) const = 0;
     virtual void positions(std::size_t object, int frame, std::vector<double>& out) const = 0;
+    /// @brief Whether the scene asks for collisions between objects @p a and @p b (default: every pair).
+    virtual bool checks_pair(std::size_t a, std::size_t b) const { return a != b; }
+    /// @brief Whether the scene asks for self-collisions of @p object (default: none).
+    virtual bool checks_self(std::size_t /*object*/) const { return false; }
 };
 
 /// @brief Size of a ProceduralScene.
@@ -103,12 +107,40 @@ struct SceneRequest {
     ProceduralSceneOptions procedural;      ///< size of the "procedural" scene
 };
 
-/// @brief Opens a scene by name. Known names: "procedural" (built in, needs no data).
-/// Throws kdet::Error naming the known scenes for an unknown name.
+/// @brief Opens a scene by name or path.
+///
+/// Names: "procedural" (built in, needs no data) and the thesis scenes "armadillos",
+/// "buddha_and_armadillo", "bunny_and_planck" (at `request.resolution`, 1-4) and
+/// "pass_through_armadillos" (always resolution 2); these read the meshes `kdet prepare` made (see
+/// prepared_mesh). A path opens a scene file (read_scene_file; a name ending in ".scene"), a recording
+/// (read_recording; ".kdetrec") or a folder of per-frame meshes (read_frame_folder).
+/// Throws kdet::Error naming the known scenes for an unknown name, and saying what is missing and
+/// where it was looked for when data is missing.
 std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& request = {});
 
 /// @brief Names open_scene accepts, for help texts and error messages.
 std::vector<std::string> scene_names();
+
+/// @brief Reads a scene file (the format of docs/scenes.md): objects with their meshes, placement and
+/// scripted motion (rigid keyframes and smooth deformations), the number of frames and the collisions
+/// checked. Objects without a fixed resolution take `request.resolution`. Throws kdet::Error
+/// "path:line: what" for a bad file and a clear message for a missing mesh.
+std::unique_ptr<Scene> read_scene_file(const std::string& path, const SceneRequest& request = {});
+
+/// @brief Plays back a simulation recorded elsewhere: a folder of per-frame tet meshes, one file per
+/// frame in the order of the numbers in their names (frame_9 before frame_10). The files are legacy
+/// VTK (.vtk) or TetGen (.node, with the tets of the folder's single .ele file); all frames must have
+/// the same vertex count and tets. One folder is one object; a folder of such folders (sorted by
+/// name) is one object each, with the same number of frames.
+std::unique_ptr<Scene> read_frame_folder(const std::string& path);
+
+/// @brief Plays back a recording in kdet's binary format (.kdetrec, see docs/scenes.md): the tets of
+/// each object once, then float32 positions per frame, read frame by frame from the file.
+std::unique_ptr<Scene> read_recording(const std::string& path);
+
+/// @brief Records every frame of @p scene into @p path in the .kdetrec format, with its collision
+/// settings; positions are stored as float32, as the detector uses them.
+void write_recording(const Scene& scene, const std::string& path);
 
 /// @brief Bends a straight bar so that, for angles above 2*pi, its two ends pass through each other.
 ///

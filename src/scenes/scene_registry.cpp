@@ -1,15 +1,58 @@
+/// @file scene_registry.cpp
+/// @brief open_scene: the built-in scenes by name, and scene files, recordings and frame folders by path.
+
+#include "scenes/scripted_scene.hpp"
+
 #include <kdet/error.hpp>
+#include <kdet/io.hpp>
 #include <kdet/scenes.hpp>
 
-namespace kdet {
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
-std::vector<std::string> scene_names() { return {"procedural"}; }
+namespace kdet {
+namespace {
+
+bool ends_with(const std::string& text, const std::string& suffix) {
+    return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::unique_ptr<Scene> play(scenes::SceneSpec spec, const std::string& default_name, const SceneRequest& request,
+                            const std::string& base_dir) {
+    if (spec.name.empty()) spec.name = default_name;
+    return std::make_unique<scenes::ScriptedScene>(std::move(spec), request.resolution, base_dir);
+}
+
+} // namespace
+
+std::vector<std::string> scene_names() {
+    std::vector<std::string> names = {"procedural"};
+    for (const auto& [name, text] : scenes::builtin_scene_files()) names.push_back(name);
+    return names;
+}
+
+std::unique_ptr<Scene> read_scene_file(const std::string& path, const SceneRequest& request) {
+    std::ifstream in(path);
+    if (!in) throw Error(path + ": cannot open scene file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    const std::filesystem::path file(path);
+    return play(scenes::parse_scene(text.str(), path), file.stem().string(), request, file.parent_path().string());
+}
 
 std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& request) {
     if (name == "procedural") return std::make_unique<ProceduralScene>(request.procedural);
+    for (const auto& [builtin, text] : scenes::builtin_scene_files())
+        if (name == builtin) return play(scenes::parse_scene(text, "scenes/" + builtin + ".scene"), builtin, request, ".");
+    std::error_code ignored;
+    if (ends_with(name, ".scene")) return read_scene_file(name, request);
+    if (ends_with(name, ".kdetrec")) return read_recording(name);
+    if (std::filesystem::is_directory(name, ignored)) return read_frame_folder(name);
     std::string known;
     for (const std::string& n : scene_names()) known += (known.empty() ? "" : ", ") + n;
-    throw Error("unknown scene '" + name + "' (known scenes: " + known + ")");
+    throw Error("unknown scene '" + name + "' (known scenes: " + known +
+                "; or a .scene file, a .kdetrec recording or a folder of frames)");
 }
 
 } // namespace kdet

@@ -1,0 +1,316 @@
+/// @file recorded_scene.cpp
+/// @brief Scenes played back from per-frame mesh files or from kdet's binary recordings (.kdetrec).
+
+#include <kdet/error.hpp>
+#include <kdet/io.hpp>
+#include <kdet/scenes.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+namespace kdet {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kMagic[8] = {'K', 'D', 'E', 'T', 'R', 'E', 'C', '1'};
+
+void check_frame(const std::string& scene, int frame, int frames) {
+    if (frame < 0 || frame >= frames)
+        throw Error("scene " + scene + " has no frame " + std::to_string(frame) + " (it has " + std::to_string(frames) +
+                    ")");
+}
+
+template <typename Real>
+void copy_positions(const std::vector<double>& in, std::vector<Real>& out) {
+    out.resize(in.size());
+    std::transform(in.begin(), in.end(), out.begin(), [](double x) { return static_cast<Real>(x); });
+}
+
+/// @brief Orders file names by the numbers in them, so that frame_9 comes before frame_10.
+bool natural_less(const std::string& a, const std::string& b) {
+    std::size_t i = 0, j = 0;
+    while (i < a.size() && j < b.size()) {
+        if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+            std::size_t ei = i, ej = j;
+            while (ei < a.size() && std::isdigit(static_cast<unsigned char>(a[ei]))) ++ei;
+            while (ej < b.size() && std::isdigit(static_cast<unsigned char>(b[ej]))) ++ej;
+            const std::string na = a.substr(i, ei - i), nb = b.substr(j, ej - j);
+            const std::size_t za = na.find_first_not_of('0'), zb = nb.find_first_not_of('0');
+            const std::string ta = za == std::string::npos ? "" : na.substr(za);
+            const std::string tb = zb == std::string::npos ? "" : nb.substr(zb);
+            if (ta.size() != tb.size()) return ta.size() < tb.size();
+            if (ta != tb) return ta < tb;
+            i = ei;
+            j = ej;
+        } else {
+            if (a[i] != b[j]) return a[i] < b[j];
+            ++i;
+            ++j;
+        }
+    }
+    return a.size() - i < b.size() - j;
+}
+
+/// @brief The frame files of one object folder: .vtk, or .node (each with its .ele).
+std::vector<std::string> frame_files(const fs::path& folder) {
+    std::vector<std::string> vtk, node;
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+        if (!entry.is_regular_file()) continue;
+        const std::string ext = entry.path().extension().string();
+        if (ext == ".vtk") vtk.push_back(entry.path().string());
+        if (ext == ".node") node.push_back(entry.path().string());
+    }
+    if (!vtk.empty() && !node.empty())
+        throw Error(folder.string() + ": holds both .vtk and .node frames; keep one kind per folder");
+    std::vector<std::string>& files = vtk.empty() ? node : vtk;
+    std::sort(files.begin(), files.end(), natural_less);
+    return files;
+}
+
+/// @brief One object per folder; each frame is read from its file when asked for.
+class FrameFolderScene final : public Scene {
+public:
+    explicit FrameFolderScene(const std::string& path) : name_(fs::path(path).filename().string()) {
+        if (!fs::is_directory(path)) throw Error(path + ": not a folder of frames");
+        std::vector<fs::path> folders;
+        if (!frame_files(path).empty()) {
+            folders.emplace_back(path);
+        } else {
+            for (const fs::directory_entry& entry : fs::directory_iterator(path))
+                if (entry.is_directory()) folders.push_back(entry.path());
+            std::sort(folders.begin(), folders.end());
+        }
+        for (const fs::path& folder : folders) {
+            files_.push_back(frame_files(folder));
+            if (files_.back().empty())
+                throw Error(folder.string() + ": no frame files (.vtk, or .node with .ele) found");
+            if (files_.back().size() != files_.front().size())
+                throw Error(folder.string() + ": " + std::to_string(files_.back().size()) + " frames, but " +
+                            folders.front().string() + " has " + std::to_string(files_.front().size()));
+            meshes_.push_back(read_tet_mesh(files_.back().front()));
+        }
+        if (files_.empty()) throw Error(path + ": no frame files (.vtk, or .node with .ele) and no object folders found");
+    }
+
+    std::string name() const override { return name_; }
+    std::size_t num_objects() const override { return meshes_.size(); }
+    int num_frames() const override { return static_cast<int>(files_.front().size()); }
+    const TetMesh& rest_mesh(std::size_t object) const override {
+        if (object >= meshes_.size()) throw Error("scene " + name_ + " has no object " + std::to_string(object));
+        return meshes_[object];
+    }
+    void positions(std::size_t object, int frame, std::vector<float>& out) const override {
+        copy_positions(read_frame(object, frame), out);
+    }
+    void positions(std::size_t object, int frame, std::vector<double>& out) const override {
+        out = read_frame(object, frame);
+    }
+
+private:
+    std::vector<double> read_frame(std::size_t object, int frame) const {
+        const TetMesh& rest = rest_mesh(object);
+        check_frame(name_, frame, num_frames());
+        const std::string& file = files_[object][static_cast<std::size_t>(frame)];
+        TetMesh mesh = read_tet_mesh(file);
+        if (mesh.tets != rest.tets)
+            throw Error(file + ": its tets differ from those of the first frame " + files_[object].front());
+        return std::move(mesh.positions);
+    }
+
+    std::string name_;
+    std::vector<std::vector<std::string>> files_;
+    std::vector<TetMesh> meshes_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// .kdetrec: little-endian throughout.
+
+void put_u32(std::ofstream& out, std::uint32_t value) {
+    const unsigned char bytes[4] = {static_cast<unsigned char>(value), static_cast<unsigned char>(value >> 8),
+                                    static_cast<unsigned char>(value >> 16), static_cast<unsigned char>(value >> 24)};
+    out.write(reinterpret_cast<const char*>(bytes), 4);
+}
+
+std::uint32_t get_u32(const unsigned char* bytes) {
+    return static_cast<std::uint32_t>(bytes[0]) | static_cast<std::uint32_t>(bytes[1]) << 8 |
+           static_cast<std::uint32_t>(bytes[2]) << 16 | static_cast<std::uint32_t>(bytes[3]) << 24;
+}
+
+std::uint32_t narrow(std::size_t value, const std::string& what) {
+    if (value > UINT32_MAX) throw Error("cannot record " + what + " " + std::to_string(value) + ": above 2^32 - 1");
+    return static_cast<std::uint32_t>(value);
+}
+
+/// @brief A .kdetrec file: the header is read at once, the positions of a frame when asked for.
+class RecordingScene final : public Scene {
+public:
+    explicit RecordingScene(const std::string& path) : path_(path), name_(fs::path(path).stem().string()) {
+        fd_ = ::open(path.c_str(), O_RDONLY);
+        if (fd_ < 0) throw Error(path + ": cannot open file");
+        try {
+            read_header();
+        } catch (...) {
+            ::close(fd_);
+            throw;
+        }
+    }
+    ~RecordingScene() override { ::close(fd_); }
+    RecordingScene(const RecordingScene&) = delete;
+    RecordingScene& operator=(const RecordingScene&) = delete;
+
+    std::string name() const override { return name_; }
+    std::size_t num_objects() const override { return meshes_.size(); }
+    int num_frames() const override { return frames_; }
+    const TetMesh& rest_mesh(std::size_t object) const override {
+        if (object >= meshes_.size()) throw Error("scene " + name_ + " has no object " + std::to_string(object));
+        return meshes_[object];
+    }
+    void positions(std::size_t object, int frame, std::vector<float>& out) const override {
+        read_frame(object, frame, out);
+    }
+    void positions(std::size_t object, int frame, std::vector<double>& out) const override {
+        std::vector<float> values;
+        read_frame(object, frame, values);
+        out.assign(values.begin(), values.end());
+    }
+    bool checks_pair(std::size_t a, std::size_t b) const override {
+        const auto pair = std::make_pair(std::min(a, b), std::max(a, b));
+        return std::find(pairs_.begin(), pairs_.end(), pair) != pairs_.end();
+    }
+    bool checks_self(std::size_t object) const override { return object < self_.size() && self_[object]; }
+
+private:
+    /// @brief Reads @p size bytes at @p offset; fails naming @p what when the file is shorter.
+    std::vector<unsigned char> read_at(std::uint64_t offset, std::size_t size, const std::string& what) const {
+        std::vector<unsigned char> bytes(size);
+        std::size_t done = 0;
+        while (done < size) {
+            const ssize_t got = ::pread(fd_, bytes.data() + done, size - done, static_cast<off_t>(offset + done));
+            if (got <= 0) throw Error(path_ + ": byte " + std::to_string(offset + done) + ": file ends inside " + what);
+            done += static_cast<std::size_t>(got);
+        }
+        return bytes;
+    }
+    std::uint32_t read_u32(std::uint64_t& offset, const std::string& what) const {
+        const std::uint32_t value = get_u32(read_at(offset, 4, what).data());
+        offset += 4;
+        return value;
+    }
+
+    void read_header() {
+        std::uint64_t at = 0;
+        if (std::memcmp(read_at(0, 8, "the header").data(), kMagic, 8) != 0)
+            throw Error(path_ + ": byte 0: not a kdet recording (it starts with KDETREC1)");
+        at = 8;
+        const std::uint32_t objects = read_u32(at, "the header");
+        frames_ = static_cast<int>(std::min<std::uint32_t>(read_u32(at, "the header"), INT32_MAX));
+        if (objects == 0 || frames_ == 0) throw Error(path_ + ": byte 8: a recording needs an object and a frame");
+        frame_bytes_ = 0;
+        for (std::uint32_t o = 0; o < objects; ++o) {
+            const std::string what = "object " + std::to_string(o);
+            TetMesh mesh;
+            const std::uint32_t vertices = read_u32(at, what), tets = read_u32(at, what);
+            self_.push_back(read_at(at, 1, what)[0] != 0);
+            at += 1;
+            const std::vector<unsigned char> bytes = read_at(at, 16ull * tets, "the tets of " + what);
+            at += 16ull * tets;
+            mesh.tets.resize(4ull * tets);
+            for (std::size_t i = 0; i < mesh.tets.size(); ++i) mesh.tets[i] = get_u32(&bytes[4 * i]);
+            mesh.positions.resize(3ull * vertices);
+            object_offset_.push_back(frame_bytes_);
+            frame_bytes_ += 12ull * vertices;
+            meshes_.push_back(std::move(mesh));
+        }
+        const std::uint32_t pairs = read_u32(at, "the pairs");
+        for (std::uint32_t p = 0; p < pairs; ++p) {
+            const std::uint32_t a = read_u32(at, "the pairs"), b = read_u32(at, "the pairs");
+            if (a >= objects || b >= objects || a == b)
+                throw Error(path_ + ": byte " + std::to_string(at - 8) + ": bad object pair " + std::to_string(a) +
+                            " " + std::to_string(b));
+            pairs_.emplace_back(std::min<std::size_t>(a, b), std::max<std::size_t>(a, b));
+        }
+        data_offset_ = at;
+        for (std::size_t o = 0; o < meshes_.size(); ++o) {
+            std::vector<double> rest;
+            positions(o, 0, rest);
+            meshes_[o].positions = rest;
+            validate_tet_mesh(meshes_[o], path_ + ": object " + std::to_string(o), {true});
+        }
+        // The last frame must be there too: a cut-off file fails now, not half-way through a run.
+        read_at(data_offset_ + frame_bytes_ * static_cast<std::uint64_t>(frames_) - 1, 1, "the last frame");
+    }
+
+    void read_frame(std::size_t object, int frame, std::vector<float>& out) const {
+        const TetMesh& mesh = rest_mesh(object);
+        check_frame(name_, frame, frames_);
+        const std::size_t count = mesh.positions.size();
+        const std::vector<unsigned char> bytes =
+            read_at(data_offset_ + frame_bytes_ * static_cast<std::uint64_t>(frame) + object_offset_[object], 4 * count,
+                    "frame " + std::to_string(frame));
+        out.resize(count);
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::uint32_t bits = get_u32(&bytes[4 * i]);
+            std::memcpy(&out[i], &bits, 4);
+        }
+    }
+
+    std::string path_, name_;
+    int fd_ = -1;
+    int frames_ = 0;
+    std::vector<TetMesh> meshes_;
+    std::vector<bool> self_;
+    std::vector<std::pair<std::size_t, std::size_t>> pairs_;
+    std::vector<std::uint64_t> object_offset_;
+    std::uint64_t frame_bytes_ = 0, data_offset_ = 0;
+};
+
+} // namespace
+
+std::unique_ptr<Scene> read_frame_folder(const std::string& path) { return std::make_unique<FrameFolderScene>(path); }
+
+std::unique_ptr<Scene> read_recording(const std::string& path) { return std::make_unique<RecordingScene>(path); }
+
+void write_recording(const Scene& scene, const std::string& path) {
+    std::ofstream out(path, std::ios::binary);
+    if (!out) throw Error(path + ": cannot create file");
+    out.write(kMagic, 8);
+    put_u32(out, narrow(scene.num_objects(), "object count"));
+    put_u32(out, narrow(static_cast<std::size_t>(scene.num_frames()), "frame count"));
+    for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+        const TetMesh& mesh = scene.rest_mesh(o);
+        put_u32(out, narrow(mesh.num_vertices(), "vertex count"));
+        put_u32(out, narrow(mesh.num_tets(), "tet count"));
+        out.put(scene.checks_self(o) ? 1 : 0);
+        for (const std::uint32_t index : mesh.tets) put_u32(out, index);
+    }
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t a = 0; a < scene.num_objects(); ++a)
+        for (std::size_t b = a + 1; b < scene.num_objects(); ++b)
+            if (scene.checks_pair(a, b)) pairs.emplace_back(static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b));
+    put_u32(out, narrow(pairs.size(), "pair count"));
+    for (const auto& [a, b] : pairs) {
+        put_u32(out, a);
+        put_u32(out, b);
+    }
+    std::vector<float> positions;
+    for (int f = 0; f < scene.num_frames(); ++f) {
+        for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+            scene.positions(o, f, positions);
+            for (const float x : positions) {
+                std::uint32_t bits;
+                std::memcpy(&bits, &x, 4);
+                put_u32(out, bits);
+            }
+        }
+    }
+    if (!out.flush()) throw Error(path + ": cannot write file");
+}
+
+} // namespace kdet

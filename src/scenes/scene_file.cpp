@@ -1,0 +1,221 @@
+/// @file scene_file.cpp
+/// @brief Parsing scene files (docs/scenes.md) into a SceneSpec.
+
+#include "scenes/scripted_scene.hpp"
+
+#include <kdet/error.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace kdet::scenes {
+namespace {
+
+constexpr const char* kHeader = "kdet-scene";
+constexpr int kMaxFrames = 1000000;
+
+/// @brief One statement: its words and its line, with the means to fail there.
+struct Statement {
+    std::vector<std::string> words;
+    std::size_t line = 0;
+    const std::string* source = nullptr;
+
+    [[noreturn]] void fail(const std::string& what) const {
+        throw Error(*source + ":" + std::to_string(line) + ": " + what);
+    }
+    /// @brief Fails unless the statement has exactly @p count words after its keyword.
+    void expect_arguments(std::size_t count, const char* usage) const {
+        if (words.size() != count + 1) fail("'" + words[0] + "' expects: " + usage);
+    }
+    double number(std::size_t i) const {
+        const std::string& text = words[i];
+        errno = 0;
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(value))
+            fail("'" + text + "' is not a finite number");
+        return value;
+    }
+    int integer(std::size_t i, int lo, int hi) const {
+        const double value = number(i);
+        if (value != std::floor(value) || value < lo || value > hi)
+            fail("'" + words[i] + "' is not a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return static_cast<int>(value);
+    }
+    int axis(std::size_t i) const {
+        const std::string& a = words[i];
+        if (a == "x") return 0;
+        if (a == "y") return 1;
+        if (a == "z") return 2;
+        fail("'" + a + "' is not an axis (x, y or z)");
+    }
+    std::array<double, 3> vector(std::size_t first) const {
+        return {number(first), number(first + 1), number(first + 2)};
+    }
+};
+
+std::vector<Statement> split_statements(const std::string& text, const std::string& source) {
+    std::vector<Statement> statements;
+    std::istringstream lines(text);
+    std::string line;
+    std::size_t number = 0;
+    while (std::getline(lines, line)) {
+        ++number;
+        line = line.substr(0, line.find('#'));
+        std::istringstream words(line);
+        Statement statement{{}, number, &source};
+        for (std::string word; words >> word;) statement.words.push_back(word);
+        if (!statement.words.empty()) statements.push_back(std::move(statement));
+    }
+    return statements;
+}
+
+std::size_t channel_width(Channel channel) { return channel == Channel::move || channel == Channel::turn ? 3 : 1; }
+
+bool parse_channel(const std::string& word, Channel& channel) {
+    static const char* const names[kNumChannels] = {"move", "turn", "bend", "twist", "squash"};
+    for (std::size_t c = 0; c < kNumChannels; ++c)
+        if (word == names[c]) {
+            channel = static_cast<Channel>(c);
+            return true;
+        }
+    return false;
+}
+
+/// @brief `key FRAME CHANNEL VALUES [CHANNEL VALUES ...]`.
+void parse_key(const Statement& s, ObjectSpec& object) {
+    if (s.words.size() < 4) s.fail("'key' expects: FRAME CHANNEL VALUE... (channels: move, turn, bend, twist, squash)");
+    const double frame = s.number(1);
+    if (frame < 0) s.fail("key frame " + s.words[1] + " is negative");
+    for (std::size_t i = 2; i < s.words.size();) {
+        Channel channel;
+        if (!parse_channel(s.words[i], channel))
+            s.fail("unknown channel '" + s.words[i] + "' (channels: move, turn, bend, twist, squash)");
+        const std::size_t width = channel_width(channel);
+        if (i + width >= s.words.size()) s.fail("'" + s.words[i] + "' needs " + std::to_string(width) + " value(s)");
+        Key key;
+        key.frame = frame;
+        for (std::size_t k = 0; k < width; ++k) key.value[k] = s.number(i + 1 + k);
+        std::vector<Key>& keys = object.keys[static_cast<std::size_t>(channel)];
+        if (!keys.empty() && keys.back().frame >= frame)
+            s.fail("keys of '" + s.words[i] + "' must have increasing frames (" + s.words[1] + " after " +
+                   std::to_string(keys.back().frame) + ")");
+        keys.push_back(key);
+        i += 1 + width;
+    }
+}
+
+/// @brief The statements that describe the current object; false for another keyword.
+bool parse_object_statement(const Statement& s, ObjectSpec& object) {
+    const std::string& w = s.words[0];
+    if (w == "mesh" || w == "file") {
+        s.expect_arguments(1, w == "mesh" ? "MODEL" : "PATH");
+        if (!object.model.empty() || !object.file.empty()) s.fail("object '" + object.name + "' already has a mesh");
+        (w == "mesh" ? object.model : object.file) = s.words[1];
+    } else if (w == "resolution") {
+        s.expect_arguments(1, "N (1-4)");
+        object.resolution = s.integer(1, 1, 4);
+    } else if (w == "scale") {
+        s.expect_arguments(1, "FACTOR");
+        object.scale = s.number(1);
+        if (!(object.scale > 0)) s.fail("scale must be positive");
+    } else if (w == "rotate") {
+        s.expect_arguments(3, "DEG_X DEG_Y DEG_Z");
+        object.rotate = s.vector(1);
+    } else if (w == "translate") {
+        s.expect_arguments(3, "X Y Z");
+        object.translate = s.vector(1);
+    } else if (w == "bend") {
+        s.expect_arguments(2, "ALONG_AXIS TOWARD_AXIS");
+        object.bend_along = s.axis(1);
+        object.bend_toward = s.axis(2);
+        if (object.bend_along == object.bend_toward) s.fail("bend needs two different axes");
+    } else if (w == "twist") {
+        s.expect_arguments(1, "AXIS");
+        object.twist_axis = s.axis(1);
+    } else if (w == "squash") {
+        s.expect_arguments(1, "AXIS");
+        object.squash_axis = s.axis(1);
+    } else if (w == "wobble") {
+        s.expect_arguments(2, "AMPLITUDE PERIOD_FRAMES");
+        object.wobble_amplitude = s.number(1);
+        object.wobble_period = s.number(2);
+        if (object.wobble_amplitude < 0 || !(object.wobble_period > 0))
+            s.fail("wobble needs an amplitude >= 0 and a positive period");
+    } else if (w == "key") {
+        parse_key(s, object);
+    } else {
+        return false;
+    }
+    return true;
+}
+
+std::size_t find_object(const SceneSpec& spec, const Statement& s, std::size_t word) {
+    for (std::size_t o = 0; o < spec.objects.size(); ++o)
+        if (spec.objects[o].name == s.words[word]) return o;
+    s.fail("no object named '" + s.words[word] + "'");
+}
+
+} // namespace
+
+SceneSpec parse_scene(const std::string& text, const std::string& source) {
+    const std::vector<Statement> statements = split_statements(text, source);
+    if (statements.empty() || statements[0].words[0] != kHeader)
+        throw Error(source + ":" + std::to_string(statements.empty() ? 1 : statements[0].line) +
+                    ": a scene file starts with '" + kHeader + " 1'");
+    statements[0].expect_arguments(1, "1 (the format version)");
+    if (statements[0].words[1] != "1") statements[0].fail("unknown scene format version '" + statements[0].words[1] + "'");
+
+    SceneSpec spec;
+    std::vector<const Statement*> collision_statements;  // resolved once every object is known
+    for (std::size_t i = 1; i < statements.size(); ++i) {
+        const Statement& s = statements[i];
+        const std::string& w = s.words[0];
+        if (w == "name") {
+            s.expect_arguments(1, "NAME");
+            spec.name = s.words[1];
+        } else if (w == "frames") {
+            s.expect_arguments(1, "N");
+            spec.frames = s.integer(1, 1, kMaxFrames);
+        } else if (w == "object") {
+            s.expect_arguments(1, "NAME");
+            for (const ObjectSpec& o : spec.objects)
+                if (o.name == s.words[1]) s.fail("object '" + s.words[1] + "' is declared twice");
+            spec.objects.emplace_back();
+            spec.objects.back().name = s.words[1];
+            spec.objects.back().line = s.line;
+        } else if (w == "collide" || w == "self") {
+            s.expect_arguments(w == "collide" ? 2 : 1, w == "collide" ? "OBJECT OBJECT" : "OBJECT");
+            collision_statements.push_back(&s);
+        } else if (spec.objects.empty()) {
+            ObjectSpec scratch;
+            if (parse_object_statement(s, scratch)) s.fail("'" + w + "' stands before any 'object'");
+            s.fail("unknown statement '" + w + "'");
+        } else if (!parse_object_statement(s, spec.objects.back())) {
+            s.fail("unknown statement '" + w + "'");
+        }
+    }
+    const Statement& last = statements.back();
+    if (spec.frames == 0) last.fail("the scene sets no 'frames'");
+    if (spec.objects.empty()) last.fail("the scene has no 'object'");
+    for (const ObjectSpec& o : spec.objects)
+        if (o.model.empty() && o.file.empty())
+            throw Error(source + ":" + std::to_string(o.line) + ": object '" + o.name + "' has no 'mesh' or 'file'");
+
+    for (const Statement* s : collision_statements) {
+        if (s->words[0] == "self") {
+            spec.self.push_back(find_object(spec, *s, 1));
+            continue;
+        }
+        std::size_t a = find_object(spec, *s, 1), b = find_object(spec, *s, 2);
+        if (a == b) s->fail("'collide' needs two different objects (use 'self' for self-collision)");
+        spec.pairs_given = true;
+        spec.pairs.emplace_back(std::min(a, b), std::max(a, b));
+    }
+    return spec;
+}
+
+} // namespace kdet::scenes

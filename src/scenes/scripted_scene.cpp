@@ -1,0 +1,193 @@
+/// @file scripted_scene.cpp
+/// @brief ScriptedScene: keyframed rigid motion plus smooth deformations of every object.
+
+#include "scenes/scripted_scene.hpp"
+
+#include <kdet/error.hpp>
+#include <kdet/io.hpp>
+#include <kdet/prepare.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace kdet::scenes {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegree = kPi / 180.0;
+
+using Vec = std::array<double, 3>;
+using Matrix = std::array<Vec, 3>;  // rows
+
+/// @brief Rotation by @p degrees about x, then y, then z.
+Matrix rotation(const Vec& degrees) {
+    const double cx = std::cos(degrees[0] * kDegree), sx = std::sin(degrees[0] * kDegree);
+    const double cy = std::cos(degrees[1] * kDegree), sy = std::sin(degrees[1] * kDegree);
+    const double cz = std::cos(degrees[2] * kDegree), sz = std::sin(degrees[2] * kDegree);
+    // Rz * Ry * Rx
+    return {Vec{cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
+            Vec{sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx}, Vec{-sy, cy * sx, cy * cx}};
+}
+
+Matrix multiply(const Matrix& a, const Matrix& b) {
+    Matrix m{};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) m[i][j] += a[i][k] * b[k][j];
+    return m;
+}
+
+/// @brief Everything about one object at one frame that does not depend on the vertex.
+struct Pose {
+    Matrix rotation{};
+    Vec translation{};
+    double bend = 0.0, twist = 0.0, squash = 0.0, wobble_phase = 0.0;
+};
+
+double channel(const ObjectSpec& object, Channel c, double frame) {
+    return evaluate(object.keys[static_cast<std::size_t>(c)], frame)[0];
+}
+
+} // namespace
+
+std::array<double, 3> evaluate(const std::vector<Key>& keys, double frame) {
+    if (keys.empty()) return {};
+    if (frame <= keys.front().frame) return keys.front().value;
+    if (frame >= keys.back().frame) return keys.back().value;
+    std::size_t k = 0;
+    while (keys[k + 1].frame <= frame) ++k;
+    // Catmull-Rom tangents; the first and last key take the slope towards their neighbour, so that two
+    // keys give a constant speed.
+    const auto tangent = [&](std::size_t i, std::size_t axis) {
+        const std::size_t before = i == 0 ? 0 : i - 1, after = i + 1 == keys.size() ? i : i + 1;
+        return (keys[after].value[axis] - keys[before].value[axis]) / (keys[after].frame - keys[before].frame);
+    };
+    const double h = keys[k + 1].frame - keys[k].frame;
+    const double s = (frame - keys[k].frame) / h;
+    // Cubic Hermite basis.
+    const double h00 = (1 + 2 * s) * (1 - s) * (1 - s), h10 = s * (1 - s) * (1 - s);
+    const double h01 = s * s * (3 - 2 * s), h11 = s * s * (s - 1);
+    std::array<double, 3> value{};
+    for (std::size_t axis = 0; axis < 3; ++axis)
+        value[axis] = h00 * keys[k].value[axis] + h10 * h * tangent(k, axis) + h01 * keys[k + 1].value[axis] +
+                      h11 * h * tangent(k + 1, axis);
+    return value;
+}
+
+ScriptedScene::ScriptedScene(SceneSpec spec, int resolution, const std::string& base_dir) : spec_(std::move(spec)) {
+    for (const ObjectSpec& object : spec_.objects) {
+        if (!object.model.empty()) {
+            meshes_.push_back(prepared_mesh(object.model, object.resolution != 0 ? object.resolution : resolution));
+        } else {
+            const std::filesystem::path path = std::filesystem::path(base_dir) / object.file;
+            meshes_.push_back(read_tet_mesh(path.string()));
+        }
+        const TetMesh& mesh = meshes_.back();
+        Vec lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+        for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+            lo[i % 3] = std::min(lo[i % 3], mesh.positions[i]);
+            hi[i % 3] = std::max(hi[i % 3], mesh.positions[i]);
+        }
+        RestFrame rest;
+        for (int a = 0; a < 3; ++a) {
+            rest.centre[a] = 0.5 * (lo[a] + hi[a]);
+            rest.half[a] = 0.5 * (hi[a] - lo[a]);
+        }
+        rest_.push_back(rest);
+        for (const Key& key : object.keys[static_cast<std::size_t>(Channel::squash)])
+            if (!(key.value[0] > -1.0 && key.value[0] < 0.9))
+                throw Error(spec_.name + ": object '" + object.name + "': squash " + std::to_string(key.value[0]) +
+                            " is outside (-1, 0.9)");
+    }
+}
+
+std::string ScriptedScene::name() const { return spec_.name; }
+
+std::size_t ScriptedScene::num_objects() const { return spec_.objects.size(); }
+
+int ScriptedScene::num_frames() const { return spec_.frames; }
+
+const TetMesh& ScriptedScene::rest_mesh(std::size_t object) const {
+    if (object >= meshes_.size())
+        throw Error("scene " + spec_.name + " has no object " + std::to_string(object) + " (it has " +
+                    std::to_string(meshes_.size()) + ")");
+    return meshes_[object];
+}
+
+bool ScriptedScene::checks_pair(std::size_t a, std::size_t b) const {
+    if (a == b) return false;
+    if (!spec_.pairs_given) return true;
+    const std::pair<std::size_t, std::size_t> pair(std::min(a, b), std::max(a, b));
+    return std::find(spec_.pairs.begin(), spec_.pairs.end(), pair) != spec_.pairs.end();
+}
+
+bool ScriptedScene::checks_self(std::size_t object) const {
+    return std::find(spec_.self.begin(), spec_.self.end(), object) != spec_.self.end();
+}
+
+template <typename Real>
+void ScriptedScene::write_positions(std::size_t object, int frame, std::vector<Real>& out) const {
+    const TetMesh& mesh = rest_mesh(object);
+    if (frame < 0 || frame >= spec_.frames)
+        throw Error("scene " + spec_.name + " has no frame " + std::to_string(frame) + " (it has " +
+                    std::to_string(spec_.frames) + ")");
+    const ObjectSpec& o = spec_.objects[object];
+    const RestFrame& rest = rest_[object];
+    const double f = frame;
+
+    Pose pose;
+    pose.rotation = multiply(rotation(evaluate(o.keys[static_cast<std::size_t>(Channel::turn)], f)), rotation(o.rotate));
+    const Vec move = evaluate(o.keys[static_cast<std::size_t>(Channel::move)], f);
+    for (int a = 0; a < 3; ++a) pose.translation[a] = o.translate[a] + move[a];
+    pose.bend = channel(o, Channel::bend, f);
+    pose.twist = channel(o, Channel::twist, f) * kDegree;
+    pose.squash = channel(o, Channel::squash, f);
+    pose.wobble_phase = o.wobble_period > 0 ? 2 * kPi * f / o.wobble_period : 0.0;
+    const double size = 2 * std::max({rest.half[0], rest.half[1], rest.half[2]});
+    const double wobble = o.wobble_amplitude * size;
+    // Squashing scales one axis and widens the other two so that the volume stays the same.
+    const double squash_along = 1.0 - pose.squash, squash_across = 1.0 / std::sqrt(squash_along);
+
+    out.resize(mesh.positions.size());
+    const auto num_vertices = static_cast<long long>(mesh.num_vertices());
+#pragma omp parallel for schedule(static)
+    for (long long v = 0; v < num_vertices; ++v) {
+        Vec q;  // relative to the centre of the rest box
+        for (int a = 0; a < 3; ++a) q[a] = mesh.positions[3 * v + a] - rest.centre[a];
+        const auto unit = [&](int a) { return rest.half[a] > 0 ? q[a] / rest.half[a] : 0.0; };
+        if (o.squash_axis >= 0) {
+            const int a = o.squash_axis;
+            // Anchored at the low end of the axis: an object squashed against the floor stays on it.
+            for (int b = 0; b < 3; ++b)
+                q[b] = b == a ? (q[b] + rest.half[b]) * squash_along - rest.half[b] : q[b] * squash_across;
+        }
+        if (o.bend_along >= 0) q[o.bend_toward] += pose.bend * rest.half[o.bend_along] * unit(o.bend_along) * unit(o.bend_along);
+        if (o.twist_axis >= 0) {
+            const int a = o.twist_axis, b = (a + 1) % 3, c = (a + 2) % 3;
+            const double angle = pose.twist * unit(a), cs = std::cos(angle), sn = std::sin(angle);
+            const double qb = q[b], qc = q[c];
+            q[b] = cs * qb - sn * qc;
+            q[c] = sn * qb + cs * qc;
+        }
+        if (wobble > 0) {
+            // A travelling wave: its phase differs between vertices, so no vertex rests between frames.
+            for (int a = 0; a < 3; ++a)
+                q[a] += wobble * std::sin(pose.wobble_phase + kPi * unit((a + 1) % 3) + 2.1 * a);
+        }
+        for (int a = 0; a < 3; ++a) q[a] = o.scale * (q[a] + rest.centre[a]);
+        for (int a = 0; a < 3; ++a)
+            out[3 * v + a] = static_cast<Real>(pose.translation[a] + pose.rotation[a][0] * q[0] +
+                                               pose.rotation[a][1] * q[1] + pose.rotation[a][2] * q[2]);
+    }
+}
+
+void ScriptedScene::positions(std::size_t object, int frame, std::vector<float>& out) const {
+    write_positions(object, frame, out);
+}
+
+void ScriptedScene::positions(std::size_t object, int frame, std::vector<double>& out) const {
+    write_positions(object, frame, out);
+}
+
+} // namespace kdet::scenes

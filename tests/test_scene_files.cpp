@@ -1,0 +1,299 @@
+// Scene files, the thesis scenes and recorded scenes.
+
+#include "prepare_support.hpp"
+#include "scenes/scripted_scene.hpp"
+#include "test_support.hpp"
+
+#include <kdet/detector.hpp>
+#include <kdet/error.hpp>
+#include <kdet/io.hpp>
+#include <kdet/scenes.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <ostream>
+#include <string>
+#include <unistd.h>
+
+namespace kdet::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("kdet-scene-test-" + name + "-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string parse_error(const std::string& text) {
+    try {
+        scenes::parse_scene(text, "s.scene");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+TEST(SceneFile, ErrorsNameFileAndLine) {
+    EXPECT_EQ(parse_error("frames 3\n"), "s.scene:1: a scene file starts with 'kdet-scene 1'");
+    EXPECT_EQ(parse_error("kdet-scene 2\n"), "s.scene:1: unknown scene format version '2'");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n  mesh bunny\n  colour red\n"),
+              "s.scene:5: unknown statement 'colour'");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes x\n"), "s.scene:2: 'x' is not a finite number");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nmesh bunny\n"), "s.scene:3: 'mesh' stands before any 'object'");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n mesh bunny\n key 5 move 1 2\n"),
+              "s.scene:5: 'move' needs 3 value(s)");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n mesh bunny\n key 5 bend 1\n key 2 bend 0\n"),
+              "s.scene:6: keys of 'bend' must have increasing frames (2 after 5.000000)");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n mesh bunny\ncollide a b\n"),
+              "s.scene:5: no object named 'b'");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n"), "s.scene:3: object 'a' has no 'mesh' or 'file'");
+    EXPECT_EQ(parse_error("kdet-scene 1\nobject a\n mesh bunny\n"), "s.scene:3: the scene sets no 'frames'");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 2\nobject a\n twist w\n"), "s.scene:4: 'w' is not an axis (x, y or z)");
+}
+
+TEST(SceneFile, KeysInterpolateSmoothly) {
+    std::vector<scenes::Key> keys = {{0, {0, 0, 0}}, {10, {1, 2, 3}}};
+    // Two keys: constant speed.
+    EXPECT_DOUBLE_EQ(scenes::evaluate(keys, 5)[0], 0.5);
+    EXPECT_DOUBLE_EQ(scenes::evaluate(keys, 2.5)[2], 0.75);
+    // Constant outside the keys; zero without keys.
+    EXPECT_DOUBLE_EQ(scenes::evaluate(keys, -3)[1], 0.0);
+    EXPECT_DOUBLE_EQ(scenes::evaluate(keys, 30)[1], 2.0);
+    EXPECT_DOUBLE_EQ(scenes::evaluate({}, 4)[0], 0.0);
+    // Through every key, and flat at a turning key between two equal neighbours.
+    keys.push_back({20, {0, 0, 0}});
+    EXPECT_DOUBLE_EQ(scenes::evaluate(keys, 10)[0], 1.0);
+    EXPECT_LT(scenes::evaluate(keys, 9.9)[0], 1.0);
+    EXPECT_LT(scenes::evaluate(keys, 10.1)[0], 1.0);
+}
+
+/// @brief A scene file of two boxes written next to their TetGen meshes.
+fs::path write_box_scene(const fs::path& dir) {
+    write_tetgen(make_box_mesh(6, 3, 3, 0.1), (dir / "box").string());
+    std::ofstream(dir / "boxes.scene") << R"(kdet-scene 1
+name boxes
+frames 30
+object left                 # comment
+  file box.node
+  rotate 0 0 10
+  translate -1 0 0
+  key 0 move 0 0 0
+  key 20 move 0.8 0 0
+  squash x
+  key 0 squash 0
+  key 29 squash 0.2
+  bend x y
+  key 0 bend 0.1
+  twist x
+  key 0 twist 0
+  key 29 twist 30
+  wobble 0.01 7
+object right
+  file box.node
+  translate 0.5 0 0
+collide left right
+self left
+)";
+    return dir / "boxes.scene";
+}
+
+TEST(SceneFile, PlaysBackDeterministicallyAndMovesEveryVertex) {
+    const fs::path dir = fresh_dir("boxes");
+    const fs::path path = write_box_scene(dir);
+    const auto one = open_scene(path.string()), two = read_scene_file(path.string());
+    EXPECT_EQ(one->name(), "boxes");
+    EXPECT_EQ(one->num_frames(), 30);
+    ASSERT_EQ(one->num_objects(), 2u);
+    EXPECT_TRUE(one->checks_pair(0, 1));
+    EXPECT_TRUE(one->checks_self(0));
+    EXPECT_FALSE(one->checks_self(1));
+    std::vector<double> a, b, previous;
+    for (int f = 0; f < one->num_frames(); ++f) {
+        one->positions(0, f, a);
+        two->positions(0, f, b);
+        EXPECT_EQ(a, b) << "frame " << f;
+        if (f > 0) {
+            for (std::size_t v = 0; v < a.size() / 3; ++v) {
+                EXPECT_TRUE(a[3 * v] != previous[3 * v] || a[3 * v + 1] != previous[3 * v + 1] ||
+                            a[3 * v + 2] != previous[3 * v + 2])
+                    << "vertex " << v << " rests at frame " << f;
+            }
+        }
+        previous = a;
+    }
+    // The still object keeps its rest shape, translated.
+    one->positions(1, 17, b);
+    EXPECT_DOUBLE_EQ(b[0], one->rest_mesh(1).positions[0] + 0.5);
+    EXPECT_THROW(one->positions(0, 30, a), Error);
+    fs::remove_all(dir);
+}
+
+TEST(SceneFile, MissingMeshFileIsNamed) {
+    const fs::path dir = fresh_dir("missing");
+    std::ofstream(dir / "m.scene") << "kdet-scene 1\nframes 2\nobject a\n file nothing.node\n";
+    try {
+        read_scene_file((dir / "m.scene").string());
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("nothing"), std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
+}
+
+TEST(SceneRegistry, KnowsTheThesisScenes) {
+    const std::vector<std::string> names = scene_names();
+    for (const char* name : {"procedural", "armadillos", "buddha_and_armadillo", "bunny_and_planck",
+                             "pass_through_armadillos"})
+        EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+    try {
+        open_scene("teapots");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("known scenes: procedural, armadillos"), std::string::npos) << e.what();
+    }
+}
+
+TEST(RecordedScene, BinaryRecordingPlaysBackExactly) {
+    const fs::path dir = fresh_dir("recording");
+    const auto scene = read_scene_file(write_box_scene(dir).string());
+    const std::string path = (dir / "boxes.kdetrec").string();
+    write_recording(*scene, path);
+    const auto played = open_scene(path);
+    ASSERT_EQ(played->num_objects(), 2u);
+    EXPECT_EQ(played->num_frames(), 30);
+    EXPECT_EQ(played->rest_mesh(0).tets, scene->rest_mesh(0).tets);
+    EXPECT_TRUE(played->checks_pair(0, 1));
+    EXPECT_TRUE(played->checks_self(0));
+    EXPECT_FALSE(played->checks_self(1));
+    std::vector<float> a, b;
+    for (int f : {0, 13, 29}) {
+        for (std::size_t o = 0; o < 2; ++o) {
+            scene->positions(o, f, a);
+            played->positions(o, f, b);
+            EXPECT_EQ(a, b) << "object " << o << " frame " << f;
+        }
+    }
+    // A cut-off file is refused when opened.
+    fs::resize_file(path, fs::file_size(path) - 5);
+    EXPECT_THROW(read_recording(path), Error);
+    fs::remove_all(dir);
+}
+
+TEST(RecordedScene, FolderOfVtkFrames) {
+    const fs::path dir = fresh_dir("frames");
+    const auto scene = read_scene_file(write_box_scene(dir).string());
+    for (std::size_t o = 0; o < 2; ++o) {
+        const fs::path folder = dir / "recorded" / (o == 0 ? "a" : "b");
+        fs::create_directories(folder);
+        for (int f = 0; f < 12; ++f) {
+            TetMesh frame = scene->rest_mesh(o);
+            scene->positions(o, f, frame.positions);
+            write_vtk(frame, (folder / ("frame_" + std::to_string(f) + ".vtk")).string());
+        }
+    }
+    const auto played = open_scene((dir / "recorded").string());
+    ASSERT_EQ(played->num_objects(), 2u);
+    ASSERT_EQ(played->num_frames(), 12);
+    std::vector<double> a, b;
+    // frame_10 must come after frame_9, not after frame_1.
+    scene->positions(0, 10, a);
+    played->positions(0, 10, b);
+    EXPECT_EQ(a, b);
+    fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The thesis scenes, with the meshes `kdet prepare` makes.
+
+struct ThesisCase {
+    const char* scene;
+    int resolution;
+    std::vector<int> contact_frames;  ///< frames that must have colliding pairs
+    std::size_t deforming_object;     ///< an object whose every vertex moves every frame
+};
+
+void PrintTo(const ThesisCase& c, std::ostream* out) { *out << c.scene << " resolution " << c.resolution; }
+
+class ThesisScene : public ::testing::TestWithParam<ThesisCase> {};
+
+TEST_P(ThesisScene, DeterministicWithContact) {
+    const ThesisCase& c = GetParam();
+    KDET_PREPARE_OR_SKIP("-r " + std::to_string(c.resolution));
+    SceneRequest request;
+    request.resolution = c.resolution;
+    const auto scene = open_scene(c.scene, request), again = open_scene(c.scene, request);
+    EXPECT_EQ(scene->name(), c.scene);
+    EXPECT_EQ(scene->num_frames(), 160);
+    ASSERT_EQ(scene->num_objects(), 2u);
+    EXPECT_TRUE(scene->checks_pair(0, 1));
+
+    Detector detector;
+    for (std::size_t o = 0; o < 2; ++o) detector.add_object(scene->rest_mesh(o));
+    std::vector<float> positions, repeated, previous;
+    int first_contact = -1;
+    for (int f = 0; f < scene->num_frames(); ++f) {
+        for (std::size_t o = 0; o < 2; ++o) {
+            scene->positions(o, f, positions);
+            detector.set_positions(static_cast<ObjectId>(o), positions.data(), positions.size() / 3);
+            if (f % 40 == 0) {
+                again->positions(o, f, repeated);
+                EXPECT_EQ(positions, repeated) << "frame " << f << " differs between two runs";
+            }
+            if (o == c.deforming_object) {
+                if (f > 0) {
+                    std::size_t resting = 0;
+                    for (std::size_t i = 0; i < positions.size(); i += 3)
+                        resting += positions[i] == previous[i] && positions[i + 1] == previous[i + 1] &&
+                                   positions[i + 2] == previous[i + 2];
+                    EXPECT_EQ(resting, 0u) << "vertices of object " << o << " rest at frame " << f;
+                }
+                previous = positions;
+            }
+        }
+        // Detection on every 8th frame and the contact frames keeps the test short.
+        const bool contact_frame =
+            std::find(c.contact_frames.begin(), c.contact_frames.end(), f) != c.contact_frames.end();
+        if (f % 8 != 0 && !contact_frame) continue;
+        const std::size_t pairs = detector.detect().pairs.size();
+        if (f == 0) {
+            EXPECT_EQ(pairs, 0u) << "the objects start apart";
+        }
+        if (pairs > 0 && first_contact < 0) first_contact = f;
+        if (contact_frame) {
+            EXPECT_GT(pairs, 0u) << c.scene << " frame " << f << " should be in contact";
+        }
+    }
+    EXPECT_GT(first_contact, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, ThesisScene,
+                         ::testing::Values(ThesisCase{"armadillos", 1, {80, 85, 90}, 0},
+                                           ThesisCase{"buddha_and_armadillo", 1, {65, 95, 130, 159}, 1},
+                                           ThesisCase{"bunny_and_planck", 1, {65, 95, 130, 159}, 0},
+                                           ThesisCase{"pass_through_armadillos", 2, {60, 79, 100}, 1}),
+                         [](const ::testing::TestParamInfo<ThesisCase>& p) { return std::string(p.param.scene); });
+
+TEST(ThesisScenes, MissingMeshSaysWhereToLook) {
+    const fs::path dir = fresh_dir("no-cache");
+    const char* old = std::getenv("KDET_CACHE_DIR");
+    const std::string saved = old ? old : "";
+    setenv("KDET_CACHE_DIR", dir.c_str(), 1);
+    try {
+        open_scene("armadillos");
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "mesh armadillo resolution 1 is not prepared; run `kdet prepare` (cache: " + dir.string() + ")");
+    }
+    old ? setenv("KDET_CACHE_DIR", saved.c_str(), 1) : unsetenv("KDET_CACHE_DIR");
+    fs::remove_all(dir);
+}
+
+} // namespace
+} // namespace kdet::test
