@@ -80,10 +80,12 @@ TEST(Cli, SelfCollisionJsonHasCountsTimesAndMemory) {
 }
 
 TEST(Cli, BenchRunsTheBuiltInSceneWithoutData) {
-    const Outcome r = kdet_cli("bench --tets 3000 --frames 9 -s yes");
+    const auto out_dir = temp_dir() / "bench";
+    const Outcome r = kdet_cli("bench --tets 3000 --scene-frames 9 -s yes -n 2 -d " + out_dir.string());
     ASSERT_EQ(r.exit_code, 0) << r.out;
     EXPECT_NE(r.out.find("scene procedural"), std::string::npos);
     EXPECT_NE(r.out.find("summary: median"), std::string::npos);
+    EXPECT_NE(r.out.find("wrote " + out_dir.string()), std::string::npos);
     EXPECT_GE(line_count(r.out), 9u + 3u);
 }
 
@@ -113,10 +115,22 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
         {"collide /nonexistent/x.mesh --self", 1, "/nonexistent/x.mesh: cannot open file"},
         {"collide BAD --self", 1, "bad.mesh:6: "},
         {"collide BUNNY BUNNY --hash md5", 2, "invalid value 'md5' for --hash"},
-        {"bench -c nope", 2, "invalid value 'nope' for -c"},
-        {"bench -s maybe", 2, "invalid value 'maybe' for -s"},
+        {"bench -c nope", 2, "invalid value 'nope' for -c: expected kdet, kdet_no_pairs, gpu or gpu_no_loop"},
+        {"bench -s maybe", 2, "invalid value 'maybe' for -s: expected yes, y, no or n"},
+        {"bench -r 5", 2, "invalid value '5' for -r"},
+        {"bench -o sat-mtv", 2, "invalid value 'sat-mtv' for -o"},
+        {"bench -g 100", 2, "invalid value '100' for -g"},
+        {"bench -n 21", 2, "invalid value '21' for -n"},
+        {"bench -h md5", 2, "invalid value 'md5' for -h: expected djb2, fnv-1a, morton or simple"},
+        {"bench -h", 2, "option '-h' needs a value"},
+        {"bench --backend gpu", 2, "invalid value 'gpu' for --backend"},
+        {"bench --threads 0", 2, "invalid value '0' for --threads"},
+        {"bench --frames 5:2", 2, "invalid value '5:2' for --frames"},
+        {"bench --tets 300 --scene-frames 9 --frames 3:9", 2, "for --frames: scene 'procedural' has frames 0 to 8"},
         {"bench --tets 5", 2, "--tets"},
         {"bench nosuchscene", 2, "unknown scene 'nosuchscene'"},
+        {"bench nosuchscene --tets 500", 2, "--tets applies to the procedural scene only"},
+        {"bench --frobnicate", 2, "unknown option '--frobnicate'"},
         {"frobnicate", 2, "unknown command 'frobnicate'"},
     };
     for (const BadCall& call : calls) {

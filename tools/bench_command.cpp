@@ -1,3 +1,7 @@
+#include "bench_args.hpp"
+#include "bench_csv.hpp"
+#include "bench_progress.hpp"
+#include "bench_runner.hpp"
 #include "commands.hpp"
 
 #include <kdet/detector.hpp>
@@ -7,124 +11,87 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
-#include <vector>
+#include <memory>
 
 namespace kdet::cli {
 
 namespace {
 
-const char* bench_help = R"(usage: kdet bench [procedural] [options]
+/// @brief Index of a column of frame_columns().
+std::size_t column(const std::string& name) {
+    const auto& columns = frame_columns();
+    return static_cast<std::size_t>(std::find(columns.begin(), columns.end(), name) - columns.begin());
+}
 
-Runs the built-in procedural scene (two deforming tori that approach, interpenetrate and separate)
-and prints per-frame detection times and pair counts. Needs no data files.
+std::unique_ptr<Scene> open_bench_scene(const BenchConfig& config) {
+    if (!config.procedural_flag.empty() && config.scene != "procedural")
+        throw UsageError("bench: " + config.procedural_flag + " applies to the procedural scene only (scene is '" +
+                         config.scene + "')");
+    std::unique_ptr<Scene> scene;
+    try {
+        scene = open_scene(config.scene, config.request);
+    } catch (const Error& e) {
+        throw UsageError(std::string("bench: ") + e.what());
+    }
+    if (config.first_frame >= scene->num_frames() || config.last_frame >= scene->num_frames())
+        throw UsageError("invalid value '" + std::to_string(config.first_frame) + ":" + std::to_string(config.last_frame) +
+                         "' for --frames: scene '" + scene->name() + "' has frames 0 to " +
+                         std::to_string(scene->num_frames() - 1));
+    return scene;
+}
 
-options:
-  --tets N             total tetrahedra of the scene (default 100000, up to 20000000)
-  --frames N           frames to run (default 120)
-  -n N                 runs of the whole scene; times are averaged per frame (default 1, at most 20)
-  -c M                 method: kdet, kdet_no_pairs, gpu (brute force, loop), gpu_no_loop (brute force, pairs)
-  -o T                 narrow phase: sat, sat_no_edges, sat_mtv, gjk, fast
-  -h H                 grid hash: djb2, fnv-1a, morton, simple (as in the thesis; --help prints this)
-  -g N                 CUDA block size: 16, 32, 64, 128 or 256
-  -s yes|y|no|n        self-collisions of both objects (default no)
-  --quiet              print only the summary
-)";
+void print_report(const BenchConfig& config, const Scene& scene, const BenchOutcome& outcome, const BenchFiles& files) {
+    const std::vector<FrameRow> mean = average_runs(outcome.runs);
+    const auto value = [&](const std::string& key) {
+        for (const auto& [k, v] : outcome.header)
+            if (k == key) return v;
+        return std::string();
+    };
+    std::printf("scene %s (resolution %d): %s+%s tets, frames %d-%d, %d run(s); method %s, test %s, hash %s, self %s, "
+                "backend %s on %s\n",
+                scene.name().c_str(), config.request.resolution, value("#tetsA").c_str(), value("#tetsB").c_str(),
+                config.first_frame, last_frame_of(config, scene), config.runs, bench_method_name(config.options.method),
+                to_string(config.options.narrow_phase), value("hashing algorithm").c_str(), config.self ? "yes" : "no",
+                to_string(config.options.backend), value("device").c_str());
+    const std::size_t device = column("device time"), pairs = column("collision pairs");
+    if (!config.quiet) {
+        std::printf("%6s %12s %12s %14s %14s %12s %12s\n", "frame", "device_ms", "host_ms", "candidates", "unique",
+                    "pairs", "tets");
+        for (const FrameRow& row : mean)
+            std::printf("%6.0f %12.3f %12.3f %14.0f %14.0f %12.0f %12.0f\n", row[column("frame")], row[device],
+                        row[column("host time")], row[column("candidates")], row[column("unique candidates")],
+                        row[pairs], row[column("colliding tets")]);
+    }
+    std::vector<double> times;
+    double max_pairs = 0;
+    for (const FrameRow& row : mean) {
+        times.push_back(row[device]);
+        max_pairs = std::max(max_pairs, row[pairs]);
+    }
+    std::sort(times.begin(), times.end());
+    std::printf("summary: median %.3f ms, max %.3f ms per frame; most colliding pairs in a frame %.0f; "
+                "peak memory %.1f MiB\n",
+                times[times.size() / 2], times.back(), max_pairs,
+                static_cast<double>(outcome.peak_memory) / (1024.0 * 1024.0));
+    std::printf("wrote %s\nwrote %s\n", files.averages.c_str(), files.runs.c_str());
+}
 
 } // namespace
 
 int run_bench(int argc, char** argv) {
-    DetectorOptions options;
-    SceneRequest request;
-    ProceduralSceneOptions& scene_options = request.procedural;
-    int runs = 1;
-    bool self = false, quiet = false, help = false;
-    std::vector<std::string> scene_arguments;
-
-    ArgParser parser("bench");
-    parser.positionals(1, scene_arguments);
-    parser.flag("--help", [&] { help = true; });
-    parser.flag("--quiet", [&] { quiet = true; });
-    parser.option("--tets", "N", [&](const std::string& v) {
-        scene_options.total_tets = static_cast<std::size_t>(parse_integer("--tets", v, 100, 20000000));
-    });
-    parser.option("--frames", "N",
-                  [&](const std::string& v) { scene_options.frames = static_cast<int>(parse_integer("--frames", v, 1, 100000)); });
-    parser.option("-n", "runs", [&](const std::string& v) { runs = static_cast<int>(parse_integer("-n", v, 1, 20)); });
-    parser.option("-c", "method", [&](const std::string& v) {
-        const std::string m = parse_choice("-c", v, {"kdet", "kdet_no_pairs", "gpu", "gpu_no_loop"});
-        options.method = m == "gpu" ? Method::brute_force_loop
-                         : m == "gpu_no_loop" ? Method::brute_force_pairs
-                                              : (m == "kdet" ? Method::kdet : Method::kdet_no_pairs);
-    });
-    parser.option("-o", "test", [&](const std::string& v) {
-        parse(parse_choice("-o", v, {"sat", "sat_no_edges", "sat_mtv", "gjk", "fast"}), options.narrow_phase);
-    });
-    parser.option("-h", "hash", [&](const std::string& v) {
-        parse(parse_choice("-h", v, {"djb2", "fnv-1a", "morton", "simple"}), options.hash);
-    });
-    parser.option("-g", "block size", [&](const std::string& v) {
-        options.block_size = std::stoi(parse_choice("-g", v, {"16", "32", "64", "128", "256"}));
-    });
-    parser.option("-s", "yes|no", [&](const std::string& v) {
-        self = parse_choice("-s", v, {"yes", "y", "no", "n"})[0] == 'y';
-    });
-    add_detector_options(parser, options);
-    parser.parse(argc, argv, 2);
-    if (help) {
-        std::cout << bench_help << detector_options_help();
+    const BenchConfig config = parse_bench_args(argc, argv, 2);
+    if (config.help) {
+        std::cout << bench_help() << "\nknown scenes: " << join_choices(scene_names()) << "\n";
         return exit_ok;
     }
-    std::unique_ptr<Scene> opened;
-    try {
-        opened = open_scene(scene_arguments.empty() ? "procedural" : scene_arguments[0], request);
-    } catch (const Error& e) {
-        throw UsageError(std::string("bench: ") + e.what());
-    }
-    const Scene& scene = *opened;
-    Detector detector(options);
-    for (std::size_t o = 0; o < scene.num_objects(); ++o) {
-        const ObjectId id = detector.add_object(scene.rest_mesh(o));
-        detector.set_self_collision(id, self);
-    }
-    const int frames = scene.num_frames();
-    std::vector<double> frame_ms(static_cast<std::size_t>(frames), 0.0);
-    std::vector<FrameCounts> counts(static_cast<std::size_t>(frames));
-    std::vector<float> xyz;
-    std::size_t peak_memory = 0;
-    for (int run = 0; run < runs; ++run)
-        for (int f = 0; f < frames; ++f) {
-            for (std::size_t o = 0; o < scene.num_objects(); ++o) {
-                scene.positions(o, f, xyz);
-                detector.set_positions(static_cast<ObjectId>(o), xyz.data(), xyz.size() / 3);
-            }
-            const FrameResult& r = detector.detect();
-            frame_ms[static_cast<std::size_t>(f)] += r.times.total / runs;
-            counts[static_cast<std::size_t>(f)] = r.counts;
-            peak_memory = std::max(peak_memory, r.memory_bytes);
-        }
-
-    std::size_t tets = 0;
-    for (std::size_t o = 0; o < scene.num_objects(); ++o) tets += scene.rest_mesh(o).num_tets();
-    std::printf("scene %s: %zu objects, %zu tets, %d frames, %d run(s); method %s, test %s, hash %s, self %s, "
-                "backend %s on %s\n",
-                scene.name().c_str(), scene.num_objects(), tets, frames, runs, to_string(options.method), to_string(options.narrow_phase),
-                to_string(options.hash), self ? "yes" : "no", to_string(options.backend), detector.device_name().c_str());
-    if (!quiet) {
-        std::printf("%6s %12s %14s %14s %12s %12s\n", "frame", "time_ms", "candidates", "unique", "pairs", "tets");
-        for (int f = 0; f < frames; ++f) {
-            const FrameCounts& c = counts[static_cast<std::size_t>(f)];
-            std::printf("%6d %12.3f %14llu %14llu %12llu %12llu\n", f, frame_ms[static_cast<std::size_t>(f)],
-                        static_cast<unsigned long long>(c.candidates), static_cast<unsigned long long>(c.unique_candidates),
-                        static_cast<unsigned long long>(c.colliding_pairs),
-                        static_cast<unsigned long long>(c.colliding_tets));
-        }
-    }
-    std::vector<double> sorted = frame_ms;
-    std::sort(sorted.begin(), sorted.end());
-    unsigned long long max_pairs = 0;
-    for (const FrameCounts& c : counts) max_pairs = std::max<unsigned long long>(max_pairs, c.colliding_pairs);
-    std::printf("summary: median %.3f ms, max %.3f ms per frame; most colliding pairs in a frame %llu; peak memory %.1f MiB\n",
-                sorted[sorted.size() / 2], sorted.back(), max_pairs, static_cast<double>(peak_memory) / (1024.0 * 1024.0));
+    std::string reason;
+    if (config.options.backend == Backend::cuda && !cuda_available(&reason))
+        throw Error("bench: --backend cuda is not available here: " + reason);
+    const std::unique_ptr<Scene> scene = open_bench_scene(config);
+    ProgressBar progress(!config.quiet, config.runs, last_frame_of(config, *scene) - config.first_frame + 1);
+    const BenchOutcome outcome = run_benchmark(config, *scene, progress);
+    const BenchFiles files = write_bench_files(config.output_dir, outcome.stem, outcome.header, outcome.runs);
+    print_report(config, *scene, outcome, files);
     return exit_ok;
 }
 

@@ -1,0 +1,274 @@
+#!/usr/bin/env python3
+"""Draws the figures of the thesis's chapter 6 from the CSV files that `kdet bench` writes.
+
+usage: python3 python/kdet_plot.py FOLDER [--out DIR]      (default DIR: FOLDER/plots)
+
+Figures ("_self" in the name: with self-collisions); times are device times in ms:
+  frame_times[_self].png             time per frame, one line per method, scenes x resolutions (6.10, 6.15)
+  stages_<method>[_self].png         stacked time per pipeline stage over the frames (6.14, 6.20)
+  boxplot_<method>[_self].png        frame times per scene and resolution (6.17, 6.18)
+  penetration_<scene>.png            time and unique candidates against the bounding-box overlap
+                                     along x, the thesis's penetration depth, with a cubic fit (6.13)
+  memory[_self].png                  peak detector memory per scene and resolution (6.22)
+  run_spread_<method>[_self].png     mean, min-max range and standard deviation over the runs (6.2)
+  host_vs_device_<method>[_self].png wall-clock time of detect() against its own total (6.4)
+  total_time.png                     frame times summed over all benchmarks per method (6.21)
+Needs matplotlib (python/requirements.txt).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections import defaultdict
+from typing import Callable
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only, no display
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from kdet_csv import BenchFile, read_folder  # noqa: E402
+
+STAGES = [
+    ("bbox time", "bounding boxes"),
+    ("populate time", "populate grid"),
+    ("find candidates time", "find candidates"),
+    ("sort unique time", "sort + unique"),
+    ("narrow phase time", "narrow phase"),
+]
+# Parameters that tell apart two files of the same method in one figure.
+DISTINGUISHING_KEYS = ["overlap test", "hashing algorithm", "block size", "threads", "backend", "first frame"]
+
+
+def series_label(bench: BenchFile, others: list[BenchFile]) -> str:
+    """The method, plus whatever parameters differ from the other files of that method."""
+    same = [o for o in others if o.algorithm == bench.algorithm]
+    extra = [f"{key} {bench.header.get(key)}" for key in DISTINGUISHING_KEYS
+             if len({o.header.get(key) for o in same}) > 1]
+    if len({o.total_tets for o in same}) > 1:
+        extra.append(f"{bench.total_tets} tets")
+    return ", ".join([bench.algorithm] + extra)
+
+
+def case_label(bench: BenchFile, files: list[BenchFile]) -> str:
+    """"scene - resolution", with the tet count when the files hold several sizes of that case."""
+    label = f"{bench.scene} - {bench.resolution}"
+    sizes = {f.total_tets for f in files if (f.scene, f.resolution) == (bench.scene, bench.resolution)}
+    return label + (f" ({bench.total_tets} tets)" if len(sizes) > 1 else "")
+
+
+def suffix(self_collisions: bool) -> str:
+    return "_self" if self_collisions else ""
+
+
+def by_setting(files: list[BenchFile]) -> dict[tuple[str, bool], list[BenchFile]]:
+    """Files grouped by (method, self-collisions)."""
+    groups: dict[tuple[str, bool], list[BenchFile]] = defaultdict(list)
+    for bench in files:
+        groups[(bench.algorithm, bench.self_collisions)].append(bench)
+    return groups
+
+
+def save(fig, path: str, written: list[str]) -> None:
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    written.append(path)
+
+
+def grid_figure(files: list[BenchFile], draw: Callable, title: str, path: str, written: list[str]) -> None:
+    """One panel per scene (rows) and resolution (columns); `draw(ax, files_of_panel)` fills a panel."""
+    scenes = sorted({f.scene for f in files})
+    resolutions = sorted({f.resolution for f in files})
+    fig, axes = plt.subplots(len(scenes), len(resolutions), squeeze=False,
+                             figsize=(4.8 * len(resolutions), 3.4 * len(scenes) + 0.6))
+    for row, scene in enumerate(scenes):
+        for col, resolution in enumerate(resolutions):
+            ax = axes[row][col]
+            panel = [f for f in files if f.scene == scene and f.resolution == resolution]
+            if not panel:
+                ax.axis("off")
+                continue
+            draw(ax, panel)
+            ax.set_title(f"{scene} - {resolution}", fontsize=10)
+            ax.set_xlabel("frame")
+            ax.grid(alpha=0.3)
+    fig.suptitle(title)
+    save(fig, path, written)
+
+
+def draw_frame_times(ax, panel: list[BenchFile]) -> None:
+    for bench in panel:
+        ax.plot(bench.column("frame"), bench.column("device time"), label=series_label(bench, panel), linewidth=1.2)
+    ax.set_ylabel("frame time (ms)")
+    ax.legend(fontsize=7)
+
+
+def draw_stages(ax, panel: list[BenchFile]) -> None:
+    bench = panel[0]  # one method per figure; several files only when other parameters vary
+    ax.stackplot(bench.column("frame"), *[bench.column(c) for c, _ in STAGES], labels=[n for _, n in STAGES])
+    ax.set_ylabel("time (ms)")
+    ax.legend(fontsize=7, loc="upper left")
+
+
+def draw_host_vs_device(ax, panel: list[BenchFile]) -> None:
+    bench = panel[0]
+    ax.plot(bench.column("frame"), bench.column("host time"), label="host", linewidth=1.2)
+    ax.plot(bench.column("frame"), bench.column("device time"), label="device", linewidth=1.0, linestyle="--")
+    ax.set_ylabel("time (ms)")
+    ax.legend(fontsize=7)
+
+
+def draw_run_spread(ax, panel: list[BenchFile]) -> None:
+    bench = panel[0]
+    per_frame: dict[float, list[float]] = defaultdict(list)
+    for frame, time in zip(bench.column("frame"), bench.column("device time")):
+        per_frame[frame].append(time)
+    frames = sorted(per_frame)
+    times = [np.array(per_frame[f]) for f in frames]
+    mean = np.array([t.mean() for t in times])
+    std = np.array([t.std() for t in times])
+    ax.fill_between(frames, mean - std, mean + std, color="tab:orange", alpha=0.6, label="standard deviation")
+    ax.fill_between(frames, [t.min() for t in times], [t.max() for t in times], color="tab:green", alpha=0.3,
+                    label="range")
+    ax.plot(frames, mean, color="tab:blue", linewidth=1.0, label=f"mean of {bench.header.get('total runs')} runs")
+    ax.set_ylabel("frame time (ms)")
+    ax.legend(fontsize=7)
+
+
+def boxplot_figure(files: list[BenchFile], title: str, path: str, written: list[str]) -> None:
+    ordered = sorted(files, key=lambda f: (f.resolution, f.scene, f.total_tets, f.path))
+    fig, ax = plt.subplots(figsize=(max(6.0, 1.1 * len(ordered) + 2), 4.5))
+    ax.boxplot([f.column("device time") for f in ordered])
+    ax.set_xticks(range(1, len(ordered) + 1), [case_label(f, files) for f in ordered], rotation=35,
+                  ha="right", fontsize=8)
+    ax.set_ylabel("frame time (ms)")
+    ax.grid(axis="y", alpha=0.3)
+    ax.set_title(title)
+    save(fig, path, written)
+
+
+def penetration_figure(scene: str, files: list[BenchFile], path: str, written: list[str]) -> None:
+    """Frames whose object boxes overlap along x; no figure when there are none."""
+    fig, (time_ax, pairs_ax) = plt.subplots(1, 2, figsize=(11, 4.2))
+    drawn = False
+    for bench in sorted(files, key=lambda f: (f.resolution, f.algorithm)):
+        points = [(d, t, c) for d, t, c in zip(bench.column("bbox overlap x"), bench.column("device time"),
+                                               bench.column("unique candidates")) if d >= 0]
+        if not points:
+            continue
+        drawn = True
+        depth, time, candidates = (np.array(v) for v in zip(*points))
+        label = f"{series_label(bench, files)} - r{bench.resolution}"
+        time_ax.scatter(depth, time, s=10, label=label)
+        if bench.header.get("hashing algorithm") != "none":  # the grid methods, as in the thesis
+            dots = pairs_ax.scatter(depth, candidates, s=10, label=label)
+            if len(depth) >= 4 and np.ptp(depth) > 0:
+                fit = np.polyfit(depth, candidates, 3)
+                line = np.linspace(depth.min(), depth.max(), 100)
+                pairs_ax.plot(line, np.polyval(fit, line), linewidth=1.0, linestyle="--", color=dots.get_facecolor()[0])
+    if not drawn:
+        plt.close(fig)
+        return
+    time_ax.set(xlabel="bounding-box overlap along x", ylabel="frame time (ms)", title="(a) frame time")
+    pairs_ax.set(xlabel="bounding-box overlap along x", ylabel="unique candidate pairs",
+                 title="(b) potential pairs, cubic fit dashed")
+    for ax in (time_ax, pairs_ax):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"{scene}: penetration depth (box overlap along x), without self-collisions")
+    save(fig, path, written)
+
+
+def memory_figure(files: list[BenchFile], title: str, path: str, written: list[str]) -> None:
+    case_of = {(f.resolution, f.scene, f.total_tets): f for f in files}
+    cases = sorted(case_of)
+    methods = sorted({f.algorithm for f in files})
+    height = 0.8 / len(methods)
+    fig, ax = plt.subplots(figsize=(8, 1.0 + 0.45 * len(cases) * len(methods)))
+    for m, method in enumerate(methods):
+        mib = []
+        for case in cases:
+            match = [f for f in files if (f.resolution, f.scene, f.total_tets, f.algorithm) == case + (method,)]
+            mib.append(int(match[0].header.get("peak memory bytes", "0")) / 2**20 if match else 0.0)
+        ax.barh(np.arange(len(cases)) + m * height, mib, height=height, label=method)
+    ax.set_yticks(np.arange(len(cases)) + 0.4 - height / 2, [case_label(case_of[c], files) for c in cases],
+                  fontsize=8)
+    ax.set_xlabel("peak detector memory (MiB)")
+    ax.legend(fontsize=8)
+    ax.grid(axis="x", alpha=0.3)
+    ax.set_title(title)
+    save(fig, path, written)
+
+
+def total_time_figure(files: list[BenchFile], path: str, written: list[str]) -> None:
+    methods = sorted({f.algorithm for f in files})
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for s, self_collisions in enumerate((False, True)):
+        totals = [sum(sum(f.column("device time")) for f in files
+                      if f.algorithm == m and f.self_collisions == self_collisions) for m in methods]
+        ax.bar(np.arange(len(methods)) + 0.4 * s, totals, width=0.4,
+               label="with self-collisions" if self_collisions else "without self-collisions")
+    ax.set_xticks(np.arange(len(methods)) + 0.2, methods)
+    ax.set_ylabel("summed frame times (ms)")
+    ax.set_title("Total time over all benchmarks")
+    ax.legend(fontsize=8)
+    ax.grid(axis="y", alpha=0.3)
+    save(fig, path, written)
+
+
+def plot_folder(folder: str, out: str) -> list[str]:
+    """Writes every figure the files of `folder` allow into `out`; returns the paths written."""
+    averages, raw = read_folder(folder)
+    if not averages:
+        raise ValueError(f"{folder}: no kdet bench CSV files")
+    os.makedirs(out, exist_ok=True)
+    written: list[str] = []
+    for self_collisions in (False, True):
+        files = [f for f in averages if f.self_collisions == self_collisions]
+        if not files:
+            continue
+        with_self = " with self-collisions" if self_collisions else ""
+        grid_figure(files, draw_frame_times, "Frame times" + with_self,
+                    os.path.join(out, f"frame_times{suffix(self_collisions)}.png"), written)
+        memory_figure(files, "Detector memory" + with_self,
+                      os.path.join(out, f"memory{suffix(self_collisions)}.png"), written)
+    for (method, self_collisions), files in sorted(by_setting(averages).items()):
+        name = f"{method}{suffix(self_collisions)}"
+        with_self = ", with self-collisions" if self_collisions else ""
+        grid_figure(files, draw_stages, f"Time per stage: {method}{with_self}",
+                    os.path.join(out, f"stages_{name}.png"), written)
+        grid_figure(files, draw_host_vs_device, f"Host vs device time: {method}{with_self}",
+                    os.path.join(out, f"host_vs_device_{name}.png"), written)
+        boxplot_figure(files, f"Frame times: {method}{with_self}", os.path.join(out, f"boxplot_{name}.png"), written)
+    for (method, self_collisions), files in sorted(by_setting(raw).items()):
+        with_self = ", with self-collisions" if self_collisions else ""
+        grid_figure(files, draw_run_spread, f"Spread over the runs: {method}{with_self}",
+                    os.path.join(out, f"run_spread_{method}{suffix(self_collisions)}.png"), written)
+    for scene in sorted({f.scene for f in averages}):
+        files = [f for f in averages if f.scene == scene and not f.self_collisions]
+        penetration_figure(scene, files, os.path.join(out, f"penetration_{scene}.png"), written)
+    total_time_figure(averages, os.path.join(out, "total_time.png"), written)
+    return written
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description="Figures from the CSV files of kdet bench.")
+    parser.add_argument("folder", help="folder with the CSV files of kdet bench")
+    parser.add_argument("--out", help="folder for the PNG files (default: FOLDER/plots)")
+    args = parser.parse_args()
+    try:
+        written = plot_folder(args.folder, args.out or os.path.join(args.folder, "plots"))
+    except (OSError, ValueError) as error:
+        print(f"kdet plot: {error}", file=sys.stderr)
+        return 1
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,131 @@
+#include "bench_args.hpp"
+
+#include <string>
+#include <vector>
+
+namespace kdet::cli {
+
+namespace {
+
+struct MethodName {
+    const char* flag;
+    Method method;
+};
+
+// The thesis named the brute-force methods after the GPU; they run on any backend here.
+constexpr MethodName method_names[] = {{"kdet", Method::kdet},
+                                       {"kdet_no_pairs", Method::kdet_no_pairs},
+                                       {"gpu", Method::brute_force_loop},
+                                       {"gpu_no_loop", Method::brute_force_pairs}};
+
+const char* help_text = R"(usage: kdet bench [scene] [options]
+
+Runs a scene frame by frame and writes per-frame times and pair counts as CSV (thesis appendix A.1.4):
+  DIR/STEM.csv        per-frame averages over the runs
+  DIR/STEM_runs.csv   every run of every frame
+where STEM names the parameters, e.g. procedural_r1_kdet_sat_djb2_g128_self-no_cpu_100000tets.
+Frames are numbered from 0. Times are in milliseconds.
+
+scene: procedural (default; two deforming tori, no data files needed) or another scene that kdet
+       opens (the known names are listed at the end).
+
+thesis options (any order):
+  -r N                 model resolution 1-4 (default 1)
+  -c M                 method: kdet (default), kdet_no_pairs, gpu (brute force, loop),
+                       gpu_no_loop (brute force, one work item per pair)
+  -o T                 overlap test: sat (default), sat_no_edges, sat_mtv, gjk, fast
+  -g N                 CUDA block size: 16, 32, 64, 128 (default) or 256
+  -n N                 runs 1-20 (default 10)
+  -s yes|y|no|n        self-collisions of every object (default no)
+  -h H                 grid hash: djb2 (default), fnv-1a, morton, simple  (-h is not help)
+  -d DIR               output folder (default exports/benchmark_data)
+
+more options:
+  --backend cpu|cuda   where detection runs (default cpu); cuda needs a GPU
+  --threads N          CPU threads (default: all)
+  --frames A:B         run frames A to B only (0-based, inclusive)
+  --quiet              no per-frame table and no progress bar; only the summary
+  --help               this text
+
+procedural scene only:
+  --tets N             total tetrahedra (default 100000, 100 to 20000000)
+  --scene-frames N     length of the motion in frames (default 120)
+  --frames N           the same as --scene-frames N (kept from earlier versions)
+)";
+
+} // namespace
+
+const char* bench_method_name(Method method) {
+    for (const MethodName& m : method_names)
+        if (m.method == method) return m.flag;
+    return "?";
+}
+
+const char* bench_help() { return help_text; }
+
+BenchConfig parse_bench_args(int argc, char** argv, int first) {
+    BenchConfig config;
+    std::vector<std::string> scene;
+    ArgParser parser("bench");
+    parser.positionals(1, scene);
+    parser.flag("--help", [&] { config.help = true; });
+    parser.flag("--quiet", [&] { config.quiet = true; });
+    parser.option("-r", "resolution", [&](const std::string& v) {
+        config.request.resolution = static_cast<int>(parse_integer("-r", v, 1, 4));
+    });
+    parser.option("-c", "method", [&](const std::string& v) {
+        std::vector<std::string> accepted;
+        for (const MethodName& m : method_names) accepted.emplace_back(m.flag);
+        const std::string name = parse_choice("-c", v, accepted);
+        for (const MethodName& m : method_names)
+            if (name == m.flag) config.options.method = m.method;
+    });
+    parser.option("-o", "test", [&](const std::string& v) {
+        parse(parse_choice("-o", v, {"sat", "sat_no_edges", "sat_mtv", "gjk", "fast"}), config.options.narrow_phase);
+    });
+    parser.option("-g", "block size", [&](const std::string& v) {
+        config.options.block_size = std::stoi(parse_choice("-g", v, {"16", "32", "64", "128", "256"}));
+    });
+    parser.option("-n", "runs", [&](const std::string& v) { config.runs = static_cast<int>(parse_integer("-n", v, 1, 20)); });
+    parser.option("-s", "yes|no", [&](const std::string& v) {
+        config.self = parse_choice("-s", v, {"yes", "y", "no", "n"})[0] == 'y';
+    });
+    parser.option("-h", "hash", [&](const std::string& v) {
+        parse(parse_choice("-h", v, {"djb2", "fnv-1a", "morton", "simple"}), config.options.hash);
+    });
+    parser.option("-d", "folder", [&](const std::string& v) {
+        if (v.empty()) throw UsageError("invalid value '' for -d: expected a folder");
+        config.output_dir = v;
+    });
+    parser.option("--backend", "cpu|cuda", [&](const std::string& v) {
+        parse(parse_choice("--backend", v, {"cpu", "cuda"}), config.options.backend);
+    });
+    parser.option("--threads", "N", [&](const std::string& v) {
+        config.options.threads = static_cast<int>(parse_integer("--threads", v, 1, 1024));
+    });
+    const auto scene_length = [&](const std::string& flag, const std::string& v) {
+        config.request.procedural.frames = static_cast<int>(parse_integer(flag, v, 1, 100000));
+        if (config.procedural_flag.empty()) config.procedural_flag = flag;
+    };
+    parser.option("--frames", "A:B", [&](const std::string& v) {
+        const auto colon = v.find(':');
+        if (colon == std::string::npos) return scene_length("--frames", v);
+        try {
+            config.first_frame = static_cast<int>(parse_integer("--frames", v.substr(0, colon), 0, 1000000));
+            config.last_frame = static_cast<int>(parse_integer("--frames", v.substr(colon + 1), config.first_frame, 1000000));
+        } catch (const UsageError&) {
+            throw UsageError("invalid value '" + v + "' for --frames: expected A:B with 0 <= A <= B (0-based frames), " +
+                             "or N (length of the procedural scene)");
+        }
+    });
+    parser.option("--scene-frames", "N", [&](const std::string& v) { scene_length("--scene-frames", v); });
+    parser.option("--tets", "N", [&](const std::string& v) {
+        config.request.procedural.total_tets = static_cast<std::size_t>(parse_integer("--tets", v, 100, 20000000));
+        if (config.procedural_flag.empty()) config.procedural_flag = "--tets";
+    });
+    parser.parse(argc, argv, first);
+    if (!scene.empty()) config.scene = scene[0];
+    return config;
+}
+
+} // namespace kdet::cli
