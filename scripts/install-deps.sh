@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what kdet needs to build and test on Debian (run as root). Skips apt when all is there.
 set -euo pipefail
-packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3)
+packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3 clang libclang-rt-14-dev tetgen)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
@@ -10,4 +10,13 @@ if ((${#missing[@]})); then
   echo "installing: ${missing[*]}"
   apt-get update -qq
   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+# Optional: matplotlib for the figures of `kdet plot` (python/requirements.txt). Building and testing do not
+# need it, so a failure only warns.
+if ! python3 -c "import matplotlib" >/dev/null 2>&1; then
+  requirements="$(dirname "$0")/../python/requirements.txt"
+  pip_install=(python3 -m pip install -q --timeout 30 --root-user-action=ignore -r "$requirements")
+  { python3 -m pip --version >/dev/null 2>&1 || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-pip >/dev/null; } &&
+    { "${pip_install[@]}" || "${pip_install[@]}" --break-system-packages; } ||
+    echo "warning: matplotlib not installed; kdet plot needs it (pip install -r python/requirements.txt)" >&2
 fi

@@ -118,17 +118,18 @@ TEST(CellRange, ClampsNonFiniteAndFarCoordinates) {
 struct TestTable {
     std::vector<BucketHeader> headers;
     std::vector<std::uint32_t> ids;
-    std::uint32_t overflow_used = 0, failure = 0;
+    std::uint32_t overflow_used = 0, failure = 0, claimed = 0;
     GridView view{};
     TestTable(std::uint32_t slots, std::uint32_t capacity, std::uint32_t pool, std::uint32_t probes, HashFunction hash)
         : headers(slots + pool, BucketHeader{}), ids(static_cast<std::size_t>(slots + pool) * capacity) {
         std::uint32_t bits = 0;
         while ((1u << bits) < slots) ++bits;
-        view = GridView{headers.data(), ids.data(), &overflow_used, &failure, slots, bits, capacity, pool, 1, probes, hash};
+        view = GridView{headers.data(), ids.data(), &overflow_used, &failure, &claimed, slots, bits, capacity, pool, 1,
+                        probes, hash};
     }
     void next_frame() {
         ++view.stamp;
-        overflow_used = failure = 0;
+        overflow_used = failure = claimed = 0;
     }
     std::multiset<std::uint32_t> contents(CellCoord cell) const {
         std::multiset<std::uint32_t> found;
@@ -146,6 +147,7 @@ TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
         grid_insert(table.view, CellCoord{static_cast<std::uint32_t>(i % cells), 1, 2, 0}, static_cast<std::uint32_t>(i));
     });
     ASSERT_EQ(table.failure, 0u);
+    EXPECT_EQ(table.claimed, cells);
     EXPECT_GT(table.overflow_used, 1000u);
     for (std::uint32_t c = 0; c < cells; ++c) {
         std::multiset<std::uint32_t> expected;

@@ -239,6 +239,11 @@ TEST(Detector, ReportsMemoryAndStageTimes) {
     EXPECT_GT(r.counts.candidates, 0u);
     EXPECT_GE(r.counts.candidates, r.counts.unique_candidates);
     EXPECT_GE(r.counts.unique_candidates, r.counts.colliding_pairs);
+    EXPECT_GT(r.counts.grid_cells, 0u);
+    EXPECT_LE(r.counts.grid_cells, r.counts.grid_slots);
+    EXPECT_GT(r.grid_bytes, 0u);
+    EXPECT_GT(r.candidate_bytes, 0u);
+    EXPECT_LT(r.grid_bytes + r.candidate_bytes, r.memory_bytes);
 }
 
 } // namespace

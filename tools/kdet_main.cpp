@@ -1,4 +1,6 @@
+#include "bench_plot.hpp"
 #include "commands.hpp"
+#include "prepare_command.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
@@ -15,7 +17,10 @@ Finds every colliding pair of tetrahedra between tetrahedral meshes and inside o
 
 commands:
   collide A [B] [options]   colliding pairs between two meshes, or inside one with --self
-  bench [options]           runs the built-in procedural scene frame by frame
+  bench [scene] [options]   runs a scene frame by frame (default: the built-in procedural scene)
+                            and writes the thesis's CSV files
+  plot FOLDER               turns the CSV files of kdet bench into PNG figures (matplotlib)
+  prepare [MODEL...] [-r N] builds the tet meshes of the thesis scenes (CGAL + TetGen) into the cache
 
   kdet <command> --help     options of a command
   kdet --version
@@ -33,6 +38,8 @@ int main(int argc, char** argv) {
     try {
         if (command == "collide") return run_collide(argc, argv);
         if (command == "bench") return run_bench(argc, argv);
+        if (command == "prepare") return run_prepare(argc, argv);
+        if (command == "plot") return run_plot(argc, argv);
         if (command == "--help" || command == "-h" || command == "help") {
             std::cout << usage;
             return exit_ok;
@@ -41,7 +48,7 @@ int main(int argc, char** argv) {
             std::cout << "kdet " << kdet::version() << "\n";
             return exit_ok;
         }
-        std::cerr << "kdet: unknown command '" << command << "' (commands: collide, bench; see 'kdet --help')\n";
+        std::cerr << "kdet: unknown command '" << command << "' (commands: collide, bench, plot, prepare; see 'kdet --help')\n";
         return exit_usage;
     } catch (const UsageError& e) {
         std::cerr << "kdet " << e.what() << "\n";

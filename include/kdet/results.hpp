@@ -57,6 +57,9 @@ struct FrameCounts {
     std::uint64_t colliding_pairs = 0;
     std::uint64_t colliding_tets = 0;    ///< tets flagged as colliding, all objects together
     std::uint32_t buffer_regrows = 0;    ///< times a buffer grew and its stage reran this frame
+    std::uint64_t grid_cells = 0;        ///< occupied grid cells (main buckets claimed)
+    std::uint64_t grid_slots = 0;        ///< main buckets of the hash table
+    std::uint64_t grid_overflow_buckets = 0; ///< overflow buckets chained this frame
 };
 
 /// @brief Result of one detection. For Method::kdet_no_pairs, `pairs` stays empty and only the
@@ -68,6 +71,8 @@ struct FrameResult {
     FrameCounts counts;
     StageTimes times;
     std::size_t memory_bytes = 0;                ///< bytes held by the detector's buffers
+    std::size_t grid_bytes = 0;                  ///< of which the grid's hash table
+    std::size_t candidate_bytes = 0;             ///< of which the candidate pair buffer
 };
 
 } // namespace kdet

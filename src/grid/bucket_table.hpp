@@ -33,6 +33,7 @@ struct GridView {
     std::uint32_t* ids;             ///< bucket_capacity ids per bucket
     std::uint32_t* overflow_used;   ///< pool buckets handed out this frame
     std::uint32_t* failure;         ///< GridFailure bits
+    std::uint32_t* cells_claimed;   ///< main buckets claimed this frame (occupied cells)
     std::uint32_t slot_count;       ///< 2^slot_bits
     std::uint32_t slot_bits;
     std::uint32_t bucket_capacity;
@@ -56,6 +57,7 @@ KDET_HD inline std::uint32_t claim_bucket(const GridView& g, CellCoord cell) {
             h.count = 0;
             h.next = no_bucket;
             atomic_store_release(&h.state, ready);
+            atomic_fetch_add(g.cells_claimed, 1u);
             return slot;
         }
         // Claimed this frame by someone (maybe just now): wait until its key is visible.

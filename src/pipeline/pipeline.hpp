@@ -21,6 +21,8 @@ struct FrameCounters {
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
     std::uint32_t non_finite;
+    std::uint32_t cells_claimed;
+    std::uint32_t unused;
 };
 
 template <class Exec>
@@ -240,12 +242,15 @@ GridView Pipeline<Exec>::populate(FrameCounts& counts) {
         FrameCounters* c = counters_.data();
         std::uint32_t slot_bits = 0;
         while ((1u << slot_bits) < slot_count_) ++slot_bits;
-        GridView grid{headers_.data(), ids_.data(), &c->overflow_used, &c->grid_failure, slot_count_, slot_bits,
-                      capacity, overflow_capacity_, stamp_, 64u, options_.hash};
+        GridView grid{headers_.data(), ids_.data(), &c->overflow_used, &c->grid_failure, &c->cells_claimed,
+                      slot_count_, slot_bits, capacity, overflow_capacity_, stamp_, 64u, options_.hash};
         exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, params_, &c->layer_mask});
         const FrameCounters after = read_counters();
         if (!after.grid_failure) {
             layer_mask_ = after.layer_mask;
+            counts.grid_cells = after.cells_claimed;
+            counts.grid_slots = slot_count_;
+            counts.grid_overflow_buckets = after.overflow_used;
             return grid;
         }
         if (after.grid_failure & grid_table_full) slot_count_ *= 2;
@@ -434,6 +439,8 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
 
     count_and_copy_flags(result);
     result.memory_bytes = memory_bytes();
+    result.grid_bytes = headers_.capacity_bytes() + ids_.capacity_bytes();
+    result.candidate_bytes = candidates_.capacity_bytes();
     result.times.total = total.stop_ms();
 }
 
