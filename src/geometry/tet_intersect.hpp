@@ -45,13 +45,15 @@ KDET_HD inline bool tets_intersect_sat_mtv(const vec3 a[4], const vec3 b[4], flo
 
 /// @brief GJK on the Minkowski difference with the signed-volumes distance sub-algorithm (Montanari
 /// et al. 2017), in the unit-size frame, with capped iterations; a separation is certified by the
-/// projection gap along the final search direction.
+/// projection gap along GJK's direction, and the rare pair whose direction cannot certify the
+/// distance GJK found (rounding on pairs much closer than their size) is decided by the SAT axes.
 KDET_HD inline bool tets_intersect_gjk(const vec3 a[4], const vec3 b[4]) { return narrow::gjk_intersect(a, b); }
 
 /// @brief Face-plane test in the style of Ganovelli, Ponchio and Rocchini (2002): the 16 + 16
 /// vertex-to-face-plane distances decide the face axes, and the edge axes are decided from the same
 /// distances, two faces at a time. Each face normal is oriented against the opposite vertex, so the
-/// vertex order does not matter. Rare pairs that it cannot decide within the tolerance go to the SAT.
+/// vertex order does not matter. An edge it cannot decide within the tolerance (sharp edges amplify
+/// rounding) is decided by that edge's 6 SAT axes; a tet too flat to orient sends the pair to the SAT.
 KDET_HD inline bool tets_intersect_fast(const vec3 a[4], const vec3 b[4]) { return narrow::gpr_intersect(a, b); }
 
 /// @brief Runs the test selected by `test`.
