@@ -48,6 +48,7 @@ protected:
         fs::remove_all(dir_, ignored);
     }
 
+public:
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
     /// Writes @p content to @p name and returns its path.
@@ -87,13 +88,15 @@ void expect_error(const std::function<void()>& action, const std::string& locati
 }
 
 std::string at_line(const std::string& file, int line) { return file + ":" + std::to_string(line) + ": "; }
-std::string at_byte(const std::string& file, std::size_t byte) { return file + ": byte " + std::to_string(byte) + ": "; }
+std::string at_byte(const std::string& file, std::size_t byte) {
+    return file + ": byte " + std::to_string(byte) + ": ";
+}
 
 /// Three tetrahedra around the unit cube's corner with coordinates that have no short decimal form.
 kdet::TetMesh small_mesh() {
     kdet::TetMesh mesh;
-    mesh.positions = {0.0, 0.0, 0.0, 1.0 / 3.0, 0.0, 0.0, 0.0, 0.1, 0.0, 0.0, 0.0, 2.0 / 7.0,
-                      1.0e-3 / 3.0, 1.0e5 / 7.0, 3.0e-7, -1.0 / 9.0, -2.0 / 3.0, -5.0 / 11.0};
+    mesh.positions = {0.0, 0.0, 0.0,       1.0 / 3.0,    0.0,         0.0,    0.0,        0.1,        0.0,
+                      0.0, 0.0, 2.0 / 7.0, 1.0e-3 / 3.0, 1.0e5 / 7.0, 3.0e-7, -1.0 / 9.0, -2.0 / 3.0, -5.0 / 11.0};
     mesh.tets = {0, 1, 2, 3, 1, 2, 3, 4, 0, 2, 1, 5};
     return mesh;
 }
@@ -156,33 +159,42 @@ TEST_F(Formats, GmshHandMshIsHandMesh) {
     expect_equal(kdet::read_tet_mesh(kdet::data_path("hand.msh")), msh);
 }
 
-TEST_F(Formats, GmshRoundTripsEveryVariant) {
-    kdet::test::use_default_data_dir();
-    const kdet::TetMesh bunny = kdet::read_medit(kdet::data_path("bunny.mesh"));
-    for (const auto& [format, name] : gmsh_formats) {
+/// Writes small_mesh() and @p model in each of @p formats (a format and a file name) with @p write,
+/// and checks that both read back exactly through @p read and through read_tet_mesh.
+template <typename Format, std::size_t count, typename Write, typename Read>
+void expect_round_trips(const Formats& test, const std::pair<Format, const char*> (&formats)[count],
+                        const kdet::TetMesh& model, Write write, Read read) {
+    for (const auto& [format, name] : formats) {
         SCOPED_TRACE(name);
-        const std::string file = path(name);
-        kdet::write_gmsh(small_mesh(), file, format);
-        expect_equal(kdet::read_gmsh(file), small_mesh());
-        expect_equal(kdet::read_tet_mesh(file), small_mesh());
-        kdet::write_gmsh(bunny, file, format);
-        expect_equal(kdet::read_gmsh(file), bunny);
+        const std::string file = test.path(name);
+        for (const kdet::TetMesh& mesh : {small_mesh(), model}) {
+            write(mesh, file, format);
+            expect_equal(read(file, kdet::ReadOptions{}), mesh);
+            expect_equal(kdet::read_tet_mesh(file), mesh);
+        }
     }
 }
 
+TEST_F(Formats, GmshRoundTripsEveryVariant) {
+    kdet::test::use_default_data_dir();
+    expect_round_trips(*this, gmsh_formats, kdet::read_medit(kdet::data_path("bunny.mesh")), kdet::write_gmsh,
+                       kdet::read_gmsh);
+}
+
 TEST_F(Formats, GmshV22AsciiTagsOtherElementsAndSections) {
-    const std::string file = write("hand_written.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
-                                                       "$PhysicalNames\n1\n3 1 \"body\"\n$EndPhysicalNames\n"
-                                                       "$Nodes\n5\n"
-                                                       "10 0 0 0\n20 1 0 0\n30 0 1 0\n40 0 0 1\n7 1 1 1\n"
-                                                       "$EndNodes\n"
-                                                       "$Elements\n4\n"
-                                                       "1 15 2 0 1 10\n"
-                                                       "2 2 2 0 1 10 20 30\n"
-                                                       "3 4 2 1 1 10 20 30 40\n"
-                                                       "4 11 3 1 1 5 20 30 40 7 10 10 10 10 10 10\n"
-                                                       "$EndElements\n"
-                                                       "$NodeData\n1\n\"T\"\n1\n0.0\n3\n0\n1\n1\n10 3.5\n$EndNodeData\n");
+    const std::string file =
+        write("hand_written.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+                                  "$PhysicalNames\n1\n3 1 \"body\"\n$EndPhysicalNames\n"
+                                  "$Nodes\n5\n"
+                                  "10 0 0 0\n20 1 0 0\n30 0 1 0\n40 0 0 1\n7 1 1 1\n"
+                                  "$EndNodes\n"
+                                  "$Elements\n4\n"
+                                  "1 15 2 0 1 10\n"
+                                  "2 2 2 0 1 10 20 30\n"
+                                  "3 4 2 1 1 10 20 30 40\n"
+                                  "4 11 3 1 1 5 20 30 40 7 10 10 10 10 10 10\n"
+                                  "$EndElements\n"
+                                  "$NodeData\n1\n\"T\"\n1\n0.0\n3\n0\n1\n1\n10 3.5\n$EndNodeData\n");
     expect_equal(kdet::read_gmsh(file), unit_tets());
 }
 
@@ -216,14 +228,16 @@ TEST_F(Formats, GmshBinaryErrorsNameTheByte) {
     const std::size_t nodes = after(valid, "$Nodes\n5\n");
 
     std::string big_endian = valid;
-    std::reverse(big_endian.begin() + static_cast<std::ptrdiff_t>(marker), big_endian.begin() + static_cast<std::ptrdiff_t>(marker) + 4);
+    std::reverse(big_endian.begin() + static_cast<std::ptrdiff_t>(marker),
+                 big_endian.begin() + static_cast<std::ptrdiff_t>(marker) + 4);
     const std::string swapped = write("swapped.msh", big_endian);
     expect_error([&] { kdet::read_gmsh(swapped); }, at_byte(swapped, marker), "written on a big-endian machine");
 
     std::string garbage = valid;
     garbage[marker] = 7;
     const std::string bad_marker = write("bad_marker.msh", garbage);
-    expect_error([&] { kdet::read_gmsh(bad_marker); }, at_byte(bad_marker, marker), "endianness marker reads 7, expected 1");
+    expect_error([&] { kdet::read_gmsh(bad_marker); }, at_byte(bad_marker, marker),
+                 "endianness marker reads 7, expected 1");
 
     // Cut inside the third node: the count check before reading catches it at the start of the block.
     const std::string cut = write("cut.msh", valid.substr(0, nodes + 2 * 28 + 10));
@@ -233,7 +247,8 @@ TEST_F(Formats, GmshBinaryErrorsNameTheByte) {
     const double not_a_number = std::numeric_limits<double>::quiet_NaN();
     std::memcpy(&nan[nodes + 28 + 4 + 8], &not_a_number, 8); // y of the second node
     const std::string nan_file = write("nan.msh", nan);
-    expect_error([&] { kdet::read_gmsh(nan_file); }, at_byte(nan_file, nodes + 28 + 12), "coordinate nan is not finite");
+    expect_error([&] { kdet::read_gmsh(nan_file); }, at_byte(nan_file, nodes + 28 + 12),
+                 "coordinate nan is not finite");
 
     // The first element's first node tag (block header 12 bytes, then number and two tags).
     const std::size_t elements = after(valid, "$Elements\n2\n");
@@ -241,7 +256,8 @@ TEST_F(Formats, GmshBinaryErrorsNameTheByte) {
     const std::int32_t missing_tag = 99;
     std::memcpy(&unknown[elements + 12 + 12], &missing_tag, 4);
     const std::string unknown_file = write("unknown_tag.msh", unknown);
-    expect_error([&] { kdet::read_gmsh(unknown_file); }, at_byte(unknown_file, elements + 24), "node tag 99 is not in $Nodes");
+    expect_error([&] { kdet::read_gmsh(unknown_file); }, at_byte(unknown_file, elements + 24),
+                 "node tag 99 is not in $Nodes");
 
     std::string type = valid;
     const std::int32_t no_such_type = 1000;
@@ -262,7 +278,8 @@ TEST_F(Formats, GmshV41BinaryAbsurdCountDoesNotAllocate) {
     const std::uint64_t large = 1000000;
     std::memcpy(&bytes[nodes + 8], &large, 8);
     const std::string large_file = write("large.msh", bytes);
-    expect_error([&] { kdet::read_gmsh(large_file); }, at_byte(large_file, nodes + 32), "1000000 nodes need 32000000 bytes");
+    expect_error([&] { kdet::read_gmsh(large_file); }, at_byte(large_file, nodes + 32),
+                 "1000000 nodes need 32000000 bytes");
 }
 
 TEST_F(Formats, GmshTextErrorsNameTheLine) {
@@ -272,20 +289,24 @@ TEST_F(Formats, GmshTextErrorsNameTheLine) {
     expect_error([&] { kdet::read_gmsh(empty); }, at_line(empty, 1), "empty file");
 
     const std::string head = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n";
-    const std::string range = write("range.msh", head + "4 0 0 1\n$EndNodes\n$Elements\n1\n1 4 0 1 2 3 5\n$EndElements\n");
+    const std::string range =
+        write("range.msh", head + "4 0 0 1\n$EndNodes\n$Elements\n1\n1 4 0 1 2 3 5\n$EndElements\n");
     expect_error([&] { kdet::read_gmsh(range); }, at_line(range, 13), "node tag 5 is not in $Nodes");
     const std::string nan = write("nan.msh", head + "4 0 nan 1\n$EndNodes\n");
     expect_error([&] { kdet::read_gmsh(nan); }, at_line(nan, 9), "coordinate 'nan' is not finite");
     const std::string duplicate = write("duplicate.msh", head + "3 0 0 1\n$EndNodes\n");
     expect_error([&] { kdet::read_gmsh(duplicate); }, at_line(duplicate, 9), "duplicate node tag 3");
-    const std::string absurd = write("absurd.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4000000000\n1 0 0 0\n");
+    const std::string absurd =
+        write("absurd.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4000000000\n1 0 0 0\n");
     expect_error([&] { kdet::read_gmsh(absurd); }, at_line(absurd, 6), "file ends early: expected a node tag");
-    const std::string flat = write("flat.msh", head + "4 1 1 0\n$EndNodes\n$Elements\n1\n1 4 0 1 2 3 4\n$EndElements\n");
+    const std::string flat =
+        write("flat.msh", head + "4 1 1 0\n$EndNodes\n$Elements\n1\n1 4 0 1 2 3 4\n$EndElements\n");
     expect_error([&] { kdet::read_gmsh(flat); }, at_line(flat, 13), "degenerate tetrahedron");
     kdet::ReadOptions allow;
     allow.allow_degenerate = true;
     EXPECT_EQ(kdet::read_gmsh(flat, allow).num_tets(), 1u);
-    const std::string no_tets = write("no_tets.msh", head + "4 0 0 1\n$EndNodes\n$Elements\n1\n1 2 0 1 2 3\n$EndElements\n");
+    const std::string no_tets =
+        write("no_tets.msh", head + "4 0 0 1\n$EndNodes\n$Elements\n1\n1 2 0 1 2 3\n$EndElements\n");
     expect_error([&] { kdet::read_gmsh(no_tets); }, at_line(no_tets, 14), "no tetrahedra");
     const std::string unterminated = write("unterminated.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Comments\nhi\n");
     expect_error([&] { kdet::read_gmsh(unterminated); }, at_line(unterminated, 4), "has no $EndComments");
@@ -304,16 +325,8 @@ const std::pair<kdet::VtkFormat, const char*> vtk_formats[] = {
 
 TEST_F(Formats, VtkRoundTripsEveryVariant) {
     kdet::test::use_default_data_dir();
-    const kdet::TetMesh hand = kdet::read_medit(kdet::data_path("hand.mesh"));
-    for (const auto& [format, name] : vtk_formats) {
-        SCOPED_TRACE(name);
-        const std::string file = path(name);
-        kdet::write_vtk(small_mesh(), file, format);
-        expect_equal(kdet::read_vtk(file), small_mesh());
-        expect_equal(kdet::read_tet_mesh(file), small_mesh());
-        kdet::write_vtk(hand, file, format);
-        expect_equal(kdet::read_vtk(file), hand);
-    }
+    expect_round_trips(*this, vtk_formats, kdet::read_medit(kdet::data_path("hand.mesh")), kdet::write_vtk,
+                       kdet::read_vtk);
 }
 
 TEST_F(Formats, VtkClassicAsciiFieldOtherCellsAndQuadraticTets) {
@@ -348,7 +361,8 @@ TEST_F(Formats, VtkBinaryErrorsNameTheByte) {
     expect_error([&] { kdet::read_vtk(cut); }, at_byte(cut, points), "5 points need 120 bytes, only 100 left");
 
     std::string nan = valid;
-    for (std::size_t k = 0; k < 8; ++k) nan[points + 8 + k] = k == 0 ? '\x7f' : (k == 1 ? '\xf8' : '\0'); // big-endian NaN
+    for (std::size_t k = 0; k < 8; ++k)
+        nan[points + 8 + k] = k == 0 ? '\x7f' : (k == 1 ? '\xf8' : '\0'); // big-endian NaN
     const std::string nan_file = write("nan.vtk", nan);
     expect_error([&] { kdet::read_vtk(nan_file); }, at_byte(nan_file, points + 8), "coordinate nan is not finite");
 
@@ -356,12 +370,14 @@ TEST_F(Formats, VtkBinaryErrorsNameTheByte) {
     std::string range = valid;
     range[cells + 4 + 3] = 5; // the first cell's first point, low byte
     const std::string range_file = write("range.vtk", range);
-    expect_error([&] { kdet::read_vtk(range_file); }, at_byte(range_file, cells + 4), "vertex index 5 out of range [0, 4]");
+    expect_error([&] { kdet::read_vtk(range_file); }, at_byte(range_file, cells + 4),
+                 "vertex index 5 out of range [0, 4]");
 
     std::string absurd = valid;
     absurd.replace(absurd.find("CELLS 2 10"), 10, "CELLS 2 99");
     const std::string absurd_file = write("absurd.vtk", absurd);
-    expect_error([&] { kdet::read_vtk(absurd_file); }, at_byte(absurd_file, cells), "99 cell list values need 396 bytes");
+    expect_error([&] { kdet::read_vtk(absurd_file); }, at_byte(absurd_file, cells),
+                 "99 cell list values need 396 bytes");
 
     const std::string v51 = path("v51.vtk");
     kdet::write_vtk(unit_tets(), v51, {kdet::VtkVersion::v5_1, true});
@@ -369,7 +385,8 @@ TEST_F(Formats, VtkBinaryErrorsNameTheByte) {
     const std::size_t first_offset = after(offsets, "OFFSETS vtktypeint64\n");
     offsets[first_offset + 7] = 1;
     const std::string offsets_file = write("offsets.vtk", offsets);
-    expect_error([&] { kdet::read_vtk(offsets_file); }, at_byte(offsets_file, first_offset), "the first offset must be 0, found 1");
+    expect_error([&] { kdet::read_vtk(offsets_file); }, at_byte(offsets_file, first_offset),
+                 "the first offset must be 0, found 1");
 }
 
 TEST_F(Formats, VtkTextErrorsNameTheLine) {
@@ -389,7 +406,8 @@ TEST_F(Formats, VtkTextErrorsNameTheLine) {
     const std::string size = write("size.vtk", head + "CELLS 1 5\n3 0 1 2 3\nCELL_TYPES 1\n10\n");
     expect_error([&] { kdet::read_vtk(size); }, at_line(size, 12), "cells hold 4 values, the header announces 5");
     const std::string short_tet = write("short.vtk", head + "CELLS 1 4\n3 0 1 2\nCELL_TYPES 1\n10\n");
-    expect_error([&] { kdet::read_vtk(short_tet); }, at_line(short_tet, 14), "cell 0 of type 10 has 3 points, expected 4");
+    expect_error([&] { kdet::read_vtk(short_tet); }, at_line(short_tet, 14),
+                 "cell 0 of type 10 has 3 points, expected 4");
     const std::string absurd = write("absurd.vtk", head + "CELLS 1000000000000 2000000000000\n4 0 1 2 3\n");
     expect_error([&] { kdet::read_vtk(absurd); }, at_line(absurd, 12), "file ends early: expected a cell point count");
     const std::string no_tets = write("no_tets.vtk", head + "CELLS 1 4\n3 0 1 2\nCELL_TYPES 1\n5\n");
@@ -407,8 +425,8 @@ struct SurfaceCounts {
 
 // Vertex counts from the models README; triangle counts from the files (every face is a triangle).
 const SurfaceCounts real_surfaces[] = {
-    {"armadillo.obj", 43243, 86482},    {"stanford-bunny.obj", 35947, 69451}, {"max-planck.obj", 5272, 10540},
-    {"bunny.off", 3485, 6966},          {"happy-buddha.off", 13295, 26999},
+    {"armadillo.obj", 43243, 86482}, {"stanford-bunny.obj", 35947, 69451}, {"max-planck.obj", 5272, 10540},
+    {"bunny.off", 3485, 6966},       {"happy-buddha.off", 13295, 26999},
 };
 
 TEST_F(Formats, SurfacesReadTheRealModels) {
@@ -471,7 +489,8 @@ TEST_F(Formats, StlAsciiAndBinaryMergeVertices) {
 TEST_F(Formats, PlyAsciiAndBothBinaryOrders) {
     const std::string ascii = write("ascii.ply", square_ply_header("ascii") + square_ply_ascii_body);
     expect_equal(kdet::read_surface(ascii), unit_square());
-    const std::string little = write("little.ply", square_ply_header("binary_little_endian") + square_ply_binary_body(false));
+    const std::string little =
+        write("little.ply", square_ply_header("binary_little_endian") + square_ply_binary_body(false));
     expect_equal(kdet::read_surface(little), unit_square());
     const std::string big = write("big.ply", square_ply_header("binary_big_endian") + square_ply_binary_body(true));
     expect_equal(kdet::read_surface(big), unit_square());
@@ -492,7 +511,8 @@ TEST_F(Formats, SurfaceErrorsNameLineOrByte) {
     const std::string obj_range = write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
     expect_error([&] { kdet::read_surface(obj_range); }, at_line(obj_range, 4), "vertex index 4 out of range [1, 3]");
     const std::string obj_negative = write("negative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
-    expect_error([&] { kdet::read_surface(obj_negative); }, at_line(obj_negative, 4), "reaches before the first vertex");
+    expect_error([&] { kdet::read_surface(obj_negative); }, at_line(obj_negative, 4),
+                 "reaches before the first vertex");
     const std::string obj_nan = write("nan.obj", "v 0 0 0\nv 1 nan 0\n");
     expect_error([&] { kdet::read_surface(obj_nan); }, at_line(obj_nan, 2), "coordinate 'nan' is not finite");
     const std::string obj_edge = write("edge.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n");
@@ -505,23 +525,28 @@ TEST_F(Formats, SurfaceErrorsNameLineOrByte) {
     const std::string off_range = write("range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n");
     expect_error([&] { kdet::read_surface(off_range); }, at_line(off_range, 6), "vertex index 3 out of range [0, 2]");
     const std::string off_absurd = write("absurd.off", "OFF\n3 1000000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-    expect_error([&] { kdet::read_surface(off_absurd); }, at_line(off_absurd, 6), "expected 1000000000000 faces, found 1");
+    expect_error([&] { kdet::read_surface(off_absurd); }, at_line(off_absurd, 6),
+                 "expected 1000000000000 faces, found 1");
 
     std::string stl_text = square_stl;
     stl_text.replace(stl_text.find("endloop"), 7, "vertex 2 2 2");
     const std::string stl_four = write("four.stl", stl_text);
     expect_error([&] { kdet::read_surface(stl_four); }, at_line(stl_four, 7), "expected endloop, found 'vertex'");
     const std::string stl_cut = write("cut.stl", square_binary_stl().substr(0, 84 + 50 + 20));
-    expect_error([&] { kdet::read_surface(stl_cut); }, at_byte(stl_cut, 84), "2 triangles need 100 bytes, only 70 left");
+    expect_error([&] { kdet::read_surface(stl_cut); }, at_byte(stl_cut, 84),
+                 "2 triangles need 100 bytes, only 70 left");
     std::string stl_nan = square_binary_stl();
     const float nan = std::numeric_limits<float>::quiet_NaN();
     std::memcpy(&stl_nan[84 + 50 + 12 + 4], &nan, 4); // y of the second triangle's first corner
     const std::string stl_nan_file = write("nan.stl", stl_nan);
-    expect_error([&] { kdet::read_surface(stl_nan_file); }, at_byte(stl_nan_file, 84 + 50 + 16), "coordinate nan is not finite");
+    expect_error([&] { kdet::read_surface(stl_nan_file); }, at_byte(stl_nan_file, 84 + 50 + 16),
+                 "coordinate nan is not finite");
 
-    const std::string ply_cut = write("cut.ply", square_ply_header("binary_little_endian") + square_ply_binary_body(false).substr(0, 30));
+    const std::string ply_cut =
+        write("cut.ply", square_ply_header("binary_little_endian") + square_ply_binary_body(false).substr(0, 30));
     const std::size_t body = square_ply_header("binary_little_endian").size();
-    expect_error([&] { kdet::read_surface(ply_cut); }, at_byte(ply_cut, body), "4 vertex records need 68 bytes, only 30 left");
+    expect_error([&] { kdet::read_surface(ply_cut); }, at_byte(ply_cut, body),
+                 "4 vertex records need 68 bytes, only 30 left");
     std::string ply_range = square_ply_binary_body(true);
     ply_range[4 * 17 + 1 + 3] = 9; // the first index, big-endian low byte
     const std::string ply_range_file = write("range.ply", square_ply_header("binary_big_endian") + ply_range);

@@ -24,16 +24,16 @@ namespace {
 
 using namespace io;
 
-constexpr long long gmsh_tet = 4;     // 4-node tetrahedron
-constexpr long long gmsh_tet10 = 11;  // 10-node tetrahedron: its first 4 nodes are the corners
-constexpr long long gmsh_volume = 3;  // entity dimension of a volume
+constexpr long long gmsh_tet = 4;       // 4-node tetrahedron
+constexpr long long gmsh_tet10 = 11;    // 10-node tetrahedron: its first 4 nodes are the corners
+constexpr long long gmsh_volume = 3;    // entity dimension of a volume
 constexpr std::int32_t gmsh_entity = 1; // the one volume entity the writer puts everything in
 
 /// @brief The number of nodes of each MSH element type, 0 for an unknown type. Binary blocks of
 /// elements the reader skips still have to be stepped over, which needs this count.
 std::size_t element_node_count(long long type) {
-    static constexpr std::size_t counts[] = {0,  2,  3, 4,  4,  8,  6,  5,  3,  6,  9,  10, 27, 18, 14, 1,
-                                             8,  20, 15, 13, 9, 10, 12, 15, 15, 21, 4, 5,  6,  20, 35, 56};
+    static constexpr std::size_t counts[] = {0, 2,  3,  4,  4, 8,  6,  5,  3,  6,  9, 10, 27, 18, 14, 1,
+                                             8, 20, 15, 13, 9, 10, 12, 15, 15, 21, 4, 5,  6,  20, 35, 56};
     if (type >= 0 && type < static_cast<long long>(std::size(counts))) return counts[type];
     if (type == 92) return 64;
     if (type == 93) return 125;
@@ -114,12 +114,15 @@ void read_nodes_v4(GmshInput& input) {
     std::size_t read = 0;
     for (std::size_t block = 0; block < blocks; ++block) {
         const long long dimension = in.integer(Scalar::int32, "an entity dimension");
-        if (dimension < 0 || dimension > 3) in.fail("entity dimension must be 0 to 3, found " + std::to_string(dimension));
+        if (dimension < 0 || dimension > 3)
+            in.fail("entity dimension must be 0 to 3, found " + std::to_string(dimension));
         in.integer(Scalar::int32, "an entity tag");
         const long long parametric = in.integer(Scalar::int32, "a parametric flag");
-        if (parametric != 0 && parametric != 1) in.fail("parametric flag must be 0 or 1, found " + std::to_string(parametric));
+        if (parametric != 0 && parametric != 1)
+            in.fail("parametric flag must be 0 or 1, found " + std::to_string(parametric));
         const std::size_t in_block = in.count(Scalar::uint64, "a node count");
-        if (in_block > count - read) in.fail("node blocks hold more than the " + std::to_string(count) + " nodes announced");
+        if (in_block > count - read)
+            in.fail("node blocks hold more than the " + std::to_string(count) + " nodes announced");
         // Nodes on curves and surfaces may carry their parametric coordinates after x, y, z.
         const std::size_t parameters = parametric == 1 ? static_cast<std::size_t>(dimension) : 0;
         in.expect_records(in_block, 8 + (3 + parameters) * 8, "nodes");
@@ -184,7 +187,8 @@ void read_elements_v4(GmshInput& input) {
         const long long type = in.integer(Scalar::int32, "an element type");
         const std::size_t nodes = known_node_count(input, type);
         const std::size_t in_block = in.count(Scalar::uint64, "an element count");
-        if (in_block > count - read) in.fail("element blocks hold more than the " + std::to_string(count) + " elements announced");
+        if (in_block > count - read)
+            in.fail("element blocks hold more than the " + std::to_string(count) + " elements announced");
         in.expect_records(in_block, 8 * (1 + nodes), "elements");
         for (std::size_t e = 0; e < in_block; ++e) {
             in.integer(Scalar::uint64, "an element tag");
@@ -211,8 +215,7 @@ bool read_mesh_format(TextFile& file, bool& version_4) {
     const Token size = file.expect_token("a data size");
     const long long data_size = read_integer(file, size, "a data size");
     const bool binary = file_type == 1;
-    if (binary && data_size != 8)
-        file.fail(size, "data size must be 8 in binary files, found " + excerpt(size.text));
+    if (binary && data_size != 8) file.fail(size, "data size must be 8 in binary files, found " + excerpt(size.text));
     if (binary) {
         file.skip_line_end();
         file.use_byte_offsets();

@@ -71,13 +71,16 @@ TriangleMesh read_obj(const std::string& path) {
         const std::string_view keyword = line.front().text;
         if (keyword == "v") {
             // "v x y z", optionally followed by w or by a colour.
-            if (line.size() < 4) file.fail(line.front(), "vertex needs x, y and z, found " + std::to_string(line.size() - 1) + " values");
+            if (line.size() < 4)
+                file.fail(line.front(),
+                          "vertex needs x, y and z, found " + std::to_string(line.size() - 1) + " values");
             check_room_for_vertex(file, line.front(), mesh);
             for (std::size_t k = 1; k < 4; ++k) mesh.positions.push_back(read_coordinate(file, line[k]));
             for (std::size_t k = 4; k < line.size(); ++k) check_number(file, line[k]);
         } else if (keyword == "f") {
             corners.clear();
-            for (std::size_t k = 1; k < line.size(); ++k) corners.push_back(read_obj_corner(file, line[k], mesh.num_vertices()));
+            for (std::size_t k = 1; k < line.size(); ++k)
+                corners.push_back(read_obj_corner(file, line[k], mesh.num_vertices()));
             add_polygon(file, line.front(), corners, mesh);
         }
         // Normals, texture coordinates, groups, materials, lines and points do not shape the surface.
@@ -103,7 +106,8 @@ TriangleMesh read_off(const std::string& path) {
     std::vector<Token> line;
     for (std::size_t v = 0; v < vertex_count; ++v) {
         if (!file.next_line(line)) fail_truncated(file, file.last_token_line(), vertex_count, v, "vertices");
-        if (line.size() < 3) file.fail(line.front(), "vertex needs x, y and z, found " + std::to_string(line.size()) + " values");
+        if (line.size() < 3)
+            file.fail(line.front(), "vertex needs x, y and z, found " + std::to_string(line.size()) + " values");
         for (std::size_t k = 0; k < 3; ++k) mesh.positions.push_back(read_coordinate(file, line[k]));
     }
     mesh.triangles.reserve(3 * reservable(face_count, 4, file));
@@ -248,10 +252,12 @@ struct PlyElement {
 
 Scalar read_ply_type(const TextFile& file, const Token& token) {
     static const std::pair<std::string_view, Scalar> names[] = {
-        {"char", Scalar::int8},     {"int8", Scalar::int8},       {"uchar", Scalar::uint8},   {"uint8", Scalar::uint8},
-        {"short", Scalar::int16},   {"int16", Scalar::int16},     {"ushort", Scalar::uint16}, {"uint16", Scalar::uint16},
-        {"int", Scalar::int32},     {"int32", Scalar::int32},     {"uint", Scalar::uint32},   {"uint32", Scalar::uint32},
-        {"float", Scalar::float32}, {"float32", Scalar::float32}, {"double", Scalar::float64}, {"float64", Scalar::float64},
+        {"char", Scalar::int8},       {"int8", Scalar::int8},       {"uchar", Scalar::uint8},
+        {"uint8", Scalar::uint8},     {"short", Scalar::int16},     {"int16", Scalar::int16},
+        {"ushort", Scalar::uint16},   {"uint16", Scalar::uint16},   {"int", Scalar::int32},
+        {"int32", Scalar::int32},     {"uint", Scalar::uint32},     {"uint32", Scalar::uint32},
+        {"float", Scalar::float32},   {"float32", Scalar::float32}, {"double", Scalar::float64},
+        {"float64", Scalar::float64},
     };
     for (const auto& [name, type] : names) {
         if (token.text == name) return type;
@@ -263,7 +269,8 @@ Scalar read_ply_type(const TextFile& file, const Token& token) {
 std::vector<PlyElement> read_ply_header(TextFile& file, bool& binary, Endian& order) {
     std::vector<Token> line;
     if (!file.next_line(line)) file.fail(1, "empty file");
-    if (line.size() != 1 || line.front().text != "ply") file.fail(line.front(), "expected ply, found " + excerpt(line.front().text));
+    if (line.size() != 1 || line.front().text != "ply")
+        file.fail(line.front(), "expected ply, found " + excerpt(line.front().text));
     if (!file.next_line(line) || line.front().text != "format" || line.size() != 3)
         file.fail_here("expected format ascii|binary_little_endian|binary_big_endian 1.0");
     const std::string_view format = line[1].text;
@@ -279,7 +286,8 @@ std::vector<PlyElement> read_ply_header(TextFile& file, bool& binary, Endian& or
         if (keyword == "comment" || keyword == "obj_info") continue;
         if (keyword == "element") {
             if (line.size() != 3) file.fail(line.front(), "expected element <name> <count>");
-            elements.push_back({std::string(line[1].text), read_count(file, line[2], "an element count"), line.front(), {}});
+            elements.push_back(
+                {std::string(line[1].text), read_count(file, line[2], "an element count"), line.front(), {}});
         } else if (keyword == "property") {
             if (elements.empty()) file.fail(line.front(), "property before any element");
             PlyProperty property;
@@ -308,13 +316,15 @@ std::size_t find_ply_property(const TextFile& file, const PlyElement& element, s
     for (std::size_t p = 0; p < element.properties.size(); ++p) {
         if (element.properties[p].name == name && element.properties[p].list == list) return p;
     }
-    file.fail(element.where, "element " + element.name + " has no " + (list ? "list " : "") + "property " + std::string(name));
+    file.fail(element.where,
+              "element " + element.name + " has no " + (list ? "list " : "") + "property " + std::string(name));
 }
 
 /// @brief The fewest bytes one record of @p element takes in a binary file (lists empty).
 std::size_t ply_record_bytes(const PlyElement& element) {
     std::size_t bytes = 0;
-    for (const PlyProperty& property : element.properties) bytes += scalar_size(property.list ? property.count_type : property.type);
+    for (const PlyProperty& property : element.properties)
+        bytes += scalar_size(property.list ? property.count_type : property.type);
     return bytes;
 }
 
@@ -347,7 +357,8 @@ TriangleMesh read_ply(const std::string& path) {
         // Records without properties hold nothing: do not step through an absurd count of them.
         if (element.properties.empty()) continue;
         in.expect_records(element.count, ply_record_bytes(element), element.name + " records");
-        if (vertices) mesh.positions.reserve(3 * in.reservable(element.count, element.properties.size(), Scalar::float32));
+        if (vertices)
+            mesh.positions.reserve(3 * in.reservable(element.count, element.properties.size(), Scalar::float32));
         for (std::size_t r = 0; r < element.count; ++r) {
             double position[3] = {0, 0, 0};
             for (std::size_t p = 0; p < element.properties.size(); ++p) {
@@ -380,13 +391,15 @@ TriangleMesh read_ply(const std::string& path) {
     if (binary && file.remaining_bytes() != 0) {
         file.fail_at_byte(file.offset(), std::to_string(file.remaining_bytes()) + " bytes after the last element");
     }
-    if (!binary) reject_trailing_data(file, elements.empty() ? 0 : elements.back().count, "records of the last element");
+    if (!binary)
+        reject_trailing_data(file, elements.empty() ? 0 : elements.back().count, "records of the last element");
     check_has_triangles(file, mesh);
     return mesh;
 }
 
 std::string lowercase(std::string text) {
-    std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    std::transform(text.begin(), text.end(), text.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     return text;
 }
 

@@ -235,7 +235,8 @@ NumberParse parse_double(std::string_view text, double& value) {
 
 long long read_integer(const TextFile& file, const Token& token, const char* what) {
     long long value = 0;
-    if (!parse_integer(token.text, value)) file.fail(token, std::string("expected ") + what + ", found " + excerpt(token.text));
+    if (!parse_integer(token.text, value))
+        file.fail(token, std::string("expected ") + what + ", found " + excerpt(token.text));
     return value;
 }
 
@@ -313,8 +314,8 @@ void fail_truncated(const TextFile& file, std::size_t line, std::size_t expected
 void reject_trailing_data(TextFile& file, std::size_t count, const char* what) {
     Token extra;
     if (file.next_token(extra)) {
-        file.fail(extra, "more data after the " + std::to_string(count) + " " + what + " the header announces: " +
-                             excerpt(extra.text));
+        file.fail(extra, "more data after the " + std::to_string(count) + " " + what +
+                             " the header announces: " + excerpt(extra.text));
     }
 }
 

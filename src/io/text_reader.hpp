@@ -53,12 +53,14 @@ inline bool is_integer(Scalar type) { return type != Scalar::float32 && type != 
 template <typename T>
 T decode(const unsigned char* bytes, Endian order) {
     static_assert(std::is_trivially_copyable_v<T>, "plain numbers only");
-    using Bits = std::conditional_t<sizeof(T) == 1, std::uint8_t,
-                                    std::conditional_t<sizeof(T) == 2, std::uint16_t,
-                                                       std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
+    using Bits =
+        std::conditional_t<sizeof(T) == 1, std::uint8_t,
+                           std::conditional_t<sizeof(T) == 2, std::uint16_t,
+                                              std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
     static_assert(sizeof(Bits) == sizeof(T), "1, 2, 4 or 8 bytes");
     std::uint64_t bits = 0;
-    for (std::size_t i = 0; i < sizeof(T); ++i) bits = (bits << 8) | bytes[order == Endian::big ? i : sizeof(T) - 1 - i];
+    for (std::size_t i = 0; i < sizeof(T); ++i)
+        bits = (bits << 8) | bytes[order == Endian::big ? i : sizeof(T) - 1 - i];
     const Bits narrow = static_cast<Bits>(bits);
     T value;
     std::memcpy(&value, &narrow, sizeof value);

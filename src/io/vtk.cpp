@@ -28,10 +28,12 @@ constexpr long long vtk_quadratic_tetra = 24; // 10 points: the first 4 are the 
 /// @brief The data type named by @p token, as VTK spells them in legacy files.
 Scalar read_vtk_type(const TextFile& file, const Token& token) {
     static const std::pair<std::string_view, Scalar> names[] = {
-        {"char", Scalar::int8},          {"unsigned_char", Scalar::uint8},   {"short", Scalar::int16},
-        {"unsigned_short", Scalar::uint16}, {"int", Scalar::int32},         {"unsigned_int", Scalar::uint32},
-        {"long", Scalar::int64},         {"unsigned_long", Scalar::uint64},  {"float", Scalar::float32},
-        {"double", Scalar::float64},     {"vtktypeint32", Scalar::int32},    {"vtktypeuint32", Scalar::uint32},
+        {"char", Scalar::int8},          {"unsigned_char", Scalar::uint8},
+        {"short", Scalar::int16},        {"unsigned_short", Scalar::uint16},
+        {"int", Scalar::int32},          {"unsigned_int", Scalar::uint32},
+        {"long", Scalar::int64},         {"unsigned_long", Scalar::uint64},
+        {"float", Scalar::float32},      {"double", Scalar::float64},
+        {"vtktypeint32", Scalar::int32}, {"vtktypeuint32", Scalar::uint32},
         {"vtktypeint64", Scalar::int64}, {"vtktypeuint64", Scalar::uint64},
     };
     for (const auto& [name, type] : names) {
@@ -97,8 +99,9 @@ void read_classic_cells(NumberStream& in, std::size_t vertex_count, Cells& cells
     const std::size_t count = read_count(file, file.expect_token("a cell count"), "a cell count");
     const Token size_token = file.expect_token("a cell list size");
     const std::size_t size = read_count(file, size_token, "a cell list size");
-    if (count > size) file.fail(size_token, "cell list size " + std::to_string(size) + " is less than the " +
-                                                std::to_string(count) + " cells need");
+    if (count > size)
+        file.fail(size_token, "cell list size " + std::to_string(size) + " is less than the " + std::to_string(count) +
+                                  " cells need");
     start_data(in);
     in.expect_records(size, 4, "cell list values");
     cells.offsets.reserve(1 + in.reservable(count, 1, Scalar::int32));
@@ -110,11 +113,13 @@ void read_classic_cells(NumberStream& in, std::size_t vertex_count, Cells& cells
             in.fail("cell " + std::to_string(c) + " of " + std::to_string(points) +
                     " points overruns the cell list size " + std::to_string(size));
         }
-        for (std::size_t k = 0; k < points; ++k) cells.connectivity.push_back(in.vertex_index(Scalar::int32, 0, vertex_count));
+        for (std::size_t k = 0; k < points; ++k)
+            cells.connectivity.push_back(in.vertex_index(Scalar::int32, 0, vertex_count));
         read += 1 + points;
         cells.offsets.push_back(cells.connectivity.size());
     }
-    if (read != size) in.fail("cells hold " + std::to_string(read) + " values, the header announces " + std::to_string(size));
+    if (read != size)
+        in.fail("cells hold " + std::to_string(read) + " values, the header announces " + std::to_string(size));
 }
 
 /// @brief Reads the keyword line of an OFFSETS or CONNECTIVITY array; returns its integer type.
@@ -123,7 +128,8 @@ Scalar read_array_header(NumberStream& in, std::string_view keyword) {
     file.expect_keyword(keyword);
     const Token type_token = file.expect_token("a data type");
     const Scalar type = read_vtk_type(file, type_token);
-    if (!is_integer(type)) file.fail(type_token, std::string(keyword) + " must hold integers, found " + excerpt(type_token.text));
+    if (!is_integer(type))
+        file.fail(type_token, std::string(keyword) + " must hold integers, found " + excerpt(type_token.text));
     start_data(in);
     return type;
 }
@@ -168,8 +174,8 @@ void read_cell_types(NumberStream& in, const Cells& cells, const ReadOptions& op
     const Token count_token = file.expect_token("a cell type count");
     const std::size_t count = read_count(file, count_token, "a cell type count");
     if (count != cells.count()) {
-        file.fail(count_token, "CELL_TYPES lists " + std::to_string(count) + " cells, CELLS holds " +
-                                   std::to_string(cells.count()));
+        file.fail(count_token,
+                  "CELL_TYPES lists " + std::to_string(count) + " cells, CELLS holds " + std::to_string(cells.count()));
     }
     start_data(in);
     in.expect_records(count, 4, "cell types");
@@ -179,8 +185,8 @@ void read_cell_types(NumberStream& in, const Cells& cells, const ReadOptions& op
         const std::size_t expected = type == vtk_tetra ? 4 : 10;
         const std::size_t first = cells.offsets[c], points = cells.offsets[c + 1] - first;
         if (points != expected) {
-            in.fail("cell " + std::to_string(c) + " of type " + std::to_string(type) + " has " + std::to_string(points) +
-                    " points, expected " + std::to_string(expected));
+            in.fail("cell " + std::to_string(c) + " of type " + std::to_string(type) + " has " +
+                    std::to_string(points) + " points, expected " + std::to_string(expected));
         }
         mesh.tets.insert(mesh.tets.end(), cells.connectivity.begin() + static_cast<std::ptrdiff_t>(first),
                          cells.connectivity.begin() + static_cast<std::ptrdiff_t>(first + 4));
@@ -196,7 +202,8 @@ bool read_vtk_header(TextFile& file, bool& offset_layout) {
     if (line.text.substr(0, signature.size()) != signature)
         file.fail(line, "expected '# vtk DataFile Version x.y', found " + excerpt(line.text));
     const std::string_view version = line.text.substr(signature.size());
-    const bool classic = version == "2.0" || version == "3.0" || version == "4.0" || version == "4.1" || version == "4.2";
+    const bool classic =
+        version == "2.0" || version == "3.0" || version == "4.0" || version == "4.1" || version == "4.2";
     offset_layout = version == "5.1";
     if (!classic && !offset_layout)
         file.fail(line, "unsupported VTK version " + excerpt(version) + "; supported: 2.0 to 4.2 and 5.1");

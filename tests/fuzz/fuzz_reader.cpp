@@ -28,8 +28,8 @@ constexpr std::string_view extension = KDET_FUZZ_EXTENSION;
 /// The stem of this process's scratch files: one per process, so parallel fuzzers do not collide.
 /// In memory (/dev/shm) where there is one: writing each input to disk would dominate the run time.
 const std::string& scratch_stem() {
-    static const std::string stem = std::string(::access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp") +
-                                    "/kdet_fuzz_" + std::to_string(::getpid());
+    static const std::string stem =
+        std::string(::access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp") + "/kdet_fuzz_" + std::to_string(::getpid());
     return stem;
 }
 

@@ -30,9 +30,7 @@ std::string read_bytes(const fs::path& file) {
     return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-void write_bytes(const fs::path& file, const std::string& content) {
-    std::ofstream(file, std::ios::binary) << content;
-}
+void write_bytes(const fs::path& file, const std::string& content) { std::ofstream(file, std::ios::binary) << content; }
 
 void write_seeds(const fs::path& root) {
     const kdet::TetMesh mesh = seed_mesh();
@@ -52,7 +50,8 @@ void write_seeds(const fs::path& root) {
     // TetGen: the .node file, a NUL byte, the .ele file (how the harness splits its input).
     const fs::path stem = root / "node" / "pair";
     kdet::write_tetgen(mesh, stem.string());
-    write_bytes(root / "node" / "two_tets", read_bytes(stem.string() + ".node") + '\0' + read_bytes(stem.string() + ".ele"));
+    write_bytes(root / "node" / "two_tets",
+                read_bytes(stem.string() + ".node") + '\0' + read_bytes(stem.string() + ".ele"));
     fs::remove(stem.string() + ".node");
     fs::remove(stem.string() + ".ele");
 

@@ -52,7 +52,8 @@ inline std::string square_binary_stl() {
 /// The PLY header of the unit square in @p format (ascii, binary_little_endian, binary_big_endian):
 /// vertices with float x, y, double z and a colour byte, one quad face, and an edge element to skip.
 inline std::string square_ply_header(const std::string& format) {
-    return "ply\nformat " + format + " 1.0\ncomment a unit square\n"
+    return "ply\nformat " + format +
+           " 1.0\ncomment a unit square\n"
            "element vertex 4\nproperty float x\nproperty float y\nproperty double z\nproperty uchar red\n"
            "element face 1\nproperty list uchar int vertex_indices\n"
            "element edge 1\nproperty int vertex1\nproperty int vertex2\n"
