@@ -79,6 +79,47 @@ TEST(Cli, SelfCollisionJsonHasCountsTimesAndMemory) {
         EXPECT_NE(r.out.find(key), std::string::npos) << key << " missing in " << r.out;
 }
 
+TEST(Cli, ContactsFileHasDepthAndUnitDirectionPerPair) {
+    test::use_default_data_dir();
+    const TetMesh octopus = read_tet_mesh(data_path("octopus-low.mesh"));
+    const auto dir = temp_dir();
+    write_medit(test::moved(octopus, 0.3, 0.1 * test::extent_of(octopus), 0.0, 0.0), (dir / "moved.mesh").string());
+    const auto contacts = dir / "contacts.txt";
+    const Outcome r = kdet_cli("collide " + data_path("octopus-low.mesh") + " " + (dir / "moved.mesh").string() +
+                               " --contacts " + contacts.string());
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    std::ifstream in(contacts);
+    std::string line;
+    std::size_t lines = 0;
+    while (std::getline(in, line)) {
+        std::istringstream fields(line);
+        std::uint32_t i, j;
+        double depth, nx, ny, nz;
+        ASSERT_TRUE(fields >> i >> j >> depth >> nx >> ny >> nz) << line;
+        EXPECT_GE(depth, 0.0);
+        EXPECT_NEAR(nx * nx + ny * ny + nz * nz, 1.0, 1e-4) << line;
+        ++lines;
+    }
+    EXPECT_GT(lines, 10u);
+    EXPECT_NE(r.out.find("colliding pairs   " + std::to_string(lines)), std::string::npos) << r.out;
+}
+
+TEST(Cli, CheckExactReportsFalsePositivesOfTheConservativeTestOnly) {
+    test::use_default_data_dir();
+    const TetMesh octopus = read_tet_mesh(data_path("octopus-low.mesh"));
+    const auto dir = temp_dir();
+    write_medit(test::moved(octopus, 0.5, 0.05 * test::extent_of(octopus), 0.0, 0.0), (dir / "moved.mesh").string());
+    const std::string meshes = data_path("octopus-low.mesh") + " " + (dir / "moved.mesh").string();
+    const Outcome exact = kdet_cli("collide " + meshes + " --check-exact --json");
+    if (exact.exit_code == 2 && exact.out.find("without CGAL") != std::string::npos) GTEST_SKIP() << exact.out;
+    ASSERT_EQ(exact.exit_code, 0) << exact.out;
+    EXPECT_NE(exact.out.find("\"false_positives\": 0, \"false_negatives\": 0"), std::string::npos) << exact.out;
+    const Outcome loose = kdet_cli("collide " + meshes + " --check-exact --test sat_no_edges");
+    ASSERT_EQ(loose.exit_code, 0) << loose.out;
+    EXPECT_NE(loose.out.find("false negatives  0"), std::string::npos) << loose.out;
+    EXPECT_EQ(loose.out.find("false positives  0"), std::string::npos) << loose.out;
+}
+
 TEST(Cli, BenchRunsTheBuiltInSceneWithoutData) {
     const auto out_dir = temp_dir() / "bench";
     const Outcome r = kdet_cli("bench --tets 3000 --scene-frames 9 -s yes -n 2 -d " + out_dir.string());

@@ -1,4 +1,5 @@
 #include "commands.hpp"
+#include "exact_check.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
@@ -22,6 +23,10 @@ Tetrahedra of one mesh that share a vertex are adjacent and never reported.
 options:
   --self               self-collision of A (give one mesh)
   --pairs FILE         write 'i j' per line: 0-based tet indices in file order, sorted
+  --contacts FILE      write 'i j depth nx ny nz' per colliding pair: moving B's tet j by depth
+                       along (nx, ny, nz) separates it from A's tet i (from the 44-axis SAT)
+  --check-exact        judge the chosen test against CGAL's exact predicates and print its
+                       false positives and false negatives on these meshes
   --json               print one JSON object instead of text
   --allow-degenerate   accept zero-volume tetrahedra (rejected by default)
 )";
@@ -50,12 +55,27 @@ std::string json_number(double value) {
     return out.str();
 }
 
-void write_pairs(const std::string& path, const FrameResult& result) {
+/// @brief Writes one line per colliding pair; with contacts, depth and direction follow the indices.
+void write_pair_lines(const std::string& path, const FrameResult& result, bool with_contacts) {
     std::ofstream out(path);
     if (!out) throw Error(path + ": cannot open file for writing");
-    for (const TetPair& p : result.pairs) out << p.tet_a << ' ' << p.tet_b << '\n';
+    out.precision(9);
+    for (std::size_t k = 0; k < result.pairs.size(); ++k) {
+        out << result.pairs[k].tet_a << ' ' << result.pairs[k].tet_b;
+        if (with_contacts) {
+            const Contact& c = result.contacts[k];
+            out << ' ' << c.depth << ' ' << c.direction[0] << ' ' << c.direction[1] << ' ' << c.direction[2];
+        }
+        out << '\n';
+    }
     out.flush();
     if (!out) throw Error(path + ": write failed");
+}
+
+void print_examples(const char* what, const std::vector<IndexPair>& pairs) {
+    std::printf("  %-16s %zu", what, pairs.size());
+    for (std::size_t k = 0; k < pairs.size() && k < 5; ++k) std::printf("%s(%u, %u)", k ? " " : "  e.g. ", pairs[k].first, pairs[k].second);
+    std::printf("\n");
 }
 
 } // namespace
@@ -104,8 +124,8 @@ const char* detector_options_help() {
 int run_collide(int argc, char** argv) {
     DetectorOptions options;
     std::vector<std::string> meshes;
-    bool self = false, json = false, help = false;
-    std::string pairs_path;
+    bool self = false, json = false, help = false, check = false;
+    std::string pairs_path, contacts_path;
     ReadOptions read_options;
 
     ArgParser parser("collide");
@@ -115,6 +135,8 @@ int run_collide(int argc, char** argv) {
     parser.flag("--allow-degenerate", [&] { read_options.allow_degenerate = true; });
     parser.flag("--help", [&] { help = true; });
     parser.option("--pairs", "FILE", [&](const std::string& v) { pairs_path = v; });
+    parser.option("--contacts", "FILE", [&](const std::string& v) { contacts_path = v; });
+    parser.flag("--check-exact", [&] { check = true; });
     add_detector_options(parser, options);
     parser.parse(argc, argv, 2);
     if (help) {
@@ -124,8 +146,13 @@ int run_collide(int argc, char** argv) {
     if (meshes.empty()) throw UsageError("collide: missing mesh A (see 'kdet collide --help')");
     if (self && meshes.size() == 2) throw UsageError("collide: --self takes one mesh, got two");
     if (!self && meshes.size() == 1) throw UsageError("collide: one mesh given: add mesh B, or --self for self-collision");
-    if (options.method == Method::kdet_no_pairs && !pairs_path.empty())
-        throw UsageError("collide: --pairs needs a method that builds pairs; kdet_no_pairs only flags tets");
+    if (options.method == Method::kdet_no_pairs && (!pairs_path.empty() || !contacts_path.empty() || check))
+        throw UsageError("collide: --pairs, --contacts and --check-exact need a method that builds pairs; "
+                         "kdet_no_pairs only flags tets");
+    std::string unavailable;
+    if (check && !exact_check_available(&unavailable))
+        throw UsageError("collide: --check-exact is not available: " + unavailable);
+    options.contacts = !contacts_path.empty();
 
     const TetMesh a = read_tet_mesh(meshes[0], read_options);
     const TetMesh b = self ? TetMesh{} : read_tet_mesh(meshes[1], read_options);
@@ -138,7 +165,14 @@ int run_collide(int argc, char** argv) {
         detector.add_object(b);
     }
     const FrameResult& result = detector.detect();
-    if (!pairs_path.empty()) write_pairs(pairs_path, result);
+    if (!pairs_path.empty()) write_pair_lines(pairs_path, result, false);
+    if (!contacts_path.empty()) write_pair_lines(contacts_path, result, true);
+    ExactReport exact;
+    if (check) {
+        std::vector<IndexPair> reported;
+        for (const TetPair& p : result.pairs) reported.emplace_back(p.tet_a, p.tet_b);
+        exact = check_exact(a, self ? nullptr : &b, reported, options);
+    }
 
     const FrameCounts& c = result.counts;
     const StageTimes& t = result.times;
@@ -155,7 +189,14 @@ int run_collide(int argc, char** argv) {
                   << ", \"find_candidates\": " << json_number(t.find_candidates)
                   << ", \"sort_unique\": " << json_number(t.sort_unique)
                   << ", \"narrow_phase\": " << json_number(t.narrow_phase) << "}, \"total_ms\": "
-                  << json_number(t.total) << ", \"memory_bytes\": " << result.memory_bytes << "}\n";
+                  << json_number(t.total) << ", \"memory_bytes\": " << result.memory_bytes;
+        if (check)
+            std::cout << ", \"exact\": {\"pairs_checked\": " << exact.pairs_checked
+                      << ", \"true_pairs\": " << exact.true_pairs
+                      << ", \"false_positives\": " << exact.false_positives.size()
+                      << ", \"false_negatives\": " << exact.false_negatives.size()
+                      << ", \"skipped_degenerate\": " << exact.skipped_degenerate << "}";
+        std::cout << "}\n";
         return exit_ok;
     }
     std::printf("meshes            %s (%zu tets)", meshes[0].c_str(), a.num_tets());
@@ -172,6 +213,13 @@ int run_collide(int argc, char** argv) {
                 t.bounding_boxes, t.populate_grid, t.find_candidates, t.sort_unique, t.narrow_phase);
     std::printf("total             %.3f ms\n", t.total);
     std::printf("memory            %zu bytes\n", result.memory_bytes);
+    if (check) {
+        std::printf("exact check       %zu pairs judged with CGAL, %zu intersect", exact.pairs_checked, exact.true_pairs);
+        if (exact.skipped_degenerate) std::printf(" (%zu with a flat tet not judged)", exact.skipped_degenerate);
+        std::printf("\n");
+        print_examples("false positives", exact.false_positives);
+        print_examples("false negatives", exact.false_negatives);
+    }
     return exit_ok;
 }
 
