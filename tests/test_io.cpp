@@ -1,6 +1,8 @@
 // Tests of the mesh reading/writing module: the real MEDIT models, round trips, and one test per kind
 // of bad input, each checking that the error names the file and the offending line.
 
+#include "test_support.hpp"
+
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 
@@ -21,6 +23,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using kdet::test::error_message;
 
 /// The models are found through KDET_DATA_DIR; when it is unset the tests use the repository's default
 /// made absolute at build time, so they pass from any working directory.
@@ -66,18 +69,6 @@ private:
     fs::path path_;
 };
 
-/// The message of the kdet::Error that @p action throws; fails the test when it throws none.
-std::string error_message(const std::function<void()>& action) {
-    try {
-        action();
-    } catch (const kdet::Error& error) {
-        const std::string message = error.what();
-        EXPECT_EQ(message.find('\n'), std::string::npos) << "message is not one line: " << message;
-        return message;
-    }
-    ADD_FAILURE() << "no kdet::Error was thrown";
-    return {};
-}
 
 /// Checks that the error of @p action starts with "file:line: " and contains @p what.
 void expect_file_error(const std::function<void()>& action, const std::string& file, int line,

@@ -66,23 +66,11 @@ std::string read_bytes(const std::string& file) {
     return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-/// The message of the kdet::Error @p action throws; fails the test when it throws none.
-std::string error_of(const std::function<void()>& action) {
-    try {
-        action();
-    } catch (const kdet::Error& error) {
-        const std::string message = error.what();
-        EXPECT_EQ(message.find('\n'), std::string::npos) << "message is not one line: " << message;
-        return message;
-    }
-    ADD_FAILURE() << "no kdet::Error was thrown";
-    return {};
-}
 
 /// Checks that the error of @p action starts with @p location ("file:7: " or "file: byte 12: ") and
 /// contains @p what.
 void expect_error(const std::function<void()>& action, const std::string& location, const std::string& what) {
-    const std::string message = error_of(action);
+    const std::string message = error_message(action);
     EXPECT_EQ(message.rfind(location, 0), 0u) << "expected it to start with '" << location << "': " << message;
     EXPECT_NE(message.find(what), std::string::npos) << "expected it to contain '" << what << "': " << message;
 }
@@ -505,7 +493,7 @@ TEST_F(Formats, PlyElementWithoutPropertiesIsSkippedWhateverItsCount) {
 
 TEST_F(Formats, SurfaceErrorsNameLineOrByte) {
     const std::string unknown = write("mesh.xyz", "");
-    EXPECT_EQ(error_of([&] { kdet::read_surface(unknown); }),
+    EXPECT_EQ(error_message([&] { kdet::read_surface(unknown); }),
               unknown + ": unsupported surface format '.xyz'; supported: .obj, .off, .stl, .ply");
 
     const std::string obj_range = write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");

@@ -1,16 +1,34 @@
 #pragma once
 /// Shared helpers for the tests: data paths, random tet soups, rigid transforms.
 
+#include <kdet/error.hpp>
 #include <kdet/io.hpp>
 #include <kdet/mesh.hpp>
+
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <random>
 #include <string>
 
 namespace kdet::test {
+
+/// @brief The message of the kdet::Error that `action` throws (checked to be one line); fails the
+/// calling test when it throws none.
+inline std::string error_message(const std::function<void()>& action) {
+    try {
+        action();
+    } catch (const Error& error) {
+        const std::string message = error.what();
+        EXPECT_EQ(message.find('\n'), std::string::npos) << "message is not one line: " << message;
+        return message;
+    }
+    ADD_FAILURE() << "no kdet::Error was thrown";
+    return {};
+}
 
 /// @brief Points KDET_DATA_DIR at the models beside the source tree unless the caller set it.
 inline void use_default_data_dir() {

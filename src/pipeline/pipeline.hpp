@@ -109,6 +109,8 @@ private:
 
     bool compute_bounds_and_culling(const std::vector<std::uint8_t>& pair_enabled);
     GridView populate(FrameCounts& counts);
+    template <class Launch>
+    void append_candidates_growing(const Launch& launch, FrameCounts& counts);
     void find_candidates(const GridView& grid, FrameCounts& counts);
     void brute_force(FrameCounts& counts);
     void narrow_phase_and_compact(std::size_t unique, FrameResult& result);
@@ -268,19 +270,31 @@ void Pipeline<Exec>::ensure_candidate_capacity(std::size_t relevant_tets) {
     if (candidates_.size() < estimate) candidates_.resize_discard(estimate);
 }
 
-/// @brief Stage 3: candidate pairs with duplicates; grows the buffer to the exact need and reruns.
+/// @brief Runs a stage that appends to the candidate buffer until the buffer held everything: an
+/// overflowing run still counts what it needed, so the buffer grows to that size and the stage reruns.
 template <class Exec>
-void Pipeline<Exec>::find_candidates(const GridView& grid, FrameCounts& counts) {
-    ensure_candidate_capacity(relevant_estimate_);
+template <class Launch>
+void Pipeline<Exec>::append_candidates_growing(const Launch& launch, FrameCounts& counts) {
     for (;;) {
         reset_counters();
-        exec_.for_each(tets_.size(), FindCandidatesKernel{scene_view(), grid, params_, layer_mask_, candidate_appender()});
+        launch(candidate_appender());
         const FrameCounters after = read_counters();
         counts.candidates = after.candidates;
         if (after.candidates <= candidates_.size()) return;
         candidates_.resize_discard(after.candidates + after.candidates / 4);
         ++counts.buffer_regrows;
     }
+}
+
+/// @brief Stage 3: candidate pairs with duplicates.
+template <class Exec>
+void Pipeline<Exec>::find_candidates(const GridView& grid, FrameCounts& counts) {
+    ensure_candidate_capacity(relevant_estimate_);
+    append_candidates_growing(
+        [&](const KeyAppender& out) {
+            exec_.for_each(tets_.size(), FindCandidatesKernel{scene_view(), grid, params_, layer_mask_, out});
+        },
+        counts);
 }
 
 /// @brief Both brute-force methods: every pair of enabled objects is tested, colliding pairs appended.
@@ -307,23 +321,18 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
         exec_.upload(block_objects_.data(), block_objects.data(), block_objects.size());
     }
     if (candidates_.size() == 0) candidates_.resize_discard(4096);
-    for (;;) {
-        reset_counters();
-        if (options_.method == Method::brute_force_pairs)
-            exec_.for_each(block_begin.back(),
-                           BruteForcePairsKernel{scene_view(), options_.narrow_phase, object_tet_begin_.data(),
-                                                 blocks_begin_.data(), block_objects_.data(),
-                                                 static_cast<std::uint32_t>(block_objects.size() / 2),
-                                                 candidate_appender()});
-        else
-            exec_.for_each(tets_.size(), BruteForceLoopKernel{scene_view(), options_.narrow_phase,
-                                                              object_tet_begin_.data(), candidate_appender()});
-        const FrameCounters after = read_counters();
-        counts.candidates = after.candidates;
-        if (after.candidates <= candidates_.size()) return;
-        candidates_.resize_discard(after.candidates + after.candidates / 4);
-        ++counts.buffer_regrows;
-    }
+    append_candidates_growing(
+        [&](const KeyAppender& out) {
+            if (options_.method == Method::brute_force_pairs)
+                exec_.for_each(block_begin.back(),
+                               BruteForcePairsKernel{scene_view(), options_.narrow_phase, object_tet_begin_.data(),
+                                                     blocks_begin_.data(), block_objects_.data(),
+                                                     static_cast<std::uint32_t>(block_objects.size() / 2), out});
+            else
+                exec_.for_each(tets_.size(), BruteForceLoopKernel{scene_view(), options_.narrow_phase,
+                                                                  object_tet_begin_.data(), out});
+        },
+        counts);
 }
 
 /// @brief Stage 5: the narrow phase once per unique candidate, then the colliding pairs in sorted order.
