@@ -25,13 +25,6 @@ namespace {
 namespace fs = std::filesystem;
 using kdet::test::error_message;
 
-/// The models are found through KDET_DATA_DIR; when it is unset the tests use the repository's default
-/// made absolute at build time, so they pass from any working directory.
-void use_default_data_dir_if_unset() {
-    const char* dir = std::getenv("KDET_DATA_DIR");
-    if (dir == nullptr || *dir == '\0') setenv("KDET_DATA_DIR", KDET_DEFAULT_DATA_DIR, 1);
-}
-
 /// A fresh folder for the files a test writes, removed with everything in it at the end of the test.
 class TempDir {
 public:
@@ -149,7 +142,7 @@ const ModelCounts real_models[] = {
 };
 
 TEST(IoMedit, ReadsTheRealModels) {
-    use_default_data_dir_if_unset();
+    kdet::test::use_default_data_dir();
     for (const ModelCounts& model : real_models) {
         SCOPED_TRACE(model.file);
         const kdet::TetMesh mesh = kdet::read_tet_mesh(kdet::data_path(model.file));
@@ -160,7 +153,7 @@ TEST(IoMedit, ReadsTheRealModels) {
 }
 
 TEST(IoMedit, BunnyFirstAndLastEntriesAreRead) {
-    use_default_data_dir_if_unset();
+    kdet::test::use_default_data_dir();
     const kdet::TetMesh mesh = kdet::read_medit(kdet::data_path("bunny.mesh"));
     // From the file: first vertex "-0.0260146 0.112578 0.0363871 0", first tetrahedron
     // "2927 2983 2982 2889 0", last tetrahedron "3887 5115 5409 5432 0" (1-based).
@@ -276,7 +269,7 @@ TEST(IoRoundTrip, MeditSmallMesh) {
 }
 
 TEST(IoRoundTrip, BunnyThroughBothFormats) {
-    use_default_data_dir_if_unset();
+    kdet::test::use_default_data_dir();
     TempDir dir;
     const kdet::TetMesh bunny = kdet::read_medit(kdet::data_path("bunny.mesh"));
     kdet::write_tetgen(bunny, dir.file_path("bunny"));
@@ -362,7 +355,7 @@ TEST(IoErrors, TruncatedMeditSectionBeforeNextKeyword) {
 }
 
 TEST(IoErrors, TruncatedRealModel) {
-    use_default_data_dir_if_unset();
+    kdet::test::use_default_data_dir();
     TempDir dir;
     // The first 20000 lines of bunny.mesh: its tetrahedra start at line 12408, so 7593 of them remain.
     std::ifstream in(kdet::data_path("bunny.mesh"));
