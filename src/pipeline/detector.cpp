@@ -1,4 +1,5 @@
 #include "pipeline/pipeline_base.hpp"
+#include "pipeline/spatial_order.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
@@ -43,13 +44,10 @@ struct Detector::Impl {
                         " objects)");
     }
 
+    /// Converts one object's coordinates to the float32 the pipeline stores, rejecting non-finite ones.
     template <class Scalar>
-    void store_positions(ObjectId object, const Scalar* xyz, std::size_t vertex_count) {
-        const std::uint32_t first = object_vertex_begin[object];
-        const std::size_t expected = object_vertex_begin[object + 1] - first;
-        if (vertex_count != expected)
-            throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
-                        " vertices, expected " + std::to_string(expected));
+    static std::vector<vec3> to_float_positions(std::size_t object, const Scalar* xyz, std::size_t vertex_count) {
+        std::vector<vec3> converted(vertex_count);
         for (std::size_t v = 0; v < vertex_count; ++v) {
             const auto x = static_cast<float>(xyz[3 * v]), y = static_cast<float>(xyz[3 * v + 1]),
                        z = static_cast<float>(xyz[3 * v + 2]);
@@ -57,12 +55,25 @@ struct Detector::Impl {
             if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
                 throw Error("object " + std::to_string(object) + ": vertex " + std::to_string(v) +
                             " has a non-finite coordinate (or one beyond float range)");
-            positions[first + v] = vec3{x, y, z};
+            converted[v] = vec3{x, y, z};
         }
+        return converted;
+    }
+
+    template <class Scalar>
+    void store_positions(ObjectId object, const Scalar* xyz, std::size_t vertex_count) {
+        const std::uint32_t first = object_vertex_begin[object];
+        const std::size_t expected = object_vertex_begin[object + 1] - first;
+        if (vertex_count != expected)
+            throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
+                        " vertices, expected " + std::to_string(expected));
+        const std::vector<vec3> converted = to_float_positions(object, xyz, vertex_count);
+        std::copy(converted.begin(), converted.end(), positions.begin() + first);
         positions_dirty[object] = 1;
         positions_on_device[object] = 0;
     }
 
+    /// Adds an object; on a bad index or coordinate it throws and leaves the detector as it was.
     template <class Scalar>
     ObjectId add(const Scalar* xyz, std::size_t vertex_count, const std::uint32_t* tets, std::size_t tet_count) {
         const std::uint64_t total_tets = topology.tets.size() + tet_count;
@@ -76,18 +87,23 @@ struct Detector::Impl {
                     throw Error("object " + std::to_string(id) + ": tet " + std::to_string(t) + " has vertex index " +
                                 std::to_string(tets[4 * t + k]) + " out of range [0, " +
                                 std::to_string(vertex_count) + ")");
+        const std::vector<vec3> converted = to_float_positions(id, xyz, vertex_count);
+
+        // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
-        for (std::size_t t = 0; t < tet_count; ++t) {
+        const std::uint32_t first_tet = static_cast<std::uint32_t>(topology.tets.size());
+        for (const std::uint32_t t : spatial_tet_order(converted.data(), tets, tet_count)) {
             TetIndices tet;
             for (int k = 0; k < 4; ++k) tet.v[k] = base + tets[4 * t + k];
             topology.tets.push_back(tet);
             topology.tet_object.push_back(id);
+            topology.tet_user_id.push_back(first_tet + t);
         }
         if (topology.object_tet_begin.empty()) topology.object_tet_begin.push_back(0);
         topology.object_tet_begin.push_back(static_cast<std::uint32_t>(topology.tets.size()));
         object_vertex_begin.push_back(base + static_cast<std::uint32_t>(vertex_count));
         topology.vertex_count = object_vertex_begin.back();
-        positions.resize(topology.vertex_count);
+        positions.insert(positions.end(), converted.begin(), converted.end());
         positions_dirty.push_back(1);
         positions_on_device.push_back(0);
 
@@ -98,7 +114,6 @@ struct Detector::Impl {
                 enabled[a * n + b] = (a < n - 1 && b < n - 1) ? pair_enabled[a * (n - 1) + b] : (a != b ? 1 : 0);
         pair_enabled.swap(enabled);
         topology_changed = true;
-        store_positions(id, xyz, vertex_count);
         return id;
     }
 };

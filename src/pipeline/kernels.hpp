@@ -67,7 +67,7 @@ KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<s
 KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
 
 /// @brief The predicate every method applies to a pair that may collide: adjacency, boxes, narrow phase.
-/// The lower global id always goes first so every method sees the same floating-point computation.
+/// The lower stored id always goes first so every method sees the same floating-point computation.
 KDET_HD inline bool tets_collide(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u) {
     const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
     if (s.tet_object[first] == s.tet_object[second] && share_vertex(s.tets[first], s.tets[second])) return false;
@@ -338,7 +338,6 @@ struct NarrowPhaseKernel {
     NarrowPhase test;
     const std::uint64_t* keys;
     std::uint32_t* hit;
-    Contact* contacts; ///< null when contacts are off
     std::uint32_t* colliding;
 
     KDET_HD void operator()(std::uint64_t k) const {
@@ -351,28 +350,52 @@ struct NarrowPhaseKernel {
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);
         atomic_store_relaxed(&colliding[u], 1u);
-        if (contacts) {
-            float depth = 0.0f;
-            vec3 direction{0.0f, 0.0f, 0.0f};
-            tets_intersect_sat_mtv(a, b, depth, direction);
-            contacts[k] = Contact{depth, {direction.x, direction.y, direction.z}};
-        }
     }
 };
 
-/// @brief Stage 5: moves the colliding pairs (and contacts) to the front, keeping their sorted order.
+/// @brief Stage 5: moves the colliding pairs to the front, keeping their sorted order.
 struct CompactKernel {
     const std::uint64_t* keys;
     const std::uint32_t* hit;
     const std::uint32_t* position;
-    const Contact* contacts;
     std::uint64_t* out_keys;
-    Contact* out_contacts;
     KDET_HD void operator()(std::uint64_t k) const {
-        if (!hit[k]) return;
-        out_keys[position[k]] = keys[k];
-        if (contacts) out_contacts[position[k]] = contacts[k];
+        if (hit[k]) out_keys[position[k]] = keys[k];
     }
+};
+
+/// @brief Stage 6: renames a pair from stored tet ids to the caller's ids, lower id first.
+struct UserPairKernel {
+    const std::uint32_t* user_id; ///< [tets] stored id -> caller's global id
+    std::uint64_t* keys;
+    KDET_HD void operator()(std::uint64_t k) const {
+        keys[k] = pair_key(user_id[key_first(keys[k])], user_id[key_second(keys[k])]);
+    }
+};
+
+/// @brief Stage 6: contact of each colliding pair given in the caller's ids; tet b is the pair's second.
+struct ContactKernel {
+    SceneView scene;
+    const std::uint32_t* stored_id; ///< [tets] caller's global id -> stored id
+    const std::uint64_t* keys;
+    Contact* contacts;
+    KDET_HD void operator()(std::uint64_t k) const {
+        vec3 a[4], b[4];
+        load_tet(scene, stored_id[key_first(keys[k])], a);
+        load_tet(scene, stored_id[key_second(keys[k])], b);
+        float depth = 0.0f;
+        vec3 direction{0.0f, 0.0f, 0.0f};
+        tets_intersect_sat_mtv(a, b, depth, direction);
+        contacts[k] = Contact{depth, {direction.x, direction.y, direction.z}};
+    }
+};
+
+/// @brief Stage 6: per-tet colliding flags in the caller's numbering.
+struct UserFlagsKernel {
+    const std::uint32_t* stored_id; ///< [tets] caller's global id -> stored id
+    const std::uint32_t* colliding; ///< per stored tet
+    std::uint32_t* user_colliding;
+    KDET_HD void operator()(std::uint64_t i) const { user_colliding[i] = colliding[stored_id[i]]; }
 };
 
 /// @brief Flags a non-finite coordinate among positions handed over in the backend's memory.

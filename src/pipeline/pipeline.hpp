@@ -41,11 +41,18 @@ public:
         exec_.upload(tets_.data(), topology.tets.data(), tets);
         tet_object_.resize_discard(tets);
         exec_.upload(tet_object_.data(), topology.tet_object.data(), tets);
+        user_id_.resize_discard(tets);
+        exec_.upload(user_id_.data(), topology.tet_user_id.data(), tets);
+        std::vector<std::uint32_t> stored_id(tets);
+        for (std::uint32_t t = 0; t < tets; ++t) stored_id[topology.tet_user_id[t]] = t;
+        stored_id_.resize_discard(tets);
+        exec_.upload(stored_id_.data(), stored_id.data(), tets);
         object_tet_begin_.resize_discard(topology.object_tet_begin.size());
         exec_.upload(object_tet_begin_.data(), topology.object_tet_begin.data(), topology.object_tet_begin.size());
         positions_.resize_discard(topology.vertex_count);
         info_.resize_discard(tets);
         colliding_.resize_discard(tets);
+        user_colliding_.resize_discard(tets);
         const std::size_t objects = topology.object_tet_begin.size() - 1;
         stats_.resize_discard(objects);
         object_boxes_.resize_discard(objects);
@@ -68,17 +75,18 @@ public:
     }
 
     DeviceResults device_results() override {
-        return DeviceResults{out_keys_.data(), colliding_count_, colliding_.data(), colliding_.size(),
+        return DeviceResults{out_keys_.data(), colliding_count_, user_colliding_.data(), user_colliding_.size(),
                              options_.contacts ? out_contacts_.data() : nullptr};
     }
 
     std::size_t memory_bytes() const override {
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
-               positions_.capacity_bytes() + info_.capacity_bytes() + colliding_.capacity_bytes() +
+               user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() +
+               info_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                stats_.capacity_bytes() + object_boxes_.capacity_bytes() + pair_active_.capacity_bytes() +
                headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + hit_.capacity_bytes() + position_.capacity_bytes() +
-               contacts_.capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
+               out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
                blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes() + exec_.scratch_bytes();
     }
 
@@ -130,9 +138,12 @@ private:
     buffer<TetIndices> tets_;
     buffer<std::uint32_t> tet_object_;
     buffer<std::uint32_t> object_tet_begin_;
+    buffer<std::uint32_t> user_id_;   ///< stored tet -> caller's global id
+    buffer<std::uint32_t> stored_id_; ///< caller's global id -> stored tet
     buffer<vec3> positions_;
     buffer<TetInfo> info_;
-    buffer<std::uint32_t> colliding_;
+    buffer<std::uint32_t> colliding_;      ///< per stored tet
+    buffer<std::uint32_t> user_colliding_; ///< per tet in the caller's numbering
     buffer<ObjectStats> stats_;
     buffer<Aabb> object_boxes_;
     buffer<std::uint8_t> pair_active_;
@@ -142,7 +153,6 @@ private:
     buffer<std::uint64_t> candidates_;
     buffer<std::uint32_t> hit_;
     buffer<std::uint32_t> position_;
-    buffer<Contact> contacts_;
     buffer<std::uint64_t> out_keys_;
     buffer<Contact> out_contacts_;
     buffer<std::uint64_t> blocks_begin_;
@@ -335,27 +345,23 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
         counts);
 }
 
-/// @brief Stage 5: the narrow phase once per unique candidate, then the colliding pairs in sorted order.
+/// @brief Stage 5: the narrow phase once per unique candidate; then (stage 6) the colliding pairs
+/// under the caller's tet ids in sorted order, and their contacts.
 template <class Exec>
 void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& result) {
     hit_.resize_discard(unique);
     position_.resize_discard(unique);
-    Contact* contacts = nullptr;
-    if (options_.contacts) {
-        contacts_.resize_discard(unique);
-        contacts = contacts_.data();
-    }
     exec_.for_each(unique, NarrowPhaseKernel{scene_view(), options_.narrow_phase, candidates_.data(), hit_.data(),
-                                             contacts, colliding_.data()});
+                                             colliding_.data()});
     const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), unique);
     out_keys_.resize_discard(colliding);
-    Contact* out_contacts = nullptr;
-    if (contacts) {
+    exec_.for_each(unique, CompactKernel{candidates_.data(), hit_.data(), position_.data(), out_keys_.data()});
+    exec_.for_each(colliding, UserPairKernel{user_id_.data(), out_keys_.data()});
+    exec_.sort_unique(out_keys_.data(), colliding); // renaming keeps pairs distinct: only the order changes
+    if (options_.contacts) {
         out_contacts_.resize_discard(colliding);
-        out_contacts = out_contacts_.data();
+        exec_.for_each(colliding, ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), out_contacts_.data()});
     }
-    exec_.for_each(unique, CompactKernel{candidates_.data(), hit_.data(), position_.data(), contacts,
-                                         out_keys_.data(), out_contacts});
 
     colliding_count_ = colliding;
     result.counts.colliding_pairs = colliding;
@@ -373,22 +379,23 @@ void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& r
         locate(key_first(keys[k]), p.object_a, p.tet_a);
         locate(key_second(keys[k]), p.object_b, p.tet_b);
     }
-    result.contacts.resize(contacts ? colliding : 0);
-    if (contacts) exec_.download(result.contacts.data(), out_contacts, colliding);
+    result.contacts.resize(options_.contacts ? colliding : 0);
+    if (options_.contacts) exec_.download(result.contacts.data(), out_contacts_.data(), colliding);
 }
 
-/// @brief Counts the colliding tets (a scan of the 0/1 flags) and, when results go to the host,
-/// copies the per-tet flags.
+/// @brief Stage 6: the per-tet flags in the caller's numbering, counted (a scan of the 0/1 flags)
+/// and, when results go to the host, copied.
 template <class Exec>
 void Pipeline<Exec>::count_and_copy_flags(FrameResult& result) {
     const std::size_t tets = tets_.size();
+    exec_.for_each(tets, UserFlagsKernel{stored_id_.data(), colliding_.data(), user_colliding_.data()});
     position_.resize_discard(tets);
-    result.counts.colliding_tets = exec_.exclusive_scan(colliding_.data(), position_.data(), tets);
+    result.counts.colliding_tets = exec_.exclusive_scan(user_colliding_.data(), position_.data(), tets);
     const std::size_t objects = stats_.size();
     result.colliding.resize(options_.results_to_host ? objects : 0);
     if (!options_.results_to_host) return;
     std::vector<std::uint32_t> flags(tets);
-    exec_.download(flags.data(), colliding_.data(), tets);
+    exec_.download(flags.data(), user_colliding_.data(), tets);
     for (std::size_t o = 0; o < objects; ++o) {
         const std::uint32_t b = topology_.object_tet_begin[o], e = topology_.object_tet_begin[o + 1];
         result.colliding[o].resize(e - b);

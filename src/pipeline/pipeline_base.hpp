@@ -17,6 +17,9 @@ struct SceneTopology {
     std::vector<TetIndices> tets;               ///< global vertex ids
     std::vector<std::uint32_t> tet_object;
     std::vector<std::uint32_t> object_tet_begin; ///< [objects + 1]
+    /// [tets] the caller's global id of each stored tet: tets are stored in spatial order
+    /// (spatial_order.hpp) and reported under the caller's numbering.
+    std::vector<std::uint32_t> tet_user_id;
     std::uint32_t vertex_count = 0;
 };
 

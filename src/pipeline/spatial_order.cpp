@@ -1,0 +1,38 @@
+#include "pipeline/spatial_order.hpp"
+
+#include "grid/hash.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace kdet {
+
+std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::uint32_t* tets, std::size_t tet_count) {
+    std::vector<vec3> centroid(tet_count);
+    const float inf = std::numeric_limits<float>::infinity();
+    vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
+    for (std::size_t t = 0; t < tet_count; ++t) {
+        const std::uint32_t* v = tets + 4 * t;
+        centroid[t] = (positions[v[0]] + positions[v[1]] + positions[v[2]] + positions[v[3]]) * 0.25f;
+        lo = min_v(lo, centroid[t]);
+        hi = max_v(hi, centroid[t]);
+    }
+    auto quantize = [](float x, float low, float high) {
+        const float scaled = high > low ? (x - low) / (high - low) * 1023.0f : 0.0f;
+        return static_cast<std::uint32_t>(std::clamp(scaled, 0.0f, 1023.0f));
+    };
+    std::vector<std::uint64_t> keys(tet_count);
+    for (std::size_t t = 0; t < tet_count; ++t) {
+        const vec3 c = centroid[t];
+        const std::uint32_t code = hash_detail::spread_bits_3(quantize(c.x, lo.x, hi.x)) |
+                                   (hash_detail::spread_bits_3(quantize(c.y, lo.y, hi.y)) << 1) |
+                                   (hash_detail::spread_bits_3(quantize(c.z, lo.z, hi.z)) << 2);
+        keys[t] = (static_cast<std::uint64_t>(code) << 32) | t;
+    }
+    std::sort(keys.begin(), keys.end());
+    std::vector<std::uint32_t> order(tet_count);
+    for (std::size_t i = 0; i < tet_count; ++i) order[i] = static_cast<std::uint32_t>(keys[i] & 0xffffffffu);
+    return order;
+}
+
+} // namespace kdet

@@ -1,0 +1,143 @@
+// The order in which the pipeline stores tets, and that results still use the caller's numbering.
+
+#include "test_support.hpp"
+
+#include "geometry/tet_intersect.hpp"
+#include "pipeline/spatial_order.hpp"
+
+#include <kdet/detector.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+namespace kdet {
+namespace {
+
+/// A block of n^3 unit cubes, one tet per cube, listed in shuffled order.
+TetMesh shuffled_block(int n, unsigned seed) {
+    TetMesh mesh;
+    std::vector<int> cubes(static_cast<std::size_t>(n * n * n));
+    std::iota(cubes.begin(), cubes.end(), 0);
+    std::shuffle(cubes.begin(), cubes.end(), std::mt19937(seed));
+    for (int c : cubes) {
+        const double x = c % n, y = (c / n) % n, z = c / (n * n);
+        const double corners[4][3] = {{x, y, z}, {x + 1, y, z}, {x, y + 1, z}, {x, y, z + 1}};
+        for (const auto& p : corners) mesh.positions.insert(mesh.positions.end(), p, p + 3);
+        const auto v = static_cast<std::uint32_t>(mesh.tets.size());
+        for (std::uint32_t k = 0; k < 4; ++k) mesh.tets.push_back(v + k);
+    }
+    return mesh;
+}
+
+double mean_step(const std::vector<vec3>& centroid, const std::vector<std::uint32_t>& order) {
+    double sum = 0;
+    for (std::size_t i = 1; i < order.size(); ++i) sum += std::sqrt(length_squared(centroid[order[i]] - centroid[order[i - 1]]));
+    return sum / static_cast<double>(order.size() - 1);
+}
+
+TEST(SpatialOrder, IsAPermutationThatKeepsNeighboursTogether) {
+    const TetMesh mesh = shuffled_block(24, 3);
+    std::vector<vec3> positions;
+    for (std::size_t v = 0; v < mesh.num_vertices(); ++v)
+        positions.push_back(make_vec3(static_cast<float>(mesh.positions[3 * v]), static_cast<float>(mesh.positions[3 * v + 1]),
+                                      static_cast<float>(mesh.positions[3 * v + 2])));
+    const std::vector<std::uint32_t> order = spatial_tet_order(positions.data(), mesh.tets.data(), mesh.num_tets());
+    std::vector<std::uint32_t> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<std::uint32_t> identity(mesh.num_tets());
+    std::iota(identity.begin(), identity.end(), 0u);
+    ASSERT_EQ(sorted, identity);
+
+    std::vector<vec3> centroid(mesh.num_tets());
+    for (std::size_t t = 0; t < mesh.num_tets(); ++t) {
+        const std::uint32_t* v = &mesh.tets[4 * t];
+        centroid[t] = (positions[v[0]] + positions[v[1]] + positions[v[2]] + positions[v[3]]) * 0.25f;
+    }
+    // Shuffled: consecutive tets are about a third of the block apart; a Morton order walks cube by cube.
+    EXPECT_GT(mean_step(centroid, identity), 7.0);
+    EXPECT_LT(mean_step(centroid, order), 1.6);
+}
+
+TEST(SpatialOrder, HandlesEmptyAndFlatInput) {
+    EXPECT_TRUE(spatial_tet_order(nullptr, nullptr, 0).empty());
+    const std::vector<vec3> same(4, make_vec3(1, 1, 1));
+    const std::vector<std::uint32_t> tets = {0, 1, 2, 3, 3, 2, 1, 0};
+    EXPECT_EQ(spatial_tet_order(same.data(), tets.data(), 2), (std::vector<std::uint32_t>{0, 1}));
+}
+
+/// The caller's tets of one object as the pipeline sees them (float32).
+std::vector<std::array<vec3, 4>> float_tets(const TetMesh& mesh) {
+    std::vector<std::array<vec3, 4>> out(mesh.num_tets());
+    for (std::size_t t = 0; t < mesh.num_tets(); ++t)
+        for (int k = 0; k < 4; ++k) {
+            const double* p = &mesh.positions[3 * mesh.tets[4 * t + k]];
+            out[t][k] = make_vec3(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
+        }
+    return out;
+}
+
+TEST(SpatialOrder, PairsFlagsAndContactsUseTheCallersNumbering) {
+    // Oracle without the detector: every pair of the caller's tets, in the caller's order.
+    const TetMesh a = test::random_soup(700, 2.0, 1.0, 81), b = test::random_soup(700, 2.0, 1.0, 82);
+    const auto ta = float_tets(a), tb = float_tets(b);
+    std::vector<TetPair> expected;
+    std::vector<Contact> expected_contacts;
+    for (std::uint32_t i = 0; i < ta.size(); ++i)
+        for (std::uint32_t j = 0; j < tb.size(); ++j) {
+            if (!boxes_overlap(tet_box(ta[i].data()), tet_box(tb[j].data())) ||
+                !tets_intersect(NarrowPhase::sat, ta[i].data(), tb[j].data()))
+                continue;
+            expected.push_back(TetPair{0, i, 1, j});
+            float depth = 0;
+            vec3 direction{};
+            tets_intersect_sat_mtv(ta[i].data(), tb[j].data(), depth, direction);
+            expected_contacts.push_back(Contact{depth, {direction.x, direction.y, direction.z}});
+        }
+    ASSERT_GT(expected.size(), 20u);
+
+    for (Method method : {Method::kdet, Method::brute_force_loop}) {
+        DetectorOptions options;
+        options.method = method;
+        options.contacts = true;
+        Detector detector(options);
+        detector.add_object(a);
+        detector.add_object(b);
+        const FrameResult& r = detector.detect();
+        EXPECT_EQ(r.pairs, expected) << to_string(method);
+        ASSERT_EQ(r.contacts.size(), expected_contacts.size());
+        for (std::size_t k = 0; k < expected_contacts.size(); ++k) {
+            EXPECT_EQ(r.contacts[k].depth, expected_contacts[k].depth);
+            for (int c = 0; c < 3; ++c) EXPECT_EQ(r.contacts[k].direction[c], expected_contacts[k].direction[c]);
+        }
+        for (const TetPair& p : expected) {
+            EXPECT_EQ(r.colliding[0][p.tet_a], 1);
+            EXPECT_EQ(r.colliding[1][p.tet_b], 1);
+        }
+        EXPECT_EQ(r.counts.colliding_tets,
+                  static_cast<std::uint64_t>(std::count(r.colliding[0].begin(), r.colliding[0].end(), 1) +
+                                             std::count(r.colliding[1].begin(), r.colliding[1].end(), 1)));
+        const DeviceResults device = detector.device_results();
+        ASSERT_EQ(device.pair_count, expected.size());
+        for (std::size_t k = 0; k < expected.size(); ++k)
+            EXPECT_EQ(device.pair_keys[k], (std::uint64_t{expected[k].tet_a} << 32) |
+                                               (detector.first_tet(1) + expected[k].tet_b));
+    }
+}
+
+TEST(Detector, AFailedAddLeavesTheDetectorAsItWas) {
+    Detector detector;
+    const TetMesh a = test::random_soup(50, 1.0, 1.0, 91);
+    detector.add_object(a);
+    TetMesh bad = a;
+    bad.positions[7] = std::nan("");
+    EXPECT_THROW(detector.add_object(bad), Error);
+    EXPECT_EQ(detector.object_count(), 1u);
+    detector.set_self_collision(0, true);
+    EXPECT_NO_THROW(detector.detect());
+}
+
+} // namespace
+} // namespace kdet
