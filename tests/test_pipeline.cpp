@@ -197,6 +197,38 @@ TEST(Detector, SeparatedObjectsSkipEverythingAfterTheBoxCheck) {
     EXPECT_EQ(r.times.populate_grid, 0.0);
 }
 
+/// Unit tets with their lowest corner at the given (x, y) points, z = 0.
+TetMesh corner_tets(std::initializer_list<std::pair<double, double>> corners) {
+    TetMesh mesh;
+    for (const auto& [x, y] : corners) {
+        const double p[4][3] = {{x, y, 0}, {x + 1, y, 0}, {x, y + 1, 0}, {x, y, 1}};
+        const auto v = static_cast<std::uint32_t>(mesh.num_vertices());
+        for (const auto& q : p) mesh.positions.insert(mesh.positions.end(), q, q + 3);
+        for (std::uint32_t k = 0; k < 4; ++k) mesh.tets.push_back(v + k);
+    }
+    return mesh;
+}
+
+TEST(Detector, OverlappingObjectBoxesWithNoTetInTheOverlapSkipTheGrid) {
+    // Each object's box overlaps the other's, yet none of its tets reaches into the other's box.
+    const TetMesh a = corner_tets({{0, 10}, {10, 0}}), b = corner_tets({{-10, 5}, {5, -10}});
+    for (Method method : {Method::kdet, Method::kdet_no_pairs}) {
+        Detector detector(with_method(method));
+        detector.add_object(a);
+        detector.add_object(b);
+        const FrameResult& r = detector.detect();
+        EXPECT_TRUE(r.pairs.empty());
+        EXPECT_EQ(r.counts.colliding_tets, 0u);
+        EXPECT_EQ(r.counts.candidates, 0u);
+        EXPECT_EQ(r.times.populate_grid, 0.0);
+    }
+    // Moving b onto a makes its tets relevant again, and the grid finds the pairs.
+    Detector detector;
+    detector.add_object(a);
+    detector.add_object(corner_tets({{0.5, 10.5}, {5, -10}}));
+    EXPECT_EQ(detector.detect().pairs, (std::vector<TetPair>{{0, 0, 1, 0}}));
+}
+
 TEST(Detector, OneOffFunctionsReturnFileOrderIndices) {
     const TetMesh a = random_soup(400, 2.0, 1.0, 61), b = random_soup(400, 2.0, 1.0, 62);
     const auto pairs = collide(a, b);

@@ -20,14 +20,13 @@ struct TetIndices {
 /// @brief Per-tet data recomputed every frame.
 struct TetInfo {
     Aabb box;
-    float diameter;     ///< of the minimum enclosing sphere
+    float diameter;     ///< of the minimum enclosing sphere; computed for relevant tets only (TetSizeKernel)
     std::int32_t layer; ///< grid layer, or -1 when the tet cannot collide with anything enabled
 };
 
-/// @brief Box and size range of one object, as order-preserving integers so threads can merge them atomically.
-struct ObjectStats {
+/// @brief Box of one object, as order-preserving integers so threads can merge boxes atomically.
+struct ObjectBounds {
     std::uint32_t lo[3], hi[3];
-    std::uint32_t min_diameter, max_diameter;
 };
 
 /// @brief All objects' geometry, concatenated; tets of one object are contiguous.
@@ -78,32 +77,30 @@ KDET_HD inline bool tets_collide(const SceneView& s, NarrowPhase test, std::uint
     return tets_intersect(test, a, b);
 }
 
-/// @brief Stage 1: box and size of each tet.
+/// @brief Stage 1: box of each tet; no size and no layer yet.
 struct TetBoundsKernel {
     SceneView scene;
     KDET_HD void operator()(std::uint64_t t) const {
         vec3 v[4];
         load_tet(scene, static_cast<std::uint32_t>(t), v);
-        scene.info[t] = TetInfo{tet_box(v), enclosing_sphere_diameter(v), -1};
+        scene.info[t] = TetInfo{tet_box(v), 0.0f, -1};
     }
 };
 
-/// @brief Stage 1: merges tet boxes and sizes into their objects' stats, one chunk of tets per item
-/// so that threads rarely contend on the same object.
-struct ObjectStatsKernel {
+/// @brief Stage 1: merges tet boxes into their objects' boxes, one chunk of tets per item so that
+/// threads rarely contend on the same object.
+struct ObjectBoundsKernel {
     SceneView scene;
-    ObjectStats* stats;
+    ObjectBounds* bounds;
     std::uint32_t chunk;
 
-    KDET_HD static void flush(ObjectStats& target, const Aabb& box, float dmin, float dmax) {
+    KDET_HD static void flush(ObjectBounds& target, const Aabb& box) {
         atomic_min(&target.lo[0], float_to_ordered(box.lo.x));
         atomic_min(&target.lo[1], float_to_ordered(box.lo.y));
         atomic_min(&target.lo[2], float_to_ordered(box.lo.z));
         atomic_max(&target.hi[0], float_to_ordered(box.hi.x));
         atomic_max(&target.hi[1], float_to_ordered(box.hi.y));
         atomic_max(&target.hi[2], float_to_ordered(box.hi.z));
-        atomic_min(&target.min_diameter, float_to_ordered(dmin));
-        atomic_max(&target.max_diameter, float_to_ordered(dmax));
     }
 
     KDET_HD void operator()(std::uint64_t c) const {
@@ -111,32 +108,28 @@ struct ObjectStatsKernel {
         const std::uint64_t end = begin + chunk < scene.tet_count ? begin + chunk : scene.tet_count;
         std::uint32_t object = scene.tet_object[begin];
         Aabb box = scene.info[begin].box;
-        float dmin = scene.info[begin].diameter, dmax = dmin;
         for (std::uint64_t t = begin + 1; t < end; ++t) {
-            const TetInfo& info = scene.info[t];
+            const Aabb& tet_box = scene.info[t].box;
             if (scene.tet_object[t] != object) {
-                flush(stats[object], box, dmin, dmax);
+                flush(bounds[object], box);
                 object = scene.tet_object[t];
-                box = info.box;
-                dmin = dmax = info.diameter;
+                box = tet_box;
                 continue;
             }
-            box = Aabb{min_v(box.lo, info.box.lo), max_v(box.hi, info.box.hi)};
-            dmin = min_f(dmin, info.diameter);
-            dmax = max_f(dmax, info.diameter);
+            box = Aabb{min_v(box.lo, tet_box.lo), max_v(box.hi, tet_box.hi)};
         }
-        flush(stats[object], box, dmin, dmax);
+        flush(bounds[object], box);
     }
 };
 
-/// @brief Stage 2: picks each relevant tet's layer and inserts it into every cell its box overlaps.
+/// @brief Stage 1, grid methods only: sizes the relevant tets and keeps the range of their sizes.
 /// A tet is relevant when its object's self-collision is on, or when its box overlaps another object
-/// it is checked against (inter-object culling: only tets in the overlap region enter the grid).
-struct PopulateKernel {
+/// it is checked against (inter-object culling: only tets in the overlap region are sized and gridded).
+/// A relevant tet gets layer 0 until populate picks its layer; the others keep -1.
+struct TetSizeKernel {
     SceneView scene;
-    GridView grid;
-    GridParams params;
-    std::uint32_t* layer_mask;
+    std::uint32_t* min_size; ///< float_to_ordered
+    std::uint32_t* max_size;
 
     KDET_HD bool relevant(std::uint32_t object, const Aabb& box) const {
         if (pair_is_active(scene, object, object)) return true;
@@ -148,10 +141,28 @@ struct PopulateKernel {
 
     KDET_HD void operator()(std::uint64_t t) const {
         TetInfo& info = scene.info[t];
-        if (!relevant(scene.tet_object[t], info.box)) {
-            info.layer = -1;
-            return;
-        }
+        if (!relevant(scene.tet_object[t], info.box)) return;
+        vec3 v[4];
+        load_tet(scene, static_cast<std::uint32_t>(t), v);
+        info.diameter = enclosing_sphere_diameter(v);
+        info.layer = 0;
+        // Reading first keeps the atomics few: after the first tets, almost none widens the range.
+        const std::uint32_t size = float_to_ordered(info.diameter);
+        if (size < atomic_load_acquire(min_size)) atomic_min(min_size, size);
+        if (size > atomic_load_acquire(max_size)) atomic_max(max_size, size);
+    }
+};
+
+/// @brief Stage 2: picks each relevant tet's layer and inserts it into every cell its box overlaps.
+struct PopulateKernel {
+    SceneView scene;
+    GridView grid;
+    GridParams params;
+    std::uint32_t* layer_mask;
+
+    KDET_HD void operator()(std::uint64_t t) const {
+        TetInfo& info = scene.info[t];
+        if (info.layer < 0) return;
         const int layer = layer_of(params, info.diameter);
         info.layer = layer;
         const std::uint32_t bit = 1u << layer;

@@ -22,7 +22,8 @@ struct FrameCounters {
     std::uint32_t layer_mask;
     std::uint32_t non_finite;
     std::uint32_t cells_claimed;
-    std::uint32_t unused;
+    std::uint32_t min_size; ///< float_to_ordered, over the relevant tets
+    std::uint32_t max_size;
 };
 
 template <class Exec>
@@ -54,7 +55,7 @@ public:
         colliding_.resize_discard(tets);
         user_colliding_.resize_discard(tets);
         const std::size_t objects = topology.object_tet_begin.size() - 1;
-        stats_.resize_discard(objects);
+        bounds_.resize_discard(objects);
         object_boxes_.resize_discard(objects);
         pair_active_.resize_discard(objects * objects);
     }
@@ -83,7 +84,7 @@ public:
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
                user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() +
                info_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
-               stats_.capacity_bytes() + object_boxes_.capacity_bytes() + pair_active_.capacity_bytes() +
+               bounds_.capacity_bytes() + object_boxes_.capacity_bytes() + pair_active_.capacity_bytes() +
                headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + hit_.capacity_bytes() + position_.capacity_bytes() +
                out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
@@ -98,7 +99,7 @@ private:
     SceneView scene_view() {
         return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), pair_active_.data(),
                          object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
-                         static_cast<std::uint32_t>(stats_.size())};
+                         static_cast<std::uint32_t>(bounds_.size())};
     }
     template <class T>
     void fill(buffer<T>& b, T value) {
@@ -116,6 +117,7 @@ private:
     }
 
     bool compute_bounds_and_culling(const std::vector<std::uint8_t>& pair_enabled);
+    bool size_relevant_tets();
     GridView populate(FrameCounts& counts);
     template <class Launch>
     void append_candidates_growing(const Launch& launch, FrameCounts& counts);
@@ -134,6 +136,7 @@ private:
     GridParams params_{};
     std::uint32_t stamp_ = 0;
     std::size_t relevant_estimate_ = 0;
+    vec3 grid_origin_{};
 
     buffer<TetIndices> tets_;
     buffer<std::uint32_t> tet_object_;
@@ -144,7 +147,7 @@ private:
     buffer<TetInfo> info_;
     buffer<std::uint32_t> colliding_;      ///< per stored tet
     buffer<std::uint32_t> user_colliding_; ///< per tet in the caller's numbering
-    buffer<ObjectStats> stats_;
+    buffer<ObjectBounds> bounds_;
     buffer<Aabb> object_boxes_;
     buffer<std::uint8_t> pair_active_;
     buffer<BucketHeader> headers_;
@@ -166,31 +169,28 @@ private:
 /// @brief Stage 1. Returns false when no enabled pair of objects can collide this frame.
 template <class Exec>
 bool Pipeline<Exec>::compute_bounds_and_culling(const std::vector<std::uint8_t>& pair_enabled) {
-    const std::size_t objects = stats_.size();
+    const std::size_t objects = bounds_.size();
     const std::uint32_t tets = static_cast<std::uint32_t>(tets_.size());
     SceneView scene = scene_view();
     exec_.for_each(tets, TetBoundsKernel{scene});
 
-    std::vector<ObjectStats> stats(objects);
-    for (auto& s : stats) {
+    std::vector<ObjectBounds> bounds(objects);
+    for (auto& b : bounds)
         for (int a = 0; a < 3; ++a) {
-            s.lo[a] = float_to_ordered(std::numeric_limits<float>::infinity());
-            s.hi[a] = float_to_ordered(-std::numeric_limits<float>::infinity());
+            b.lo[a] = float_to_ordered(std::numeric_limits<float>::infinity());
+            b.hi[a] = float_to_ordered(-std::numeric_limits<float>::infinity());
         }
-        s.min_diameter = float_to_ordered(std::numeric_limits<float>::infinity());
-        s.max_diameter = float_to_ordered(0.0f);
-    }
-    exec_.upload(stats_.data(), stats.data(), objects);
+    exec_.upload(bounds_.data(), bounds.data(), objects);
     constexpr std::uint32_t chunk = 256;
-    exec_.for_each((tets + chunk - 1) / chunk, ObjectStatsKernel{scene, stats_.data(), chunk});
-    exec_.download(stats.data(), stats_.data(), objects);
+    exec_.for_each((tets + chunk - 1) / chunk, ObjectBoundsKernel{scene, bounds_.data(), chunk});
+    exec_.download(bounds.data(), bounds_.data(), objects);
 
     std::vector<Aabb> boxes(objects);
     for (std::size_t o = 0; o < objects; ++o)
-        boxes[o] = Aabb{{ordered_to_float(stats[o].lo[0]), ordered_to_float(stats[o].lo[1]),
-                         ordered_to_float(stats[o].lo[2])},
-                        {ordered_to_float(stats[o].hi[0]), ordered_to_float(stats[o].hi[1]),
-                         ordered_to_float(stats[o].hi[2])}};
+        boxes[o] = Aabb{{ordered_to_float(bounds[o].lo[0]), ordered_to_float(bounds[o].lo[1]),
+                         ordered_to_float(bounds[o].lo[2])},
+                        {ordered_to_float(bounds[o].hi[0]), ordered_to_float(bounds[o].hi[1]),
+                         ordered_to_float(bounds[o].hi[2])}};
 
     // Object-level culling: a pair of objects is only checked when their boxes overlap.
     std::vector<std::uint8_t> active(objects * objects, 0);
@@ -208,25 +208,41 @@ bool Pipeline<Exec>::compute_bounds_and_culling(const std::vector<std::uint8_t>&
     exec_.upload(object_boxes_.data(), boxes.data(), objects);
     if (!any) return false;
 
-    // Grid geometry: c0 is the smallest size among the objects that take part, so the smallest tets
-    // sit on layer 0; enough layers to hold the largest tets, capped at max_grid_layers.
-    vec3 origin{std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
-                std::numeric_limits<float>::infinity()};
-    float dmin = std::numeric_limits<float>::infinity(), dmax = 0.0f;
+    const float inf = std::numeric_limits<float>::infinity();
+    grid_origin_ = vec3{inf, inf, inf};
     relevant_estimate_ = 0;
     for (std::size_t o = 0; o < objects; ++o) {
         if (!involved[o]) continue;
-        origin = min_v(origin, boxes[o].lo);
-        dmin = std::min(dmin, ordered_to_float(stats[o].min_diameter));
-        dmax = std::max(dmax, ordered_to_float(stats[o].max_diameter));
+        grid_origin_ = min_v(grid_origin_, boxes[o].lo);
         relevant_estimate_ += topology_.object_tet_begin[o + 1] - topology_.object_tet_begin[o];
     }
+    return true;
+}
+
+/// @brief Stage 1, grid methods only: sizes the relevant tets and picks the grid's geometry from
+/// them. Returns false when no tet is relevant (the objects' boxes overlap, but no tet reaches
+/// into the other object's box).
+template <class Exec>
+bool Pipeline<Exec>::size_relevant_tets() {
+    FrameCounters start{};
+    start.min_size = float_to_ordered(std::numeric_limits<float>::infinity());
+    start.max_size = float_to_ordered(0.0f);
+    counters_.resize_discard(1);
+    exec_.upload(counters_.data(), &start, 1);
+    FrameCounters* c = counters_.data();
+    exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size});
+    const FrameCounters sizes = read_counters();
+    if (sizes.min_size == start.min_size) return false;
+
+    // c0 is the smallest size among the gridded tets, so the smallest sit on layer 0; enough layers
+    // to hold the largest, capped at max_grid_layers.
+    const float dmin = ordered_to_float(sizes.min_size), dmax = ordered_to_float(sizes.max_size);
     // Zero-size tets (allowed only when the caller asked for degenerate input) must not make c0 zero.
     const float floor_size = std::max(dmax * 1e-6f, std::numeric_limits<float>::min() * 1e6f);
     const float c0 = std::max(dmin, floor_size);
     int layers = 1;
     while (layers < max_grid_layers && std::ldexp(c0, layers - 1) < dmax) ++layers;
-    params_ = GridParams{origin, c0, 1.0f / c0, layers};
+    params_ = GridParams{grid_origin_, c0, 1.0f / c0, layers};
     return true;
 }
 
@@ -310,7 +326,7 @@ void Pipeline<Exec>::find_candidates(const GridView& grid, FrameCounts& counts) 
 /// @brief Both brute-force methods: every pair of enabled objects is tested, colliding pairs appended.
 template <class Exec>
 void Pipeline<Exec>::brute_force(FrameCounts& counts) {
-    const std::size_t objects = stats_.size();
+    const std::size_t objects = bounds_.size();
     std::vector<std::uint8_t> active(objects * objects);
     exec_.download(active.data(), pair_active_.data(), active.size());
     std::vector<std::uint64_t> block_begin{0};
@@ -391,7 +407,7 @@ void Pipeline<Exec>::count_and_copy_flags(FrameResult& result) {
     exec_.for_each(tets, UserFlagsKernel{stored_id_.data(), colliding_.data(), user_colliding_.data()});
     position_.resize_discard(tets);
     result.counts.colliding_tets = exec_.exclusive_scan(user_colliding_.data(), position_.data(), tets);
-    const std::size_t objects = stats_.size();
+    const std::size_t objects = bounds_.size();
     result.colliding.resize(options_.results_to_host ? objects : 0);
     if (!options_.results_to_host) return;
     std::vector<std::uint32_t> flags(tets);
@@ -416,13 +432,15 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
 
     stage.start();
     fill(colliding_, 0u);
-    const bool any = tets_.size() > 0 && compute_bounds_and_culling(pair_enabled);
+    const Method method = options_.method;
+    const bool grid_method = method == Method::kdet || method == Method::kdet_no_pairs;
+    const bool any =
+        tets_.size() > 0 && compute_bounds_and_culling(pair_enabled) && (!grid_method || size_relevant_tets());
     result.times.bounding_boxes = stage.stop_ms();
 
     if (any) {
-        const Method method = options_.method;
         std::size_t unique = 0;
-        if (method == Method::kdet || method == Method::kdet_no_pairs) {
+        if (grid_method) {
             stage.start();
             const GridView grid = populate(counts);
             result.times.populate_grid = stage.stop_ms();
