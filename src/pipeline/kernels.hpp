@@ -220,9 +220,29 @@ struct KeyAppender {
     std::uint64_t* keys;
     std::uint64_t capacity;
     unsigned long long* count;
-    KDET_HD void push(std::uint64_t key) const {
-        const unsigned long long index = atomic_fetch_add(count, 1ull);
-        if (index < capacity) keys[index] = key;
+    KDET_HD void push(std::uint64_t key) const { write(&key, 1); }
+    KDET_HD void write(const std::uint64_t* batch, std::uint32_t n) const {
+        const unsigned long long first = atomic_fetch_add(count, static_cast<unsigned long long>(n));
+        for (std::uint32_t k = 0; k < n; ++k)
+            if (first + k < capacity) keys[first + k] = batch[k];
+    }
+};
+
+/// @brief One work item's keys, handed to a KeyAppender a batch at a time: one atomic per batch
+/// instead of one per key, which matters when many threads append at once.
+struct KeyBatch {
+    static constexpr std::uint32_t size = 16;
+    const KeyAppender* out;
+    std::uint64_t keys[size];
+    std::uint32_t n = 0;
+    KDET_HD explicit KeyBatch(const KeyAppender* appender) : out(appender) {}
+    KDET_HD void push(std::uint64_t key) {
+        keys[n++] = key;
+        if (n == size) flush();
+    }
+    KDET_HD void flush() {
+        if (n) out->write(keys, n);
+        n = 0;
     }
 };
 
@@ -236,20 +256,22 @@ struct FindCandidatesKernel {
 
     struct Emit {
         const SceneView* scene;
-        const KeyAppender* out;
+        KeyBatch* batch;
         std::uint32_t t;
         TetIndices tet;
         std::uint32_t object;
         KDET_HD void operator()(std::uint32_t u) const {
             if (scene->tet_object[u] == object && share_vertex(tet, scene->tets[u])) return;
-            out->push(pair_key(t, u));
+            batch->push(pair_key(t, u));
         }
     };
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto t = static_cast<std::uint32_t>(i);
-        Emit emit{&scene, &out, t, scene.tets[t], scene.tet_object[t]};
+        KeyBatch batch(&out);
+        Emit emit{&scene, &batch, t, scene.tets[t], scene.tet_object[t]};
         for_each_larger_neighbour(scene, grid, params, layer_mask, t, emit);
+        batch.flush();
     }
 };
 
@@ -296,12 +318,14 @@ struct BruteForceLoopKernel {
     KDET_HD void operator()(std::uint64_t i) const {
         const auto t = static_cast<std::uint32_t>(i);
         const std::uint32_t object = scene.tet_object[t];
+        KeyBatch batch(&out);
         for (std::uint32_t other = object; other < scene.object_count; ++other) {
             if (!pair_is_active(scene, object, other)) continue;
             const std::uint32_t begin = other == object ? t + 1 : object_tet_begin[other];
             for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u)
-                if (tets_collide(scene, test, t, u)) out.push(pair_key(t, u));
+                if (tets_collide(scene, test, t, u)) batch.push(pair_key(t, u));
         }
+        batch.flush();
     }
 };
 
