@@ -175,24 +175,43 @@ struct PopulateKernel {
     }
 };
 
-/// @brief Calls visit(u) for every tet u that tet t must test: u is stored in a cell that t's box
-/// overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
+/// @brief Calls visit(u) once for every tet u that tet t must test: u is stored in a cell that t's
+/// box overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
 /// higher id, so each direction of a pair is found by one tet only), the objects are checked against
 /// each other, and the boxes overlap. Adjacency and the narrow phase are left to the caller.
+///
+/// A pair shares every cell that both boxes overlap; it is reported from one of them only, the cell
+/// holding the lower corner of the boxes' intersection. That corner is max(t.lo, u.lo) per axis, and
+/// cell indices are monotone, so its cell is max(t's first cell, u's first cell): inside both ranges,
+/// hence always visited. No duplicates are written, so the candidate buffer holds unique pairs.
 template <class Visitor>
 struct LargerNeighbourFilter {
     const SceneView* scene;
+    const GridParams* params;
     std::uint32_t t;
     std::uint32_t object;
-    bool same_layer; ///< visiting t's own layer: every id there is on t's layer
     Aabb box;
     Visitor* visit;
+    int layer;                 ///< layer being visited
+    bool same_layer;           ///< visiting t's own layer: every id there is on t's layer
+    std::uint32_t first[3];    ///< t's first cell per axis on this layer
+    std::uint32_t cell[3];     ///< cell being visited (not wrapped)
+
+    KDET_HD bool reports_from_this_cell(const Aabb& other) const {
+        const float lo[3] = {other.lo.x, other.lo.y, other.lo.z};
+        const float origin[3] = {params->origin.x, params->origin.y, params->origin.z};
+        for (int a = 0; a < 3; ++a)
+            if (cell[a] != first[a] && cell_index(*params, lo[a], origin[a], layer) != cell[a]) return false;
+        return true;
+    }
 
     KDET_HD void operator()(std::uint32_t u) const {
         // A cell holds only tets of its own layer, so the tie-break needs no load of u's data.
         if (same_layer && u <= t) return;
         if (!pair_is_active(*scene, object, scene->tet_object[u])) return;
-        if (!boxes_overlap(box, scene->info[u].box)) return;
+        const Aabb& other = scene->info[u].box;
+        if (!boxes_overlap(box, other)) return;
+        if (!reports_from_this_cell(other)) return;
         (*visit)(u);
     }
 };
@@ -202,15 +221,21 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
                                              std::uint32_t layer_mask, std::uint32_t t, Visitor& visit) {
     const TetInfo self = scene.info[t];
     if (self.layer < 0) return;
-    LargerNeighbourFilter<Visitor> filter{&scene, t, scene.tet_object[t], true, self.box, &visit};
+    LargerNeighbourFilter<Visitor> filter{&scene, &params, t, scene.tet_object[t], self.box, &visit, 0, true, {}, {}};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
+        filter.layer = layer;
         filter.same_layer = layer == self.layer;
         const CellRange r = cell_range(params, self.box, layer);
+        for (int a = 0; a < 3; ++a) filter.first[a] = r.lo[a];
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
-                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
+                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
+                    filter.cell[0] = x;
+                    filter.cell[1] = y;
+                    filter.cell[2] = z;
                     grid_for_each_in_cell(grid, make_cell(x, y, z, layer), filter);
+                }
     }
 }
 
