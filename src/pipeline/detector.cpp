@@ -236,11 +236,11 @@ std::vector<IndexPair> collide_self(const TetMesh& mesh, const DetectorOptions& 
     return to_index_pairs(detector.detect());
 }
 
+const char* git_commit(); // generated at build time by cmake/write_commit.cmake
+
 std::string version() {
-#ifdef KDET_GIT_COMMIT
-    const std::string commit = KDET_GIT_COMMIT;
+    const std::string commit = git_commit();
     if (!commit.empty()) return std::string(KDET_VERSION_STRING) + " (" + commit + ")";
-#endif
     return KDET_VERSION_STRING;
 }
 
