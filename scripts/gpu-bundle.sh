@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Packs what the GPU checks of the CUDA backend need on the `device` machine, which has the CUDA
+# toolkit and CMake but none of kdet's other dependencies and no network: the CUDA build for sm_90
+# (made here), the shared libraries it needs beyond the C/C++ runtimes, the models and the prepared
+# meshes of the thesis scenes. The bundle is a git-ignored folder that the device tool carries.
+#
+# usage: scripts/gpu-bundle.sh            builds build-gpu/ and fills .gpu-bundle/
+# then, with the device tool, one call per part:
+#   run(command="bash scripts/gpu-session.sh checks", carry=[".gpu-bundle"]), then matrix, then scaling
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+bundle="$repo/.gpu-bundle"
+build="${KDET_GPU_BUILD:-$repo/build-gpu}"
+data_dir="${KDET_DATA_DIR:-$repo/../shared/models}"
+cache_dir="${KDET_CACHE_DIR:-$HOME/.cache/kdet}"
+
+exclude="$(git -C "$repo" rev-parse --absolute-git-dir)/info/exclude"
+mkdir -p "$(dirname "$exclude")"
+grep -qx '/.gpu-bundle/' "$exclude" 2>/dev/null || echo '/.gpu-bundle/' >>"$exclude"
+cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKDET_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 >/dev/null
+cmake --build "$build" -j"$(nproc)" --target kdet_cli kdet_tests
+
+# The thesis scenes read their models and prepared meshes; prepare any that are missing.
+KDET_DATA_DIR="$data_dir" KDET_CACHE_DIR="$cache_dir" "$build/kdet" prepare >/dev/null
+
+rm -rf "$bundle"
+mkdir -p "$bundle/lib"
+cp "$build/kdet" "$build/tests/kdet_tests" "$bundle/"
+# Libraries beyond glibc (and its libdl, libpthread, librt), libstdc++, libgcc and libgomp, which the device image has.
+for program in "$bundle/kdet" "$bundle/kdet_tests"; do
+  ldd "$program" | awk '/=> \//{print $3}' | grep -Ev '/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|libgomp|ld-linux[^/]*)\.so' |
+    xargs -r cp -Ln -t "$bundle/lib/"
+done
+tar -C "$data_dir" -cJf "$bundle/models.tar.xz" .
+tar -C "$cache_dir" -cJf "$bundle/cache.tar.xz" .
+du -sh "$bundle"
