@@ -200,6 +200,25 @@ TEST(Detector, SeparatedObjectsSkipEverythingAfterTheBoxCheck) {
     EXPECT_EQ(r.times.populate_grid, 0.0);
 }
 
+TEST(Detector, FlagsClearWhenObjectsSeparateAfterColliding) {
+    const TetMesh a = random_soup(500, 1.0, 1.0, 53);
+    const TetMesh near = moved(a, 0.3, 0.05, 0.0, 0.0), far = moved(a, 0.3, 5.0, 0.0, 0.0);
+    for (Method method : {Method::kdet, Method::kdet_no_pairs, Method::brute_force_loop}) {
+        Detector detector(with_method(method));
+        detector.add_object(a);
+        const ObjectId b = detector.add_object(near);
+        ASSERT_GT(detector.detect().counts.colliding_tets, 0u) << to_string(method);
+        detector.set_positions(b, far.positions.data(), far.num_vertices());
+        const FrameResult& r = detector.detect();
+        EXPECT_EQ(r.counts.colliding_tets, 0u);
+        for (const auto& flags : r.colliding) EXPECT_EQ(std::count(flags.begin(), flags.end(), 1), 0);
+        const DeviceResults device = detector.device_results();
+        EXPECT_EQ(std::count_if(device.colliding, device.colliding + device.tet_count,
+                                [](std::uint32_t f) { return f != 0; }),
+                  0);
+    }
+}
+
 /// Unit tets with their lowest corner at the given (x, y) points, z = 0.
 TetMesh corner_tets(std::initializer_list<std::pair<double, double>> corners) {
     TetMesh mesh;

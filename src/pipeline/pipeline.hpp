@@ -54,6 +54,7 @@ public:
         info_.resize_discard(tets);
         colliding_.resize_discard(tets);
         user_colliding_.resize_discard(tets);
+        user_flags_set_ = true; // new memory: unknown until cleared
         const std::size_t objects = topology.object_tet_begin.size() - 1;
         bounds_.resize_discard(objects);
         object_boxes_.resize_discard(objects);
@@ -124,7 +125,7 @@ private:
     void find_candidates(const GridView& grid, FrameCounts& counts);
     void brute_force(FrameCounts& counts);
     void narrow_phase_and_compact(std::size_t unique, FrameResult& result);
-    void count_and_copy_flags(FrameResult& result);
+    void count_and_copy_flags(bool any, FrameResult& result);
     KeyAppender candidate_appender() {
         return KeyAppender{candidates_.data(), candidates_.size(), &counters_.data()->candidates};
     }
@@ -164,6 +165,7 @@ private:
     std::uint32_t overflow_capacity_ = 0;
     std::uint32_t layer_mask_ = 0;
     std::size_t colliding_count_ = 0; ///< pairs in out_keys_ after the last detection
+    bool user_flags_set_ = true;      ///< user_colliding_ may hold a nonzero flag
 };
 
 /// @brief Stage 1. Returns false when no enabled pair of objects can collide this frame.
@@ -400,15 +402,25 @@ void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& r
 }
 
 /// @brief Stage 6: the per-tet flags in the caller's numbering, counted (a scan of the 0/1 flags)
-/// and, when results go to the host, copied.
+/// and, when results go to the host, copied. A frame where nothing can collide (`any` false) needs
+/// no pass over the tets: its flags are all zero, and the backend's are cleared only if they were set.
 template <class Exec>
-void Pipeline<Exec>::count_and_copy_flags(FrameResult& result) {
+void Pipeline<Exec>::count_and_copy_flags(bool any, FrameResult& result) {
     const std::size_t tets = tets_.size();
+    const std::size_t objects = bounds_.size();
+    result.colliding.resize(options_.results_to_host ? objects : 0);
+    if (!any) {
+        if (user_flags_set_) fill(user_colliding_, 0u);
+        user_flags_set_ = false;
+        result.counts.colliding_tets = 0;
+        for (std::size_t o = 0; o < result.colliding.size(); ++o)
+            result.colliding[o].assign(topology_.object_tet_begin[o + 1] - topology_.object_tet_begin[o], 0);
+        return;
+    }
     exec_.for_each(tets, UserFlagsKernel{stored_id_.data(), colliding_.data(), user_colliding_.data()});
     position_.resize_discard(tets);
     result.counts.colliding_tets = exec_.exclusive_scan(user_colliding_.data(), position_.data(), tets);
-    const std::size_t objects = bounds_.size();
-    result.colliding.resize(options_.results_to_host ? objects : 0);
+    user_flags_set_ = result.counts.colliding_tets > 0;
     if (!options_.results_to_host) return;
     std::vector<std::uint32_t> flags(tets);
     exec_.download(flags.data(), user_colliding_.data(), tets);
@@ -431,11 +443,11 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
     colliding_count_ = 0;
 
     stage.start();
-    fill(colliding_, 0u);
     const Method method = options_.method;
     const bool grid_method = method == Method::kdet || method == Method::kdet_no_pairs;
     const bool any =
         tets_.size() > 0 && compute_bounds_and_culling(pair_enabled) && (!grid_method || size_relevant_tets());
+    if (any) fill(colliding_, 0u);
     result.times.bounding_boxes = stage.stop_ms();
 
     if (any) {
@@ -471,7 +483,7 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
         }
     }
 
-    count_and_copy_flags(result);
+    count_and_copy_flags(any, result);
     result.memory_bytes = memory_bytes();
     result.grid_bytes = headers_.capacity_bytes() + ids_.capacity_bytes();
     result.candidate_bytes = candidates_.capacity_bytes();
