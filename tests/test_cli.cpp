@@ -25,8 +25,8 @@ struct Outcome {
     std::string out; // stdout and stderr together
 };
 
-Outcome kdet_cli(const std::string& arguments) {
-    const std::string command = std::string(KDET_CLI_PATH) + " " + arguments + " 2>&1";
+Outcome run_command(const std::string& command_line) {
+    const std::string command = command_line + " 2>&1";
     FILE* pipe = popen(command.c_str(), "r");
     std::string out;
     std::array<char, 4096> chunk{};
@@ -34,6 +34,8 @@ Outcome kdet_cli(const std::string& arguments) {
     const int status = pclose(pipe);
     return Outcome{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
+
+Outcome kdet_cli(const std::string& arguments) { return run_command(std::string(KDET_CLI_PATH) + " " + arguments); }
 
 std::filesystem::path temp_dir() {
     const auto dir = std::filesystem::temp_directory_path() / ("kdet_cli_test_" + std::to_string(getpid()));
@@ -184,6 +186,16 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
         EXPECT_EQ(line_count(r.out), 1u) << arguments << " -> " << r.out;
         EXPECT_NE(r.out.find(call.message), std::string::npos) << arguments << " -> " << r.out;
     }
+}
+
+TEST(Cli, VersionNamesTheCommitTheProgramWasBuiltFrom) {
+    // The commit used to be read when CMake configured the build folder, so rebuilt programs
+    // reported an older one.
+    const Outcome head = run_command("git -C \"" KDET_SOURCE_DIR "\" rev-parse --short=12 HEAD");
+    if (head.exit_code != 0) GTEST_SKIP() << "the sources are not a git checkout: " << head.out;
+    const std::string commit = head.out.substr(0, head.out.find('\n'));
+    const Outcome version = kdet_cli("--version");
+    EXPECT_NE(version.out.find("(" + commit), std::string::npos) << version.out << " vs HEAD " << commit;
 }
 
 TEST(Cli, HelpAndVersion) {

@@ -198,10 +198,10 @@ struct LargerNeighbourFilter {
     std::uint32_t cell[3];     ///< cell being visited (not wrapped)
 
     KDET_HD bool reports_from_this_cell(const Aabb& other) const {
-        const float lo[3] = {other.lo.x, other.lo.y, other.lo.z};
-        const float origin[3] = {params->origin.x, params->origin.y, params->origin.z};
         for (int a = 0; a < 3; ++a)
-            if (cell[a] != first[a] && cell_index(*params, lo[a], origin[a], layer) != cell[a]) return false;
+            if (cell[a] != first[a] &&
+                cell_index(*params, component(other.lo, a), component(params->origin, a), layer) != cell[a])
+                return false;
         return true;
     }
 
