@@ -8,9 +8,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 
-cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKDET_ENABLE_CUDA=OFF -DKDET_BUILD_BENCHMARKS=OFF \
-  -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" >/dev/null
-cmake --build build-sanitize -j"$(nproc)" --target kdet_tests kdet_cli
+# Presets (CMakePresets.json): asan builds into build-sanitize/, release into build/.
+cmake --preset asan >/dev/null
+cmake --build --preset asan -j"$(nproc)" --target kdet_tests kdet_cli
 echo "== the tests under AddressSanitizer and UndefinedBehaviorSanitizer"
 KDET_DATA_DIR="${KDET_DATA_DIR:-$PWD/../shared/models}" build-sanitize/tests/kdet_tests \
   --gtest_filter='-Models/RealMesh.*bunny*:Models/RealMesh.*hand*:Prepare.*:*Thesis*'
