@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Installs what kdet needs to build and test on Debian (run as root). Skips apt when all is there.
 set -euo pipefail
-packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3 clang libclang-rt-14-dev tetgen)
+# python3-venv and python3-dev: the Python package is built (headers) and tested in a virtual environment;
+# ninja-build: the generator scikit-build-core uses for it, the same one for every pip call.
+packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3 python3-venv python3-dev ninja-build clang
+  libclang-rt-14-dev tetgen)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
