@@ -9,6 +9,8 @@ include(CMakePackageConfigHelpers)
 
 set(KDET_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/kdet CACHE STRING "Where the CMake package files go")
 
+# A shared build (BUILD_SHARED_LIBS) gets libkdet.so.0 -> libkdet.so.0.1.0, matching SameMajorVersion below.
+set_target_properties(kdet PROPERTIES VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR})
 install(TARGETS kdet EXPORT kdetTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development

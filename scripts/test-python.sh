@@ -3,8 +3,9 @@
 # `pip wheel .` builds the wheel (its contents are checked), `pip install .` installs the package, and
 # pytest runs python/tests, which compare the pairs with those of the C++ command build/kdet (or
 # $KDET_CLI) on the models in ../shared/models (or $KDET_DATA_DIR). Both pip calls share one CMake
-# build folder (build-python/cmake), so the library is compiled once. pytest, meshio and matplotlib
-# come from PyPI. Extra arguments go to pytest.
+# build folder (build-python/cmake), so the library is compiled once (--config-settings, not -C: Debian's
+# pip 23.0 lacks the short form). pytest, meshio and matplotlib come from PyPI. Extra arguments go to
+# pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$PATH:/usr/local/cuda/bin"
@@ -19,7 +20,7 @@ python=("$venv/bin/python")
 pip=("${python[@]}" -m pip --disable-pip-version-check)
 "${pip[@]}" install -q --timeout 60 pytest meshio matplotlib
 
-"${pip[@]}" wheel -q --timeout 60 . -w build-python/dist -C build-dir=build-python/cmake
+"${pip[@]}" wheel -q --timeout 60 . -w build-python/dist --config-settings=build-dir=build-python/cmake
 "${python[@]}" - build-python/dist <<'PY'
 import pathlib, sys, zipfile
 wheel, = pathlib.Path(sys.argv[1]).glob("kdet-*.whl")
@@ -31,6 +32,6 @@ if missing or stray:
     sys.exit(f"{wheel.name}: missing {missing}, not part of the package {stray}")
 print(f"{wheel.name}: {len(names)} files, stubs and extension included, nothing else")
 PY
-"${pip[@]}" install -q . -C build-dir=build-python/cmake
+"${pip[@]}" install -q . --config-settings=build-dir=build-python/cmake
 echo "== the Python package's tests"
 "${python[@]}" -m pytest -rs python/tests "$@"
