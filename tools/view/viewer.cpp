@@ -1,0 +1,380 @@
+#include "viewer.hpp"
+
+#include "png_file.hpp"
+
+#include <kdet/error.hpp>
+
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+namespace kdet::view {
+
+namespace {
+
+constexpr float panel_width = 390.0f;
+
+std::string glfw_error;
+
+void remember_glfw_error(int, const char* description) { glfw_error = description ? description : "unknown error"; }
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+Bounds bounds_of(const ViewSession& session) {
+    Bounds box;
+    for (const std::vector<float>& xyz : session.positions()) box.add(xyz);
+    return box;
+}
+
+/// @brief The vertices of every colliding tet (repeated where tets share them), x y z each.
+std::vector<float> colliding_points_of(const ViewSession& session) {
+    std::vector<float> points;
+    const FrameResult& result = session.result();
+    for (std::size_t o = 0; o < result.colliding.size() && o < session.positions().size(); ++o) {
+        const std::vector<float>& p = session.positions()[o];
+        const TetMesh& mesh = session.scene().rest_mesh(o);
+        for (std::size_t t = 0; t < result.colliding[o].size(); ++t) {
+            if (!result.colliding[o][t]) continue;
+            for (int k = 0; k < 4; ++k) {
+                const std::size_t v = mesh.tets[4 * t + static_cast<std::size_t>(k)];
+                points.insert(points.end(), {p[3 * v], p[3 * v + 1], p[3 * v + 2]});
+            }
+        }
+    }
+    return points;
+}
+
+double median(std::vector<double> values) {
+    if (values.empty()) return 0;
+    std::sort(values.begin(), values.end());
+    return values[values.size() / 2];
+}
+
+} // namespace
+
+void Viewer::History::add(float detect, float draw) {
+    detect_ms[static_cast<std::size_t>(next)] = detect;
+    draw_ms[static_cast<std::size_t>(next)] = draw;
+    next = (next + 1) % size;
+    count = std::min(count + 1, size);
+}
+
+Viewer::Viewer(ViewSession& session, const ViewConfig& config, bool visible) : session_(session), config_(config) {
+    glfwSetErrorCallback(remember_glfw_error);
+    if (!glfwInit())
+        throw Error("view: cannot open a window: " + glfw_error +
+                    " (no display? `xvfb-run -a kdet view ...` draws without one)");
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_VISIBLE, visible ? GLFW_TRUE : GLFW_FALSE);
+    glfwWindowHint(GLFW_SAMPLES, visible && config.samples > 1 ? config.samples : 0);
+    const std::string title = "kdet view - " + session.scene().name();
+    window_ = glfwCreateWindow(config.width, config.height, title.c_str(), nullptr, nullptr);
+    if (!window_) {
+        glfwTerminate();
+        throw Error("view: cannot create an OpenGL 3.3 window: " + glfw_error);
+    }
+    glfwMakeContextCurrent(window_);
+    glfwSwapInterval(1);
+    if (epoxy_gl_version() < 33) {
+        glfwDestroyWindow(window_);
+        glfwTerminate();
+        throw Error("view: OpenGL 3.3 is needed, the driver gives " + std::to_string(epoxy_gl_version() / 10) + "." +
+                    std::to_string(epoxy_gl_version() % 10));
+    }
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr; // no imgui.ini in the user's folder
+    ImGui::StyleColorsDark();
+    ImGuiStyle& style = ImGui::GetStyle();
+    style.WindowRounding = 0.0f;
+    style.FrameRounding = 3.0f;
+    style.GrabRounding = 3.0f;
+    style.WindowBorderSize = 0.0f;
+    ImGui_ImplGlfw_InitForOpenGL(window_, true);
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+    imgui_ready_ = true;
+    renderer_ = std::make_unique<Renderer>();
+    glGenQueries(2, timer_queries_);
+    session_.set_frame(config.frame);
+}
+
+Viewer::~Viewer() {
+    bench_job_.reset();
+    glDeleteQueries(2, timer_queries_);
+    renderer_.reset();
+    if (imgui_ready_) {
+        ImGui_ImplOpenGL3_Shutdown();
+        ImGui_ImplGlfw_Shutdown();
+        ImGui::DestroyContext();
+    }
+    glfwDestroyWindow(window_);
+    glfwTerminate();
+}
+
+float Viewer::scene_aspect() const {
+    int width = 0, height = 0;
+    glfwGetWindowSize(window_, &width, &height);
+    const float scene_width = static_cast<float>(width) - (panel_shown_ ? panel_width : 0.0f);
+    return std::max(scene_width, 1.0f) / static_cast<float>(std::max(height, 1));
+}
+
+void Viewer::reset_camera(float aspect) {
+    camera_.set_angles(config_.camera.angles_given ? config_.camera.yaw : OrbitCamera::default_yaw,
+                       config_.camera.angles_given ? config_.camera.pitch : OrbitCamera::default_pitch);
+    scene_box_ = bounds_of(session_);
+    camera_.frame(session_.positions(), aspect);
+    camera_.zoom(config_.camera.zoom);
+}
+
+void Viewer::frame_colliding(float aspect) {
+    std::vector<std::vector<float>> points(1, colliding_points_of(session_));
+    if (points[0].empty()) {
+        set_status("nothing collides in this frame");
+        return;
+    }
+    camera_.frame(points, aspect);
+}
+
+void Viewer::set_status(const std::string& text) {
+    status_ = text;
+    status_time_ = std::chrono::steady_clock::now();
+}
+
+void Viewer::apply(const DetectorOptions& options) {
+    DetectorOptions o = options;
+    o.contacts = o.narrow_phase == NarrowPhase::sat_mtv;
+    session_.set_options(o);
+    config_.options = o;
+}
+
+void Viewer::open_source(const ViewSource& source) {
+    try {
+        session_.open(source);
+        config_.source = source;
+        session_.update();
+        reset_camera(scene_aspect());
+        glfwSetWindowTitle(window_, ("kdet view - " + session_.scene().name()).c_str());
+        set_status("opened " + session_.scene().name());
+    } catch (const std::exception& e) {
+        set_status(std::string("cannot open: ") + e.what());
+    }
+}
+
+void Viewer::handle_input(int scene_x, int scene_height) {
+    const ImGuiIO& io = ImGui::GetIO();
+    const float aspect = scene_aspect();
+    if (!io.WantCaptureKeyboard) {
+        const auto pressed = [](int key) { return ImGui::IsKeyPressed(key, false); };
+        if (pressed(GLFW_KEY_SPACE) && session_.num_frames() > 1) playing_ = !playing_;
+        if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT)) {
+            playing_ = false;
+            session_.set_frame(session_.frame() + 1);
+        }
+        if (ImGui::IsKeyPressed(GLFW_KEY_LEFT)) {
+            playing_ = false;
+            session_.set_frame(session_.frame() - 1);
+        }
+        if (pressed(GLFW_KEY_R)) {
+            config_.camera = CameraRequest{};
+            reset_camera(aspect);
+        }
+        if (pressed(GLFW_KEY_F)) frame_colliding(aspect);
+        if (pressed(GLFW_KEY_P)) screenshot_requested_ = true;
+        if (pressed(GLFW_KEY_W)) config_.display.wireframe = !config_.display.wireframe;
+        if (pressed(GLFW_KEY_C)) config_.display.clip = !config_.display.clip;
+        if (pressed(GLFW_KEY_H)) config_.display.only_colliding = !config_.display.only_colliding;
+        if (pressed(GLFW_KEY_N)) config_.display.contact_normals = !config_.display.contact_normals;
+        if (pressed(GLFW_KEY_TAB)) panel_shown_ = !panel_shown_;
+        if (pressed(GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+    }
+    if (io.WantCaptureMouse || io.MousePos.x < static_cast<float>(scene_x)) return;
+    const bool pan = io.MouseDown[1] || io.MouseDown[2] || (io.MouseDown[0] && io.KeyShift);
+    if (pan) {
+        camera_.pan(io.MouseDelta.x, io.MouseDelta.y, scene_height);
+    } else if (io.MouseDown[0]) {
+        camera_.orbit(io.MouseDelta.x, io.MouseDelta.y, scene_height);
+    }
+    if (io.MouseWheel != 0.0f) camera_.zoom(std::pow(0.88f, io.MouseWheel));
+}
+
+void Viewer::build_ui(int width, int height, bool with_panel) {
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGuiIO& io = ImGui::GetIO();
+    // Off-screen pictures have their own size, whatever the hidden window's.
+    io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
+    io.DisplayFramebufferScale = ImVec2(1.0f, 1.0f);
+    ImGui::NewFrame();
+    if (with_panel) draw_panel(panel_width, static_cast<float>(height));
+}
+
+void Viewer::run() {
+    session_.update();
+    reset_camera(scene_aspect());
+    if (config_.camera.focus_colliding) frame_colliding(scene_aspect());
+    while (!glfwWindowShouldClose(window_)) {
+        // Sleep until something happens unless an animation or a benchmark is running.
+        if (bench_job_) {
+            glfwWaitEventsTimeout(0.1);
+        } else if (playing_) {
+            glfwPollEvents();
+        } else {
+            glfwWaitEventsTimeout(0.5);
+        }
+        int window_width = 0, window_height = 0, fb_width = 0, fb_height = 0;
+        glfwGetWindowSize(window_, &window_width, &window_height);
+        glfwGetFramebufferSize(window_, &fb_width, &fb_height);
+        if (fb_width == 0 || fb_height == 0) continue; // minimised
+        const float scale = static_cast<float>(fb_width) / static_cast<float>(std::max(window_width, 1));
+
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        if (panel_shown_) draw_panel(panel_width, static_cast<float>(window_height));
+        const int scene_x = panel_shown_ ? static_cast<int>(panel_width) : 0;
+        handle_input(scene_x, window_height);
+        ImGui::Render();
+
+        if (bench_job_ && bench_job_->finished()) {
+            bench_outcome_ = bench_job_->outcome();
+            set_status(bench_outcome_);
+            bench_job_.reset();
+        }
+        if (playing_ && !bench_job_) {
+            int next = session_.frame() + 1;
+            if (next >= session_.num_frames()) {
+                next = 0;
+                if (!loop_) playing_ = false;
+            }
+            if (playing_) session_.set_frame(next);
+        }
+        // The benchmark has the processor to itself: the view keeps its last frame meanwhile.
+        const bool computed = !bench_job_ && session_.update();
+        renderer_->update(session_);
+
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glViewport(0, 0, fb_width, fb_height);
+        glClearColor(0.09f, 0.09f, 0.10f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        const unsigned query = timer_queries_[timer_frame_ % 2], previous = timer_queries_[(timer_frame_ + 1) % 2];
+        glBeginQuery(GL_TIME_ELAPSED, query);
+        const int fb_scene_x = static_cast<int>(static_cast<float>(scene_x) * scale);
+        renderer_->draw(camera_, fb_scene_x, 0, fb_width - fb_scene_x, fb_height, config_.display, scene_box_);
+        glEndQuery(GL_TIME_ELAPSED);
+        if (timer_frame_ > 0) {
+            GLuint available = 0;
+            glGetQueryObjectuiv(previous, GL_QUERY_RESULT_AVAILABLE, &available);
+            if (available) {
+                GLuint64 nanoseconds = 0;
+                glGetQueryObjectui64v(previous, GL_QUERY_RESULT, &nanoseconds);
+                last_draw_ms_ = static_cast<float>(static_cast<double>(nanoseconds) * 1e-6);
+            }
+        }
+        ++timer_frame_;
+        if (computed) history_.add(static_cast<float>(session_.detect_ms()), last_draw_ms_);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (screenshot_requested_) {
+            screenshot_requested_ = false;
+            save_window_screenshot(fb_width, fb_height);
+        }
+        glfwSwapBuffers(window_);
+    }
+}
+
+void Viewer::save_window_screenshot(int width, int height) {
+    const std::string stem = "kdet-" + session_.scene().name() + "-frame" + std::to_string(session_.frame());
+    std::string path = stem + ".png";
+    for (int n = 2; std::filesystem::exists(path); ++n) path = stem + "-" + std::to_string(n) + ".png";
+    try {
+        glReadBuffer(GL_BACK);
+        write_png(path, width, height, read_framebuffer_rgb(0, 0, width, height));
+        set_status("saved " + path);
+        std::printf("kdet view: saved %s\n", path.c_str());
+        std::fflush(stdout);
+    } catch (const Error& e) {
+        set_status(e.what());
+    }
+}
+
+void Viewer::screenshot(const std::string& path, int width, int height, bool with_panel) {
+    session_.update();
+    renderer_->update(session_);
+    const int scene_x = with_panel ? static_cast<int>(panel_width) : 0;
+    const float aspect = static_cast<float>(width - scene_x) / static_cast<float>(height);
+    reset_camera(aspect);
+    if (config_.camera.focus_colliding) frame_colliding(aspect);
+    OffscreenTarget target(width, height, config_.samples);
+    if (with_panel) {
+        // ImGui sizes its windows from what they held the frame before: let it settle first.
+        for (int warm_up = 0; warm_up < 3; ++warm_up) {
+            build_ui(width, height, true);
+            ImGui::Render();
+        }
+        build_ui(width, height, true);
+        ImGui::Render();
+    }
+    target.bind();
+    glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    renderer_->draw(camera_, scene_x, 0, width - scene_x, height, config_.display, scene_box_);
+    if (with_panel) ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    write_png(path, width, height, target.read_rgb());
+}
+
+void Viewer::profile(int width, int height) {
+    OffscreenTarget target(width, height, config_.samples);
+    session_.set_frame(0);
+    session_.update();
+    renderer_->update(session_);
+    reset_camera(static_cast<float>(width) / static_cast<float>(height));
+    std::size_t tets = 0, triangles = 0;
+    for (std::size_t o = 0; o < session_.scene().num_objects(); ++o) {
+        tets += session_.scene().rest_mesh(o).num_tets();
+        triangles += session_.surfaces()[o].size() / 3;
+    }
+    std::printf("profile: scene %s, %zu objects, %zu tets, %zu surface triangles, %d frames; method %s, test %s, "
+                "backend %s on %s\n",
+                session_.scene().name().c_str(), session_.scene().num_objects(), tets, triangles, session_.num_frames(),
+                to_string(session_.options().method), to_string(session_.options().narrow_phase),
+                to_string(session_.options().backend), session_.device_name().c_str());
+    std::printf("drawing: %dx%d, %d samples, %s, OpenGL %s\n", width, height, config_.samples,
+                reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+                reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+    std::printf("%6s %12s %12s %12s %12s %14s\n", "frame", "positions_ms", "detect_ms", "upload_ms", "draw_ms",
+                "colliding_tets");
+    std::vector<double> detect, upload, draw;
+    for (int frame = 0; frame < session_.num_frames(); ++frame) {
+        session_.set_frame(frame);
+        session_.update();
+        auto start = std::chrono::steady_clock::now();
+        renderer_->update(session_);
+        glFinish();
+        upload.push_back(milliseconds_since(start));
+        start = std::chrono::steady_clock::now();
+        target.bind();
+        renderer_->draw(camera_, 0, 0, width, height, config_.display, scene_box_);
+        glFinish();
+        draw.push_back(milliseconds_since(start));
+        detect.push_back(session_.detect_ms());
+        std::printf("%6d %12.3f %12.3f %12.3f %12.3f %14llu\n", frame, session_.positions_ms(), detect.back(),
+                    upload.back(), draw.back(), static_cast<unsigned long long>(session_.result().counts.colliding_tets));
+    }
+    std::printf("median: detect %.3f ms, upload %.3f ms, draw %.3f ms per frame\n", median(detect), median(upload),
+                median(draw));
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+} // namespace kdet::view
