@@ -48,7 +48,7 @@ double enclosed_volume(const TetMesh& mesh, const std::vector<std::uint32_t>& tr
 
 TEST(ViewSurface, BoxBoundaryIsClosedAndFacesOutward) {
     const TetMesh box = make_box_mesh(3, 2, 4, 0.5);
-    const std::vector<std::uint32_t> triangles = boundary_triangles(box);
+    const std::vector<std::uint32_t> triangles = analyse_faces(box).boundary;
     // Two triangles per boundary square of the 3x2x4 grid.
     EXPECT_EQ(triangles.size() / 3, 2u * 2u * (3 * 2 + 2 * 4 + 3 * 4));
     // Closed and consistently oriented: every directed edge appears once, and its reverse once.
@@ -66,16 +66,19 @@ TEST(ViewSurface, FacesOutwardWhateverTheTetOrientation) {
     TetMesh two;
     two.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1};
     two.tets = {0, 1, 2, 3, 0, 2, 1, 4}; // one positive, one negative; they share face 0 1 2
-    const std::vector<std::uint32_t> triangles = boundary_triangles(two);
+    const MeshFaces faces = analyse_faces(two);
+    const std::vector<std::uint32_t>& triangles = faces.boundary;
     EXPECT_EQ(triangles.size(), 6u * 3u);
     EXPECT_NEAR(enclosed_volume(two, triangles), 2.0 / 6.0, 1e-12);
-    std::set<std::array<std::uint32_t, 3>> faces;
+    std::set<std::array<std::uint32_t, 3>> distinct;
     for (std::size_t t = 0; t < triangles.size(); t += 3) {
         std::array<std::uint32_t, 3> f = {triangles[t], triangles[t + 1], triangles[t + 2]};
         std::sort(f.begin(), f.end());
-        faces.insert(f);
+        distinct.insert(f);
     }
-    EXPECT_EQ(faces.count({0, 1, 2}), 0u) << "the shared face is interior";
+    EXPECT_EQ(distinct.count({0, 1, 2}), 0u) << "the shared face is interior";
+    // Face 0 of tet 0 and face 0 of tet 1 are the shared one (vertices 0 1 2 of each).
+    EXPECT_EQ(faces.neighbour, (std::vector<std::uint32_t>{1, no_tet, no_tet, no_tet, 0, no_tet, no_tet, no_tet}));
 }
 
 TEST(ViewSurface, TorusSurfaceEnclosesItsTets) {
@@ -90,18 +93,40 @@ TEST(ViewSurface, TorusSurfaceEnclosesItsTets) {
         volume += std::abs(e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
                            e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6.0;
     }
-    EXPECT_NEAR(enclosed_volume(torus, boundary_triangles(torus)), volume, 1e-9 * volume);
+    EXPECT_NEAR(enclosed_volume(torus, analyse_faces(torus).boundary), volume, 1e-9 * volume);
 }
 
-TEST(ViewSurface, TetFacesCoverAllFourFaces) {
-    const TetMesh box = make_box_mesh(1, 1, 1, 1.0);
-    std::vector<std::uint32_t> faces;
-    append_tet_faces(box, 2, faces);
-    ASSERT_EQ(faces.size(), 12u);
-    std::set<std::set<std::uint32_t>> distinct;
-    for (std::size_t f = 0; f < 12; f += 3) distinct.insert({faces[f], faces[f + 1], faces[f + 2]});
-    EXPECT_EQ(distinct.size(), 4u);
-    for (const auto& face : distinct) EXPECT_EQ(face.size(), 3u);
+TEST(ViewSurface, FlaggedRegionIsTheSurfaceOfTheFlaggedTets) {
+    const TetMesh box = make_box_mesh(4, 3, 2, 1.0);
+    const MeshFaces faces = analyse_faces(box);
+    std::size_t interior = 0;
+    for (const std::uint32_t n : faces.neighbour) interior += n != no_tet;
+    EXPECT_EQ(interior + faces.boundary.size() / 3, 4 * box.num_tets()) << "every face is interior or boundary";
+    // Neighbours are mutual and share three vertices.
+    for (std::size_t t = 0; t < box.num_tets(); ++t)
+        for (int k = 0; k < 4; ++k) {
+            const std::uint32_t n = faces.neighbour[4 * t + static_cast<std::size_t>(k)];
+            if (n == no_tet) continue;
+            EXPECT_EQ(std::count(faces.neighbour.begin() + 4 * n, faces.neighbour.begin() + 4 * n + 4, t), 1);
+            std::set<std::uint32_t> a(&box.tets[4 * t], &box.tets[4 * t] + 4), b(&box.tets[4 * n], &box.tets[4 * n] + 4);
+            std::vector<std::uint32_t> shared;
+            std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(shared));
+            EXPECT_EQ(shared.size(), 3u);
+        }
+    // Every tet flagged: the region's surface is the whole boundary.
+    std::vector<std::uint8_t> all(box.num_tets(), 1), one(box.num_tets(), 0), none(box.num_tets(), 0);
+    std::vector<std::uint32_t> region;
+    append_flagged_region(box, faces, all, region);
+    EXPECT_EQ(region.size(), faces.boundary.size());
+    // One tet: its four faces.
+    one[7] = 1;
+    region.clear();
+    append_flagged_region(box, faces, one, region);
+    EXPECT_EQ(region.size(), 12u);
+    EXPECT_EQ(std::set<std::uint32_t>(region.begin(), region.end()), std::set<std::uint32_t>(&box.tets[28], &box.tets[32]));
+    region.clear();
+    append_flagged_region(box, faces, none, region);
+    EXPECT_TRUE(region.empty());
 }
 
 // ---- camera ----
@@ -273,7 +298,7 @@ TEST(ViewSession, ShowsTheDetectorsPairsForTheFrame) {
     std::vector<float> xyz;
     session.scene().positions(1, 10, xyz);
     EXPECT_EQ(session.positions()[1], xyz);
-    EXPECT_EQ(session.surfaces().size(), 2u);
+    EXPECT_EQ(session.faces().size(), 2u);
     session.set_frame(1000);
     EXPECT_EQ(session.frame(), 20) << "clamped";
 }

@@ -147,7 +147,7 @@ void Viewer::panel_scene() {
         ImGui::ColorButton("##color", ImVec4(c.r, c.g, c.b, 1.0f), ImGuiColorEditFlags_NoTooltip, ImVec2(12, 12));
         ImGui::SameLine();
         ImGui::Text("object %zu: %zu tets, %zu surface triangles", o, scene.rest_mesh(o).num_tets(),
-                    session_.surfaces()[o].size() / 3);
+                    session_.faces()[o].boundary.size() / 3);
     }
 }
 
@@ -280,7 +280,11 @@ void Viewer::panel_results() {
         row_ms("sort + unique", t.sort_unique);
         row_ms("narrow phase", t.narrow_phase);
         row_ms("detect() total", t.total);
-        row_ms("drawing (GPU)", last_draw_ms_);
+        if (timer_frame_ > 1) {
+            row_ms("drawing (GPU)", last_draw_ms_);
+        } else {
+            row("drawing (GPU)", "not measured yet");
+        }
         row("detector memory", mebibytes(r.memory_bytes));
         row("  grid / candidates", mebibytes(r.grid_bytes) + " / " + mebibytes(r.candidate_bytes));
         row("process memory", mebibytes(resident_bytes()));

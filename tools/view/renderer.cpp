@@ -177,7 +177,7 @@ void Renderer::load_scene(const ViewSession& session) {
     for (std::size_t o = 0; o < scene.num_objects(); ++o) {
         ObjectBuffers b;
         const TetMesh& mesh = scene.rest_mesh(o);
-        const std::vector<std::uint32_t>& surface = session.surfaces()[o];
+        const std::vector<std::uint32_t>& surface = session.faces()[o].boundary;
         b.vertex_bytes = mesh.num_vertices() * 3 * sizeof(float);
         b.surface_count = surface.size();
         glGenVertexArrays(1, &b.surface_array);
@@ -226,12 +226,9 @@ void Renderer::upload_highlights(const ViewSession& session) {
     for (std::size_t o = 0; o < objects_.size(); ++o) {
         ObjectBuffers& b = objects_[o];
         scratch_indices_.clear();
-        if (o < result.colliding.size()) {
-            const std::vector<std::uint8_t>& flags = result.colliding[o];
-            const TetMesh& mesh = session.scene().rest_mesh(o);
-            for (std::size_t t = 0; t < flags.size(); ++t)
-                if (flags[t]) append_tet_faces(mesh, static_cast<std::uint32_t>(t), scratch_indices_);
-        }
+        // Faces between two colliding tets are hidden inside the region: only its surface is drawn.
+        if (o < result.colliding.size())
+            append_flagged_region(session.scene().rest_mesh(o), session.faces()[o], result.colliding[o], scratch_indices_);
         b.highlight_count = scratch_indices_.size();
         if (b.highlight_count == 0) continue;
         if (b.highlight_count > b.highlight_capacity) {

@@ -1,7 +1,6 @@
 #include "session.hpp"
 
 #include "bench_runner.hpp"
-#include "surface.hpp"
 
 #include <kdet/error.hpp>
 
@@ -67,12 +66,12 @@ ViewSession::ViewSession(const ViewSource& source, const DetectorOptions& option
 
 void ViewSession::open(const ViewSource& source) {
     std::unique_ptr<Scene> scene = open_view_source(source);
-    std::vector<std::vector<std::uint32_t>> surfaces;
-    for (std::size_t o = 0; o < scene->num_objects(); ++o) surfaces.push_back(boundary_triangles(scene->rest_mesh(o)));
+    std::vector<MeshFaces> faces;
+    for (std::size_t o = 0; o < scene->num_objects(); ++o) faces.push_back(analyse_faces(scene->rest_mesh(o)));
     // Release the old detector before the new scene's buffers are made.
     detector_.reset();
     scene_ = std::move(scene);
-    surfaces_ = std::move(surfaces);
+    faces_ = std::move(faces);
     source_ = source;
     positions_.assign(scene_->num_objects(), {});
     if (frame_ >= scene_->num_frames()) frame_ = 0;

@@ -3,6 +3,8 @@
 /// @brief What the viewer shows and computes, without any drawing: the open scene, the Detector
 /// with the chosen options, the current frame's positions and the detection's results.
 
+#include "surface.hpp"
+
 #include <kdet/detector.hpp>
 #include <kdet/io.hpp>
 #include <kdet/scenes.hpp>
@@ -58,8 +60,8 @@ public:
     int frame() const { return frame_; }
     int num_frames() const { return scene_->num_frames(); }
 
-    /// @brief The outward boundary triangles of each object, computed once when the scene opens.
-    const std::vector<std::vector<std::uint32_t>>& surfaces() const { return surfaces_; }
+    /// @brief Each object's boundary and face neighbours, computed once when the scene opens.
+    const std::vector<MeshFaces>& faces() const { return faces_; }
     /// @brief Positions (x y z per vertex) of each object at frame() as of the last update().
     const std::vector<std::vector<float>>& positions() const { return positions_; }
     /// @brief The last detection; empty before the first update().
@@ -85,7 +87,7 @@ private:
 
     ViewSource source_;
     std::unique_ptr<Scene> scene_;
-    std::vector<std::vector<std::uint32_t>> surfaces_;
+    std::vector<MeshFaces> faces_;
     DetectorOptions options_;
     bool self_ = false;
     int frame_ = 0;

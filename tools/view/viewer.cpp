@@ -103,6 +103,9 @@ Viewer::Viewer(ViewSession& session, const ViewConfig& config, bool visible) : s
     style.FrameRounding = 3.0f;
     style.GrabRounding = 3.0f;
     style.WindowBorderSize = 0.0f;
+    // Installed before ImGui's, which calls it first.
+    glfwSetWindowUserPointer(window_, this);
+    glfwSetKeyCallback(window_, on_key);
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
     imgui_ready_ = true;
@@ -173,34 +176,62 @@ void Viewer::open_source(const ViewSource& source) {
     }
 }
 
-void Viewer::handle_input(int scene_x, int scene_height) {
-    const ImGuiIO& io = ImGui::GetIO();
-    const float aspect = scene_aspect();
-    if (!io.WantCaptureKeyboard) {
-        const auto pressed = [](int key) { return ImGui::IsKeyPressed(key, false); };
-        if (pressed(GLFW_KEY_SPACE) && session_.num_frames() > 1) playing_ = !playing_;
-        if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT)) {
-            playing_ = false;
-            session_.set_frame(session_.frame() + 1);
-        }
-        if (ImGui::IsKeyPressed(GLFW_KEY_LEFT)) {
-            playing_ = false;
-            session_.set_frame(session_.frame() - 1);
-        }
-        if (pressed(GLFW_KEY_R)) {
-            config_.camera = CameraRequest{};
-            reset_camera(aspect);
-        }
-        if (pressed(GLFW_KEY_F)) frame_colliding(aspect);
-        if (pressed(GLFW_KEY_P)) screenshot_requested_ = true;
-        if (pressed(GLFW_KEY_W)) config_.display.wireframe = !config_.display.wireframe;
-        if (pressed(GLFW_KEY_C)) config_.display.clip = !config_.display.clip;
-        if (pressed(GLFW_KEY_H)) config_.display.only_colliding = !config_.display.only_colliding;
-        if (pressed(GLFW_KEY_N)) config_.display.contact_normals = !config_.display.contact_normals;
-        if (pressed(GLFW_KEY_TAB)) panel_shown_ = !panel_shown_;
-        if (pressed(GLFW_KEY_ESCAPE)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+void Viewer::on_key(GLFWwindow* window, int key, int, int action, int) {
+    auto* viewer = static_cast<Viewer*>(glfwGetWindowUserPointer(window));
+    if (!viewer || action == GLFW_RELEASE || ImGui::GetIO().WantCaptureKeyboard) return;
+    // Only the frame steps repeat while the key is held.
+    if (action == GLFW_REPEAT && key != GLFW_KEY_LEFT && key != GLFW_KEY_RIGHT) return;
+    viewer->pending_keys_.push_back(key);
+}
+
+void Viewer::handle_key(int key) {
+    switch (key) {
+    case GLFW_KEY_SPACE:
+        playing_ = !playing_ && session_.num_frames() > 1;
+        break;
+    case GLFW_KEY_RIGHT:
+    case GLFW_KEY_LEFT:
+        playing_ = false;
+        session_.set_frame(session_.frame() + (key == GLFW_KEY_RIGHT ? 1 : -1));
+        break;
+    case GLFW_KEY_R:
+        config_.camera = CameraRequest{};
+        reset_camera(scene_aspect());
+        break;
+    case GLFW_KEY_F:
+        frame_colliding(scene_aspect());
+        break;
+    case GLFW_KEY_P:
+        screenshot_requested_ = true;
+        break;
+    case GLFW_KEY_W:
+        config_.display.wireframe = !config_.display.wireframe;
+        break;
+    case GLFW_KEY_C:
+        config_.display.clip = !config_.display.clip;
+        break;
+    case GLFW_KEY_H:
+        config_.display.only_colliding = !config_.display.only_colliding;
+        break;
+    case GLFW_KEY_N:
+        config_.display.contact_normals = !config_.display.contact_normals;
+        break;
+    case GLFW_KEY_TAB:
+        panel_shown_ = !panel_shown_;
+        break;
+    case GLFW_KEY_ESCAPE:
+        glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        break;
+    default:
+        break;
     }
-    if (io.WantCaptureMouse || io.MousePos.x < static_cast<float>(scene_x)) return;
+}
+
+void Viewer::handle_input(int scene_height) {
+    for (const int key : pending_keys_) handle_key(key);
+    pending_keys_.clear();
+    const ImGuiIO& io = ImGui::GetIO();
+    if (io.WantCaptureMouse) return;
     const bool pan = io.MouseDown[1] || io.MouseDown[2] || (io.MouseDown[0] && io.KeyShift);
     if (pan) {
         camera_.pan(io.MouseDelta.x, io.MouseDelta.y, scene_height);
@@ -245,7 +276,7 @@ void Viewer::run() {
         ImGui::NewFrame();
         if (panel_shown_) draw_panel(panel_width, static_cast<float>(window_height));
         const int scene_x = panel_shown_ ? static_cast<int>(panel_width) : 0;
-        handle_input(scene_x, window_height);
+        handle_input(window_height);
         ImGui::Render();
 
         if (bench_job_ && bench_job_->finished()) {
@@ -343,7 +374,7 @@ void Viewer::profile(int width, int height) {
     std::size_t tets = 0, triangles = 0;
     for (std::size_t o = 0; o < session_.scene().num_objects(); ++o) {
         tets += session_.scene().rest_mesh(o).num_tets();
-        triangles += session_.surfaces()[o].size() / 3;
+        triangles += session_.faces()[o].boundary.size() / 3;
     }
     std::printf("profile: scene %s, %zu objects, %zu tets, %zu surface triangles, %d frames; method %s, test %s, "
                 "backend %s on %s\n",

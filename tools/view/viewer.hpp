@@ -50,7 +50,11 @@ private:
     float scene_aspect() const;
     void reset_camera(float aspect);
     void frame_colliding(float aspect);
-    void handle_input(int scene_x, int scene_height);
+    /// @brief GLFW's key callback: keeps the keys meant for the viewer until the next frame, so that
+    /// a press and release between two frames still counts.
+    static void on_key(GLFWwindow* window, int key, int scancode, int action, int mods);
+    void handle_key(int key);
+    void handle_input(int scene_height);
     void apply(const DetectorOptions& options);
     void open_source(const ViewSource& source);
     void draw_panel(float width, float height);
@@ -75,6 +79,7 @@ private:
     bool panel_shown_ = true;
     bool playing_ = false, loop_ = true;
     bool screenshot_requested_ = false;
+    std::vector<int> pending_keys_;
     int bench_runs_ = 3;
     std::string bench_dir_ = "exports/benchmark_data";
     std::unique_ptr<BenchJob> bench_job_;
