@@ -50,7 +50,7 @@ void print_report(const BenchConfig& config, const Scene& scene, const BenchOutc
     std::printf("scene %s (resolution %d): %s+%s tets, frames %d-%d, %d run(s); method %s, test %s, hash %s, self %s, "
                 "backend %s on %s\n",
                 scene.name().c_str(), config.request.resolution, value("#tetsA").c_str(), value("#tetsB").c_str(),
-                config.first_frame, last_frame_of(config, scene), config.runs, bench_method_name(config.options.method),
+                config.first_frame, last_frame_of(config, scene), config.runs, bench_method_name(config.options.method).c_str(),
                 to_string(config.options.narrow_phase), value("hashing algorithm").c_str(), config.self ? "yes" : "no",
                 to_string(config.options.backend), value("device").c_str());
     const std::size_t device = column("device time"), pairs = column("collision pairs");

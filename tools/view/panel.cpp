@@ -2,6 +2,8 @@
 
 #include "viewer.hpp"
 
+#include "bench_args.hpp"
+
 #include <kdet/scenes.hpp>
 
 #include <imgui.h>
@@ -10,20 +12,28 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 
 namespace kdet::view {
 
 namespace {
 
-template <class Option, std::size_t N>
-bool option_combo(const char* label, Option& value, const Option (&values)[N]) {
+/// @brief A combo box of every name of an option type (the library's table); `usable` may grey out
+/// values this machine cannot run, with the reason as a tooltip.
+template <class Option>
+bool option_combo(const char* label, Option& value, const std::function<bool(Option, std::string*)>& usable = nullptr) {
     bool changed = false;
     if (ImGui::BeginCombo(label, to_string(value))) {
-        for (const Option v : values) {
-            if (ImGui::Selectable(to_string(v), v == value) && v != value) {
+        for (const std::string& name : option_names<Option>()) {
+            Option v{};
+            parse(name, v);
+            std::string reason;
+            const bool enabled = !usable || usable(v, &reason);
+            if (ImGui::Selectable(name.c_str(), v == value, enabled ? 0 : ImGuiSelectableFlags_Disabled) && v != value) {
                 value = v;
                 changed = true;
             }
+            if (!enabled && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", reason.c_str());
         }
         ImGui::EndCombo();
     }
@@ -177,40 +187,23 @@ void Viewer::panel_detection() {
     ImGui::BeginDisabled(bench_job_ != nullptr);
     DetectorOptions o = session_.options();
     bool changed = false;
-    static constexpr Method methods[] = {Method::kdet, Method::kdet_no_pairs, Method::brute_force_loop,
-                                         Method::brute_force_pairs};
-    static constexpr NarrowPhase tests[] = {NarrowPhase::sat, NarrowPhase::sat_no_edges, NarrowPhase::sat_mtv,
-                                            NarrowPhase::gjk, NarrowPhase::fast};
-    static constexpr HashFunction hashes[] = {HashFunction::djb2, HashFunction::fnv1a, HashFunction::simple,
-                                              HashFunction::morton};
-    changed |= option_combo("method", o.method, methods);
-    changed |= option_combo("narrow phase", o.narrow_phase, tests);
+    changed |= option_combo("method", o.method);
+    changed |= option_combo("narrow phase", o.narrow_phase);
     ImGui::BeginDisabled(o.method != Method::kdet && o.method != Method::kdet_no_pairs);
-    changed |= option_combo("hash", o.hash, hashes);
+    changed |= option_combo("hash", o.hash);
     ImGui::EndDisabled();
-    std::string cuda_missing;
-    const bool cuda = cuda_available(&cuda_missing);
-    if (ImGui::BeginCombo("backend", to_string(o.backend))) {
-        if (ImGui::Selectable("cpu", o.backend == Backend::cpu) && o.backend != Backend::cpu) {
-            o.backend = Backend::cpu;
-            changed = true;
-        }
-        if (ImGui::Selectable("cuda", o.backend == Backend::cuda, cuda ? 0 : ImGuiSelectableFlags_Disabled) &&
-            o.backend != Backend::cuda) {
-            o.backend = Backend::cuda;
-            changed = true;
-        }
-        if (!cuda) ImGui::TextDisabled("cuda: %s", cuda_missing.c_str());
-        ImGui::EndCombo();
-    }
+    changed |= option_combo<Backend>("backend", o.backend, [](Backend b, std::string* reason) {
+        return b != Backend::cuda || cuda_available(reason);
+    });
     ImGui::BeginDisabled(o.backend != Backend::cuda);
-    static constexpr int block_sizes[] = {16, 32, 64, 128, 256};
     if (ImGui::BeginCombo("block size", std::to_string(o.block_size).c_str())) {
-        for (const int b : block_sizes)
-            if (ImGui::Selectable(std::to_string(b).c_str(), b == o.block_size) && b != o.block_size) {
+        for (const std::string& size : cli::bench_block_sizes()) {
+            const int b = std::stoi(size);
+            if (ImGui::Selectable(size.c_str(), b == o.block_size) && b != o.block_size) {
                 o.block_size = b;
                 changed = true;
             }
+        }
         ImGui::EndCombo();
     }
     ImGui::EndDisabled();
