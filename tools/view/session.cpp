@@ -4,6 +4,7 @@
 
 #include <kdet/error.hpp>
 
+#include <time.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -57,6 +58,12 @@ std::size_t resident_bytes() {
     std::size_t total_pages = 0, resident_pages = 0;
     if (!(statm >> total_pages >> resident_pages)) return 0;
     return resident_pages * static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+}
+
+double process_cpu_ms() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
 ViewSession::ViewSession(const ViewSource& source, const DetectorOptions& options, bool self)
@@ -119,7 +126,9 @@ bool ViewSession::update() {
         for (std::size_t o = 0; o < scene_->num_objects(); ++o)
             detector_->set_positions(static_cast<ObjectId>(o), positions_[o].data(), positions_[o].size() / 3);
         const auto start = std::chrono::steady_clock::now();
+        const double cpu_start = process_cpu_ms();
         result_ = detector_->detect();
+        detect_cpu_ms_ = process_cpu_ms() - cpu_start;
         detect_ms_ = milliseconds_since(start);
         has_result_ = true;
         results_stale_ = false;

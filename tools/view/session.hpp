@@ -32,6 +32,10 @@ std::unique_ptr<Scene> open_view_source(const ViewSource& source);
 /// @brief The process's resident set in bytes (0 when the system does not tell).
 std::size_t resident_bytes();
 
+/// @brief Processor time used by all threads of the process so far, in milliseconds. Unlike wall
+/// time it hardly changes when other programs share the processors.
+double process_cpu_ms();
+
 /// @brief The scene, detector and current results of one viewer. Every setting may change at any
 /// time, before or after the first detection: the detector is rebuilt with the new settings the next
 /// time results are needed, and the old one is released.
@@ -72,9 +76,11 @@ public:
     /// @brief Name of the device the detector runs on (empty before the first detection).
     std::string device_name() const;
 
-    /// @brief Milliseconds the last update() spent computing positions and in detect().
+    /// @brief Milliseconds the last update() spent computing positions and in detect() (wall
+    /// clock), and the processor time of every thread of the process during detect().
     double positions_ms() const { return positions_ms_; }
     double detect_ms() const { return detect_ms_; }
+    double detect_cpu_ms() const { return detect_cpu_ms_; }
     /// @brief Counters that step whenever positions or results change; a renderer compares them to
     /// know what to upload.
     std::uint64_t positions_version() const { return positions_version_; }
@@ -97,7 +103,7 @@ private:
     std::vector<std::vector<float>> positions_;
     FrameResult result_;
     bool has_result_ = false;
-    double positions_ms_ = 0, detect_ms_ = 0;
+    double positions_ms_ = 0, detect_ms_ = 0, detect_cpu_ms_ = 0;
     std::uint64_t positions_version_ = 0, result_version_ = 0, scene_version_ = 0;
 };
 

@@ -384,27 +384,35 @@ void Viewer::profile(int width, int height) {
     std::printf("drawing: %dx%d, %d samples, %s, OpenGL %s\n", width, height, config_.samples,
                 reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
                 reinterpret_cast<const char*>(glGetString(GL_VERSION)));
-    std::printf("%6s %12s %12s %12s %12s %14s\n", "frame", "positions_ms", "detect_ms", "upload_ms", "draw_ms",
-                "colliding_tets");
-    std::vector<double> detect, upload, draw;
+    std::printf("%6s %12s %10s %10s %10s %10s %10s %10s %14s\n", "frame", "positions_ms", "detect_ms", "upload_ms",
+                "draw_ms", "detect_cpu", "draw_cpu", "ratio_cpu", "colliding_tets");
+    std::vector<double> detect, draw, detect_cpu, draw_cpu;
     for (int frame = 0; frame < session_.num_frames(); ++frame) {
         session_.set_frame(frame);
         session_.update();
+        // Drawing's cost: the uploads and the drawing until the driver has finished them (Mesa's
+        // software renderer draws in threads of this process, which the processor time includes).
+        const double cpu_start = process_cpu_ms();
         auto start = std::chrono::steady_clock::now();
         renderer_->update(session_);
         glFinish();
-        upload.push_back(milliseconds_since(start));
+        const double upload_ms = milliseconds_since(start);
         start = std::chrono::steady_clock::now();
         target.bind();
         renderer_->draw(camera_, 0, 0, width, height, config_.display, scene_box_);
         glFinish();
         draw.push_back(milliseconds_since(start));
+        draw_cpu.push_back(process_cpu_ms() - cpu_start);
         detect.push_back(session_.detect_ms());
-        std::printf("%6d %12.3f %12.3f %12.3f %12.3f %14llu\n", frame, session_.positions_ms(), detect.back(),
-                    upload.back(), draw.back(), static_cast<unsigned long long>(session_.result().counts.colliding_tets));
+        detect_cpu.push_back(session_.detect_cpu_ms());
+        std::printf("%6d %12.3f %10.3f %10.3f %10.3f %10.3f %10.3f %10.3f %14llu\n", frame, session_.positions_ms(),
+                    detect.back(), upload_ms, draw.back(), detect_cpu.back(), draw_cpu.back(),
+                    draw_cpu.back() / std::max(detect_cpu.back(), 1e-3),
+                    static_cast<unsigned long long>(session_.result().counts.colliding_tets));
     }
-    std::printf("median: detect %.3f ms, upload %.3f ms, draw %.3f ms per frame\n", median(detect), median(upload),
-                median(draw));
+    std::printf("median per frame: detect %.3f ms (processor %.3f ms), draw %.3f ms (processor %.3f ms, uploads "
+                "included)\n",
+                median(detect), median(detect_cpu), median(draw), median(draw_cpu));
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
