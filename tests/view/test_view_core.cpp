@@ -4,6 +4,7 @@
 #include "bench_job.hpp"
 #include "camera.hpp"
 #include "cli_args.hpp"
+#include "picking.hpp"
 #include "session.hpp"
 #include "surface.hpp"
 #include "view_args.hpp"
@@ -179,6 +180,21 @@ TEST(ViewCamera, TargetProjectsToTheCentreAndMovesAsAsked) {
     EXPECT_FLOAT_EQ(camera.pitch(), 89.0f);
     // A point behind the camera does not project.
     EXPECT_FALSE(camera.project(camera.eye() + (camera.eye() - camera.target()), 200, 100).has_value());
+}
+
+TEST(ViewCamera, RaysGoThroughTheirPixels) {
+    OrbitCamera camera;
+    camera.set_angles(-60, 35);
+    camera.frame({{0, 0, 0, 1, 2, 3}}, 1.5f);
+    for (const auto& [x, y] : {std::pair{150.0f, 100.0f}, std::pair{3.0f, 190.0f}, std::pair{297.0f, 1.0f}}) {
+        const auto [origin, direction] = camera.ray(x, y, 300, 200);
+        EXPECT_NEAR(length(direction), 1.0f, 1e-5f);
+        EXPECT_NEAR(length(origin - camera.eye()), 0.0f, 1e-5f);
+        const auto p = camera.project(origin + direction * (2.0f * camera.distance()), 300, 200);
+        ASSERT_TRUE(p.has_value());
+        EXPECT_NEAR((*p)[0], x, 1e-2f);
+        EXPECT_NEAR((*p)[1], y, 1e-2f);
+    }
 }
 
 // ---- command line ----
@@ -416,6 +432,60 @@ TEST(ViewSession, AFailedOpenKeepsTheSceneShown) {
     EXPECT_EQ(session.scene_version(), version);
     session.set_frame(2);
     EXPECT_TRUE(session.update());
+}
+
+// ---- picking ----
+
+TEST(ViewPicking, PicksWhatIsDrawnAtThePixel) {
+    DetectorOptions options;
+    options.narrow_phase = NarrowPhase::sat_mtv;
+    options.contacts = true;
+    ViewSession session(test::nested_boxes(), options, false);
+    session.update();
+    OrbitCamera camera;
+    camera.frame(session.positions(), 1.0f);
+    Bounds box;
+    for (const auto& xyz : session.positions()) box.add(xyz);
+    // The centre of the small box, seen through the big one.
+    const auto centre = camera.project(Vec3{4.37f, 4.37f, 4.37f}, 400, 400);
+    ASSERT_TRUE(centre.has_value());
+    DisplaySettings translucent;
+    const auto hit = pick_tet(session, camera, (*centre)[0], (*centre)[1], 400, 400, translucent, box);
+    ASSERT_TRUE(hit.has_value());
+    EXPECT_TRUE(session.result().colliding[hit->object][hit->tet]) << "colliding tets are drawn over the surface";
+    // Opaque, the big box's surface is in front: the tet of that surface triangle.
+    DisplaySettings opaque;
+    opaque.surface_opacity = 1.0f;
+    const auto outside = pick_tet(session, camera, (*centre)[0], (*centre)[1], 400, 400, opaque, box);
+    ASSERT_TRUE(outside.has_value());
+    EXPECT_EQ(outside->object, 0u);
+    EXPECT_FALSE(session.result().colliding[0][outside->tet]);
+    const auto& boundary_tets = session.faces()[0].boundary_tet;
+    EXPECT_NE(std::find(boundary_tets.begin(), boundary_tets.end(), outside->tet), boundary_tets.end());
+    // Opaque but opened by the clipping plane halfway along z, seen from +z: the colliding tets again.
+    opaque.clip = true;
+    opaque.clip_axis = 2;
+    const auto opened = pick_tet(session, camera, (*centre)[0], (*centre)[1], 400, 400, opaque, box);
+    ASSERT_TRUE(opened.has_value());
+    EXPECT_TRUE(session.result().colliding[opened->object][opened->tet]);
+    // The corner of the picture shows the background.
+    EXPECT_FALSE(pick_tet(session, camera, 1, 1, 400, 400, translucent, box).has_value());
+
+    // What the panel lists: the tets the detector pairs with the picked one, with their contacts.
+    const std::vector<Partner> partners = partners_of(session.result(), *hit);
+    ASSERT_FALSE(partners.empty());
+    std::size_t expected = 0;
+    for (const TetPair& p : session.result().pairs)
+        expected += (p.object_a == hit->object && p.tet_a == hit->tet) || (p.object_b == hit->object && p.tet_b == hit->tet);
+    EXPECT_EQ(partners.size(), expected);
+    for (const Partner& p : partners) {
+        EXPECT_NE(p.tet.object, hit->object);
+        EXPECT_TRUE(session.result().colliding[p.tet.object][p.tet.tet]);
+        EXPECT_TRUE(p.has_contact);
+        EXPECT_GE(p.contact.depth, 0.0f);
+    }
+    const std::vector<float> corners = vertices_of(session, {*hit});
+    EXPECT_EQ(corners.size(), 12u);
 }
 
 // ---- benchmark button ----

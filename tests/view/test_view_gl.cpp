@@ -275,21 +275,9 @@ TEST(ViewPicture, NoHighlightWithoutCollisions) {
     EXPECT_EQ(count(picture, is_highlight), 0u);
 }
 
-/// @brief A small box wholly inside a big one: every colliding tet is hidden inside the big box.
-ViewSource nested_boxes() {
-    const auto dir = test::temp_dir("nested");
-    TetMesh small = make_box_mesh(2, 2, 2, 1.0);
-    for (double& x : small.positions) x += 3.37;
-    write_tetgen(make_box_mesh(8, 8, 8, 1.0), (dir / "big").string());
-    write_tetgen(small, (dir / "small").string());
-    ViewSource source;
-    source.meshes = {(dir / "big").string(), (dir / "small").string()};
-    return source;
-}
-
 TEST(ViewPicture, InteriorCollisionsShowThroughTheSurface) {
     REQUIRE_GL();
-    const ViewSource source = nested_boxes();
+    const ViewSource source = test::nested_boxes();
     const auto scene = open_view_source(source);
     const std::string files = source.meshes[0] + " " + source.meshes[1];
     const Picture translucent = screenshot(files + " --size 480x360", "nested");
@@ -303,7 +291,7 @@ TEST(ViewPicture, InteriorCollisionsShowThroughTheSurface) {
 
 TEST(ViewPicture, TheClippingPlaneOpensTheMesh) {
     REQUIRE_GL();
-    const ViewSource source = nested_boxes();
+    const ViewSource source = test::nested_boxes();
     const auto scene = open_view_source(source);
     const std::string files = source.meshes[0] + " " + source.meshes[1] + " --size 480x360 --opacity 1";
     struct Cut {
@@ -429,6 +417,39 @@ TEST(ViewRenderer, VertexBuffersAreUpdatedInPlace) {
     EXPECT_EQ(second.position_uploads, 2u * 2u * 31u);
     EXPECT_EQ(second.bytes, first.bytes);
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+TEST(ViewRenderer, TheSelectionIsDrawnOverEverything) {
+    REQUIRE_GL();
+    ViewSession session(test::nested_boxes(), DetectorOptions{}, false);
+    session.update();
+    Renderer renderer;
+    renderer.update(session);
+    OffscreenTarget target(240, 180, 1);
+    DisplaySettings opaque;
+    opaque.surface_opacity = 1.0f; // the selected tet lies inside the big box
+    const auto picture = [&] {
+        target.bind();
+        renderer.draw(camera_for(session.positions(), 240, 180), 0, 0, 240, 180, opaque, Bounds{});
+        return target.read_rgb();
+    };
+    const std::vector<std::uint8_t> before = picture();
+    const std::vector<TetRef> colliding = colliding_tets(session);
+    ASSERT_FALSE(colliding.empty());
+    std::vector<TetRef> shown = {colliding.front()};
+    for (const Partner& p : partners_of(session.result(), colliding.front())) shown.push_back(p.tet);
+    renderer.select(session, shown);
+    const std::vector<std::uint8_t> selected = picture();
+    // Pixels that the selection turned white-grey (it is lit, so not pure white).
+    std::size_t grey = 0;
+    for (std::size_t i = 0; i < selected.size(); i += 3) {
+        const int r = selected[i], g = selected[i + 1], b = selected[i + 2];
+        const bool changed = r != before[i] || g != before[i + 1] || b != before[i + 2];
+        grey += changed && r > 90 && std::abs(r - g) < 12 && std::abs(g - b) < 12;
+    }
+    EXPECT_GT(grey, 20u) << "the selected tet shows through the opaque box";
+    renderer.select(session, {});
+    EXPECT_EQ(picture(), before);
 }
 
 TEST(ViewRenderer, FiftySwitchesKeepBuffersAndMemoryBounded) {

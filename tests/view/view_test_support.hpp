@@ -7,6 +7,7 @@
 #include "test_support.hpp"
 
 #include <kdet/io.hpp>
+#include <kdet/scenes.hpp>
 
 #include <unistd.h>
 
@@ -39,6 +40,19 @@ inline ViewSource octopus_pair() {
     write_tetgen(kdet::test::moved(mesh, 0.3, 0.15 * kdet::test::extent_of(mesh), 0.0, 0.0), (dir / "moved").string());
     ViewSource source;
     source.meshes = {octopus, (dir / "moved").string()};
+    return source;
+}
+
+/// @brief Two mesh files: an 8x8x8 box of unit cubes and a 2x2x2 box wholly inside it, so that
+/// every colliding tet lies inside the big box.
+inline ViewSource nested_boxes() {
+    const auto dir = temp_dir("nested");
+    TetMesh small = make_box_mesh(2, 2, 2, 1.0);
+    for (double& x : small.positions) x += 3.37;
+    write_tetgen(make_box_mesh(8, 8, 8, 1.0), (dir / "big").string());
+    write_tetgen(small, (dir / "small").string());
+    ViewSource source;
+    source.meshes = {(dir / "big").string(), (dir / "small").string()};
     return source;
 }
 

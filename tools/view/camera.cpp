@@ -77,9 +77,7 @@ void OrbitCamera::frame(const std::vector<std::vector<float>>& point_sets, float
     // across and z towards the camera needs distance >= z + |x| / tan(half width).
     const float tan_y = 0.9f * std::tan(radians(fov_y_degrees) * 0.5f);
     const float tan_x = tan_y * std::max(aspect, 1e-3f);
-    const Vec3 forward = normalize(target_ - eye());
-    const Vec3 right = normalize(cross(forward, Vec3{0, 1, 0}));
-    const Vec3 up = cross(right, forward);
+    const auto [forward, right, up] = basis();
     float distance = 1e-3f * scene_radius_;
     for (const std::vector<float>& xyz : point_sets)
         for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) {
@@ -109,10 +107,14 @@ void OrbitCamera::pan(float dx_pixels, float dy_pixels, int viewport_height) {
     // World units per pixel at the target's depth.
     const float scale = 2.0f * distance_ * std::tan(radians(fov_y_degrees) * 0.5f) /
                         static_cast<float>(std::max(viewport_height, 1));
+    const auto [forward, right, up] = basis();
+    target_ = target_ - right * (dx_pixels * scale) + up * (dy_pixels * scale);
+}
+
+std::array<Vec3, 3> OrbitCamera::basis() const {
     const Vec3 forward = normalize(target_ - eye());
     const Vec3 right = normalize(cross(forward, Vec3{0, 1, 0}));
-    const Vec3 up = cross(right, forward);
-    target_ = target_ - right * (dx_pixels * scale) + up * (dy_pixels * scale);
+    return {forward, right, cross(right, forward)};
 }
 
 Vec3 OrbitCamera::eye() const {
@@ -123,9 +125,7 @@ Vec3 OrbitCamera::eye() const {
 
 Mat4 OrbitCamera::view() const {
     const Vec3 from = eye();
-    const Vec3 forward = normalize(target_ - from);
-    const Vec3 right = normalize(cross(forward, Vec3{0, 1, 0}));
-    const Vec3 up = cross(right, forward);
+    const auto [forward, right, up] = basis();
     Mat4 v = Mat4::identity();
     const Vec3 rows[3] = {right, up, forward * -1.0f};
     for (int r = 0; r < 3; ++r) {
@@ -150,6 +150,16 @@ Mat4 OrbitCamera::projection(float aspect) const {
     p.m[11] = -1.0f;
     p.m[14] = 2.0f * far_plane * near_plane / (near_plane - far_plane);
     return p;
+}
+
+std::array<Vec3, 2> OrbitCamera::ray(float x, float y, int width, int height) const {
+    const float tan_y = std::tan(radians(fov_y_degrees) * 0.5f);
+    const float aspect = static_cast<float>(width) / static_cast<float>(std::max(height, 1));
+    const float ndc_x = 2.0f * x / static_cast<float>(std::max(width, 1)) - 1.0f;
+    const float ndc_y = 1.0f - 2.0f * y / static_cast<float>(std::max(height, 1));
+    const Vec3 from = eye();
+    const auto [forward, right, up] = basis();
+    return {from, normalize(forward + right * (ndc_x * tan_y * aspect) + up * (ndc_y * tan_y))};
 }
 
 std::optional<std::array<float, 2>> OrbitCamera::project(Vec3 p, int width, int height) const {

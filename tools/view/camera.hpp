@@ -70,11 +70,18 @@ public:
     Mat4 view() const;
     Mat4 projection(float aspect) const;
 
+    /// @brief The ray from the eye through pixel (x, y) (origin top-left) of a width x height view:
+    /// origin and unit direction.
+    std::array<Vec3, 2> ray(float x, float y, int width, int height) const;
+
     /// @brief Pixel coordinates (x right, y down, in [0, width] x [0, height] when visible) of a
     /// point, or nothing when it lies behind the camera.
     std::optional<std::array<float, 2>> project(Vec3 p, int width, int height) const;
 
 private:
+    /// @brief Unit vectors along the view, to the right and up on screen.
+    std::array<Vec3, 3> basis() const;
+
     Vec3 target_{0, 0, 0};
     Vec3 scene_center_{0, 0, 0}; ///< with scene_radius_, sets the clipping planes
     float yaw_ = default_yaw, pitch_ = default_pitch;

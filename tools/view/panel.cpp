@@ -88,6 +88,7 @@ void Viewer::draw_panel(float width, float height) {
     panel_playback();
     panel_detection();
     panel_results();
+    panel_selection();
     panel_display();
     panel_benchmark();
     if (ImGui::CollapsingHeader("Mouse and keys")) {
@@ -293,6 +294,45 @@ void Viewer::panel_results() {
         std::snprintf(label, sizeof label, "draw %.2f ms", static_cast<double>(last_draw_ms_));
         ImGui::PlotLines("##draw", history_.draw_ms.data(), History::size, history_.next, label, 0.0f,
                          std::max(most, 1.0f) * 1.1f, ImVec2(-1.0f, 60.0f));
+    }
+}
+
+void Viewer::panel_selection() {
+    if (!ImGui::CollapsingHeader("Selected tet (click one)", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    if (!selected_) {
+        ImGui::TextDisabled("nothing selected");
+        return;
+    }
+    const TetRef s = *selected_;
+    const FrameResult& r = session_.result();
+    const bool colliding = s.object < r.colliding.size() && s.tet < r.colliding[s.object].size() && r.colliding[s.object][s.tet];
+    ImGui::Text("object %u, tet %u: %s", s.object, s.tet, colliding ? "colliding" : "not colliding");
+    if (session_.options().method == Method::kdet_no_pairs) {
+        ImGui::TextDisabled("kdet_no_pairs flags tets and builds no pairs");
+    } else if (colliding) {
+        ImGui::TextWrapped("collides with %zu tet(s) (yellow)%s", partners_.size(),
+                    !partners_.empty() && !partners_[0].has_contact ? "; depths with test sat_mtv" : "");
+        constexpr std::size_t listed = 8;
+        for (std::size_t k = 0; k < partners_.size() && k < listed; ++k) {
+            const Partner& p = partners_[k];
+            ImGui::Text("  object %u, tet %u", p.tet.object, p.tet.tet);
+            if (p.has_contact)
+                ImGui::TextDisabled("    depth %.3g along (%.2f, %.2f, %.2f)", static_cast<double>(p.contact.depth),
+                                    static_cast<double>(p.contact.direction[0]), static_cast<double>(p.contact.direction[1]),
+                                    static_cast<double>(p.contact.direction[2]));
+        }
+        if (partners_.size() > listed) ImGui::TextDisabled("and %zu more", partners_.size() - listed);
+    }
+    if (ImGui::Button("frame it")) {
+        std::vector<TetRef> tets = {s};
+        for (const Partner& p : partners_) tets.push_back(p.tet);
+        const std::vector<std::vector<float>> points(1, vertices_of(session_, tets));
+        camera_.frame(points, scene_aspect());
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("clear")) {
+        selected_.reset();
+        selection_version_ = 0;
     }
 }
 

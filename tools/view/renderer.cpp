@@ -128,13 +128,16 @@ Renderer::Renderer() {
     mesh_program_ = link(mesh_vertex_shader, mesh_fragment_shader);
     background_program_ = link(background_vertex_shader, background_fragment_shader);
     glGenVertexArrays(1, &empty_array_);
-    glGenVertexArrays(1, &lines_array_);
+    glGenVertexArrays(1, &contacts_.array);
+    glGenVertexArrays(1, &selection_.array);
 }
 
 Renderer::~Renderer() {
     release_scene();
-    release_buffer(lines_buffer_, lines_capacity_ * sizeof(float));
-    glDeleteVertexArrays(1, &lines_array_);
+    for (Stream* stream : {&contacts_, &selection_}) {
+        release_buffer(stream->buffer, stream->capacity * sizeof(float));
+        glDeleteVertexArrays(1, &stream->array);
+    }
     glDeleteVertexArrays(1, &empty_array_);
     glDeleteProgram(background_program_);
     glDeleteProgram(mesh_program_);
@@ -201,6 +204,7 @@ void Renderer::load_scene(const ViewSession& session) {
     scene_radius_ = std::max(box.radius(), 1e-6f);
     scene_version_ = session.scene_version();
     positions_version_ = result_version_ = 0;
+    contacts_.vertices = selection_.vertices = 0;
 }
 
 void Renderer::update(const ViewSession& session) {
@@ -249,7 +253,7 @@ void Renderer::upload_highlights(const ViewSession& session) {
 
 void Renderer::upload_contacts(const ViewSession& session) {
     const FrameResult& result = session.result();
-    scratch_lines_.clear();
+    scratch_vertices_.clear();
     if (!result.contacts.empty()) {
         const auto centroid = [&](std::uint32_t object, std::uint32_t tet, int axis) {
             const std::uint32_t* v = &session.scene().rest_mesh(object).tets[4 * static_cast<std::size_t>(tet)];
@@ -266,26 +270,45 @@ void Renderer::upload_contacts(const ViewSession& session) {
             float base[3];
             for (int a = 0; a < 3; ++a) base[a] = 0.5f * (centroid(p.object_a, p.tet_a, a) + centroid(p.object_b, p.tet_b, a));
             const float* d = result.contacts[k].direction;
-            scratch_lines_.insert(scratch_lines_.end(), {base[0], base[1], base[2], 0, 0, 0});
-            scratch_lines_.insert(scratch_lines_.end(), {base[0], base[1], base[2], d[0], d[1], d[2]});
+            scratch_vertices_.insert(scratch_vertices_.end(), {base[0], base[1], base[2], 0, 0, 0});
+            scratch_vertices_.insert(scratch_vertices_.end(), {base[0], base[1], base[2], d[0], d[1], d[2]});
         }
     }
-    contact_vertices_ = scratch_lines_.size() / 6;
-    if (contact_vertices_ == 0) return;
-    glBindVertexArray(lines_array_);
-    if (scratch_lines_.size() > lines_capacity_) {
-        release_buffer(lines_buffer_, lines_capacity_ * sizeof(float));
-        lines_capacity_ = std::max(scratch_lines_.size(), 2 * lines_capacity_);
-        lines_buffer_ = make_buffer(GL_ARRAY_BUFFER, lines_capacity_ * sizeof(float), nullptr, GL_DYNAMIC_DRAW);
+    upload_stream(contacts_, scratch_vertices_);
+}
+
+void Renderer::upload_stream(Stream& stream, const std::vector<float>& vertices) {
+    stream.vertices = vertices.size() / 6;
+    if (stream.vertices == 0) return;
+    glBindVertexArray(stream.array);
+    if (vertices.size() > stream.capacity) {
+        release_buffer(stream.buffer, stream.capacity * sizeof(float));
+        stream.capacity = std::max(vertices.size(), 2 * stream.capacity);
+        stream.buffer = make_buffer(GL_ARRAY_BUFFER, stream.capacity * sizeof(float), nullptr, GL_DYNAMIC_DRAW);
         glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
         glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<const void*>(3 * sizeof(float)));
         glEnableVertexAttribArray(0);
         glEnableVertexAttribArray(1);
     }
-    glBindBuffer(GL_ARRAY_BUFFER, lines_buffer_);
-    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(scratch_lines_.size() * sizeof(float)),
-                    scratch_lines_.data());
+    glBindBuffer(GL_ARRAY_BUFFER, stream.buffer);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)), vertices.data());
     glBindVertexArray(0);
+}
+
+void Renderer::select(const ViewSession& session, const std::vector<TetRef>& tets) {
+    // Every face of every tet as its own triangle; the first tet is the selected one.
+    scratch_vertices_.clear();
+    for (const TetRef& ref : tets) {
+        if (ref.object >= session.positions().size()) continue;
+        const std::uint32_t* v = &session.scene().rest_mesh(ref.object).tets[4 * static_cast<std::size_t>(ref.tet)];
+        const std::vector<float>& p = session.positions()[ref.object];
+        for (const auto& corners : tet_face_vertices)
+            for (const int c : corners) {
+                const std::size_t i = 3 * static_cast<std::size_t>(v[c]);
+                scratch_vertices_.insert(scratch_vertices_.end(), {p[i], p[i + 1], p[i + 2], 0, 0, 0});
+            }
+    }
+    upload_stream(selection_, scratch_vertices_);
 }
 
 void Renderer::draw_objects(bool surfaces, bool highlights) const {
@@ -324,20 +347,13 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
     glUniformMatrix4fv(uniform(mesh_program_, "projection"), 1, GL_FALSE, projection.m.data());
     glUniform1f(uniform(mesh_program_, "offset_scale"), 0.0f);
     glVertexAttrib3f(1, 0.0f, 0.0f, 0.0f);
-    float plane[4] = {0, 0, 0, 1};
-    if (display.clip && !scene_box.empty()) {
-        const float lo[3] = {scene_box.lo.x, scene_box.lo.y, scene_box.lo.z};
-        const float hi[3] = {scene_box.hi.x, scene_box.hi.y, scene_box.hi.z};
-        const int a = std::clamp(display.clip_axis, 0, 2);
-        const float at = lo[a] + display.clip_position * (hi[a] - lo[a]);
-        const float side = display.clip_flip ? 1.0f : -1.0f; // kept: side * (x - at) >= 0
-        plane[a] = side;
-        plane[3] = -side * at;
+    const std::array<float, 4> plane = clip_plane(display, scene_box);
+    if (display.clip) {
         glEnable(GL_CLIP_DISTANCE0);
     } else {
         glDisable(GL_CLIP_DISTANCE0);
     }
-    glUniform4fv(uniform(mesh_program_, "clip_plane"), 1, plane);
+    glUniform4fv(uniform(mesh_program_, "clip_plane"), 1, plane.data());
 
     const GLint lit = uniform(mesh_program_, "lit"), back = uniform(mesh_program_, "shade_back_faces");
     const bool translucent = display.surface_opacity < 1.0f && !display.only_colliding;
@@ -404,13 +420,27 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
         glUniform1i(lit, 1);
     }
 
-    if (display.contact_normals && contact_vertices_ > 0) {
+    if (selection_.vertices > 0) {
+        // The tets the selected one collides with in yellow over everything else (they usually
+        // lie inside other colliding tets), and the selected tet in white over them.
+        glUniform1i(lit, 1);
+        glBindVertexArray(selection_.array);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        set_color(mesh_program_, Color{1.0f, 0.82f, 0.25f}, 1.0f);
+        glDrawArrays(GL_TRIANGLES, 12, static_cast<GLsizei>(selection_.vertices) - 12);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        set_color(mesh_program_, Color{0.95f, 0.95f, 0.95f}, 1.0f);
+        glDrawArrays(GL_TRIANGLES, 0, 12);
+        glBindVertexArray(0);
+    }
+
+    if (display.contact_normals && contacts_.vertices > 0) {
         glUniform1i(lit, 0);
         glUniform1f(uniform(mesh_program_, "offset_scale"), 0.05f * scene_radius_ * display.normal_length);
         set_color(mesh_program_, Color{1.0f, 0.88f, 0.22f}, 1.0f);
         if (translucent) glDisable(GL_DEPTH_TEST);
-        glBindVertexArray(lines_array_);
-        glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(contact_vertices_));
+        glBindVertexArray(contacts_.array);
+        glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(contacts_.vertices));
         glBindVertexArray(0);
         glEnable(GL_DEPTH_TEST);
     }

@@ -4,6 +4,7 @@
 /// clipping plane and contact normals. It only reads the session's positions and results.
 
 #include "camera.hpp"
+#include "picking.hpp"
 #include "session.hpp"
 #include "view_args.hpp"
 
@@ -52,9 +53,13 @@ public:
     void draw(const OrbitCamera& camera, int x, int y, int width, int height, const DisplaySettings& display,
               const Bounds& scene_box) const;
 
+    /// @brief Shows @p tets (the selected tet first, then its partners) over everything else, at the
+    /// session's current positions; an empty list clears the selection.
+    void select(const ViewSession& session, const std::vector<TetRef>& tets);
+
     const BufferStats& stats() const { return stats_; }
     /// @brief Contact normals the last update() prepared (0 without contacts).
-    std::size_t contact_lines() const { return contact_vertices_ / 2; }
+    std::size_t contact_lines() const { return contacts_.vertices / 2; }
 
 private:
     struct ObjectBuffers {
@@ -67,7 +72,16 @@ private:
         std::size_t vertex_bytes = 0;
     };
 
+    /// @brief Vertices drawn without indices: position and offset (6 floats) each.
+    struct Stream {
+        unsigned array = 0, buffer = 0;
+        std::size_t capacity = 0; ///< floats
+        std::size_t vertices = 0;
+    };
+
     unsigned make_buffer(unsigned target, std::size_t bytes, const void* data, unsigned usage);
+    /// @brief Writes @p vertices into the stream's buffer, which grows geometrically when too small.
+    void upload_stream(Stream& stream, const std::vector<float>& vertices);
     void release_buffer(unsigned& buffer, std::size_t bytes);
     void release_scene();
     void load_scene(const ViewSession& session);
@@ -76,14 +90,12 @@ private:
     void draw_objects(bool surfaces, bool highlights) const;
 
     unsigned mesh_program_ = 0, background_program_ = 0, empty_array_ = 0;
-    unsigned lines_array_ = 0, lines_buffer_ = 0;
-    std::size_t lines_capacity_ = 0; ///< floats
-    std::size_t contact_vertices_ = 0;
+    Stream contacts_, selection_;
     std::vector<ObjectBuffers> objects_;
     std::uint64_t scene_version_ = 0, positions_version_ = 0, result_version_ = 0;
     float scene_radius_ = 1.0f;
     std::vector<std::uint32_t> scratch_indices_;
-    std::vector<float> scratch_lines_;
+    std::vector<float> scratch_vertices_;
     BufferStats stats_;
 };
 

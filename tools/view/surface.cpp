@@ -54,6 +54,7 @@ MeshFaces analyse_faces(const TetMesh& mesh) {
         while (j < faces.size() && faces[j].key == faces[i].key) ++j;
         if (j - i == 1) {
             out.boundary.insert(out.boundary.end(), faces[i].oriented.begin(), faces[i].oriented.end());
+            out.boundary_tet.push_back(faces[i].tet);
         } else if (j - i == 2) {
             out.neighbour[4 * faces[i].tet + faces[i].k] = faces[i + 1].tet;
             out.neighbour[4 * faces[i + 1].tet + faces[i + 1].k] = faces[i].tet;

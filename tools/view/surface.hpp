@@ -22,6 +22,8 @@ struct MeshFaces {
     /// Faces shared by two tets are interior; a face used by three or more tets (a non-manifold
     /// mesh) is interior too.
     std::vector<std::uint32_t> boundary;
+    /// The tet each boundary triangle belongs to.
+    std::vector<std::uint32_t> boundary_tet;
     /// neighbour[4 * t + k]: the tet across face k of tet t, or no_tet on the boundary (and for
     /// faces of a non-manifold fan).
     std::vector<std::uint32_t> neighbour;

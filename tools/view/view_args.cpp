@@ -24,9 +24,10 @@ counts, stage times and memory, a frame-time plot and a benchmark button.
 SCENE is anything `kdet bench` opens: procedural (default), a thesis scene, a .scene file, a
 .kdetrec recording or a folder of per-frame meshes. A [B] are mesh files as in `kdet collide`.
 
-mouse and keys: left drag orbits, right or middle drag (or shift + left) pans, the wheel zooms;
-  space plays and pauses, left/right step a frame, R resets the camera, F frames the colliding tets,
-  P saves a screenshot, W wireframe, C clipping plane, H colliding tets only, Tab hides the panel,
+mouse and keys: left drag orbits, right or middle drag (or shift + left) pans, the wheel zooms, a
+  click selects a tet (the panel lists the tets it collides with); space plays and pauses,
+  left/right step a frame, R resets the camera, F frames the colliding tets, P saves a screenshot,
+  W wireframe, C clipping plane, H colliding tets only, N contact normals, Tab hides the panel,
   Esc quits.
 
 scene options:
@@ -101,6 +102,19 @@ bool names_a_scene(const std::string& argument) {
     if (extension == ".scene" || extension == ".kdetrec") return true;
     std::error_code error;
     return std::filesystem::is_directory(argument, error);
+}
+
+std::array<float, 4> clip_plane(const DisplaySettings& display, const Bounds& scene_box) {
+    std::array<float, 4> plane = {0, 0, 0, 1};
+    if (!display.clip || scene_box.empty()) return plane;
+    const float lo[3] = {scene_box.lo.x, scene_box.lo.y, scene_box.lo.z};
+    const float hi[3] = {scene_box.hi.x, scene_box.hi.y, scene_box.hi.z};
+    const int a = std::clamp(display.clip_axis, 0, 2);
+    const float at = lo[a] + display.clip_position * (hi[a] - lo[a]);
+    const float side = display.clip_flip ? 1.0f : -1.0f; // kept: side * (x - at) >= 0
+    plane[static_cast<std::size_t>(a)] = side;
+    plane[3] = -side * at;
+    return plane;
 }
 
 std::string view_help() { return std::string(help_text) + cli::detector_options_help() + display_help; }

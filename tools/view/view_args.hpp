@@ -2,6 +2,7 @@
 /// @file view_args.hpp
 /// @brief The command line of `kdet view`.
 
+#include "camera.hpp"
 #include "session.hpp"
 
 #include <kdet/options.hpp>
@@ -22,6 +23,10 @@ struct DisplaySettings {
     bool clip_flip = false;        ///< keep the upper side of the plane instead of the lower
     float clip_position = 0.5f;    ///< across the scene's box along the axis, 0 to 1
 };
+
+/// @brief The clipping plane across @p scene_box as (a, b, c, d): a point is kept when
+/// a x + b y + c z + d >= 0. Keeps everything when the plane is off.
+std::array<float, 4> clip_plane(const DisplaySettings& display, const Bounds& scene_box);
 
 /// @brief Where the camera starts.
 struct CameraRequest {

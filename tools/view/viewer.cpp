@@ -36,24 +36,6 @@ Bounds bounds_of(const ViewSession& session) {
     return box;
 }
 
-/// @brief The vertices of every colliding tet (repeated where tets share them), x y z each.
-std::vector<float> colliding_points_of(const ViewSession& session) {
-    std::vector<float> points;
-    const FrameResult& result = session.result();
-    for (std::size_t o = 0; o < result.colliding.size() && o < session.positions().size(); ++o) {
-        const std::vector<float>& p = session.positions()[o];
-        const TetMesh& mesh = session.scene().rest_mesh(o);
-        for (std::size_t t = 0; t < result.colliding[o].size(); ++t) {
-            if (!result.colliding[o][t]) continue;
-            for (int k = 0; k < 4; ++k) {
-                const std::size_t v = mesh.tets[4 * t + static_cast<std::size_t>(k)];
-                points.insert(points.end(), {p[3 * v], p[3 * v + 1], p[3 * v + 2]});
-            }
-        }
-    }
-    return points;
-}
-
 double median(std::vector<double> values) {
     if (values.empty()) return 0;
     std::sort(values.begin(), values.end());
@@ -143,7 +125,7 @@ void Viewer::reset_camera(float aspect) {
 }
 
 void Viewer::frame_colliding(float aspect) {
-    std::vector<std::vector<float>> points(1, colliding_points_of(session_));
+    const std::vector<std::vector<float>> points(1, vertices_of(session_, colliding_tets(session_)));
     if (points[0].empty()) {
         set_status("nothing collides in this frame");
         return;
@@ -166,6 +148,7 @@ void Viewer::apply(const DetectorOptions& options) {
 void Viewer::open_source(const ViewSource& source) {
     try {
         session_.open(source);
+        selected_.reset();
         config_.source = source;
         session_.update();
         reset_camera(scene_aspect());
@@ -227,6 +210,14 @@ void Viewer::handle_key(int key) {
     }
 }
 
+void Viewer::handle_click(int scene_x, int scene_width, int scene_height) {
+    const ImGuiIO& io = ImGui::GetIO();
+    if (io.WantCaptureMouse || !io.MouseReleased[0] || io.MouseDragMaxDistanceSqr[0] > 16.0f) return;
+    selected_ = pick_tet(session_, camera_, io.MousePos.x - static_cast<float>(scene_x), io.MousePos.y, scene_width,
+                         scene_height, config_.display, scene_box_);
+    selection_version_ = 0;
+}
+
 void Viewer::handle_input(int scene_height) {
     for (const int key : pending_keys_) handle_key(key);
     pending_keys_.clear();
@@ -277,6 +268,7 @@ void Viewer::run() {
         if (panel_shown_) draw_panel(panel_width, static_cast<float>(window_height));
         const int scene_x = panel_shown_ ? static_cast<int>(panel_width) : 0;
         handle_input(window_height);
+        handle_click(scene_x, window_width - scene_x, window_height);
         ImGui::Render();
 
         if (bench_job_ && bench_job_->finished()) {
@@ -295,6 +287,16 @@ void Viewer::run() {
         // The benchmark has the processor to itself: the view keeps its last frame meanwhile.
         const bool computed = !bench_job_ && session_.update();
         renderer_->update(session_);
+        if (selection_version_ != session_.result_version()) {
+            // The selection follows its tet through the frames; a new scene drops it.
+            if (selected_ && selected_->object >= session_.scene().num_objects()) selected_.reset();
+            partners_ = selected_ ? partners_of(session_.result(), *selected_) : std::vector<Partner>{};
+            std::vector<TetRef> shown;
+            if (selected_) shown.push_back(*selected_);
+            for (const Partner& p : partners_) shown.push_back(p.tet);
+            renderer_->select(session_, shown);
+            selection_version_ = session_.result_version();
+        }
 
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         glViewport(0, 0, fb_width, fb_height);

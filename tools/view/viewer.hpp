@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,9 @@ private:
     void panel_display();
     void panel_results();
     void panel_benchmark();
+    void panel_selection();
+    /// @brief Picks the tet under the cursor after a click (a press and release without a drag).
+    void handle_click(int scene_x, int scene_width, int scene_height);
     void save_window_screenshot(int width, int height);
     void set_status(const std::string& text);
     /// @brief Runs ImGui for one frame of the given size, with the panel when it is shown.
@@ -80,6 +84,9 @@ private:
     bool playing_ = false, loop_ = true;
     bool screenshot_requested_ = false;
     std::vector<int> pending_keys_;
+    std::optional<TetRef> selected_;
+    std::vector<Partner> partners_;      ///< of the selected tet, in the shown frame
+    std::uint64_t selection_version_ = 0; ///< the session's result version partners_ belong to
     int bench_runs_ = 3;
     std::string bench_dir_ = "exports/benchmark_data";
     std::unique_ptr<BenchJob> bench_job_;
