@@ -274,10 +274,10 @@ void Viewer::panel_results() {
         row_ms("sort + unique", t.sort_unique);
         row_ms("narrow phase", t.narrow_phase);
         row_ms("detect() total", t.total);
-        if (timer_frame_ > 1) {
-            row_ms("drawing (GPU)", last_draw_ms_);
+        if (draw_measured_) {
+            row_ms("drawing", last_draw_ms_);
         } else {
-            row("drawing (GPU)", "not measured yet");
+            row("drawing", "not measured yet");
         }
         row("detector memory", mebibytes(r.memory_bytes));
         row("  grid / candidates", mebibytes(r.grid_bytes) + " / " + mebibytes(r.candidate_bytes));
@@ -286,14 +286,19 @@ void Viewer::panel_results() {
         ImGui::EndTable();
     }
     if (history_.count > 0) {
-        const float most = *std::max_element(history_.detect_ms.begin(), history_.detect_ms.end());
+        // Both plots share one scale, so that their heights compare.
+        const float most = std::max(*std::max_element(history_.detect_ms.begin(), history_.detect_ms.end()),
+                                    *std::max_element(history_.draw_ms.begin(), history_.draw_ms.end()));
+        const ImVec2 size(ImGui::GetContentRegionAvail().x, 56.0f);
+        // The ring holds the newest `count` values; until it is full they start at 0.
+        const int offset = history_.count < History::size ? 0 : history_.next;
         char label[64];
-        std::snprintf(label, sizeof label, "detect %.2f ms", static_cast<double>(t.total));
-        ImGui::PlotLines("##detect", history_.detect_ms.data(), History::size, history_.next, label, 0.0f,
-                         std::max(most, 1.0f) * 1.1f, ImVec2(-1.0f, 60.0f));
-        std::snprintf(label, sizeof label, "draw %.2f ms", static_cast<double>(last_draw_ms_));
-        ImGui::PlotLines("##draw", history_.draw_ms.data(), History::size, history_.next, label, 0.0f,
-                         std::max(most, 1.0f) * 1.1f, ImVec2(-1.0f, 60.0f));
+        std::snprintf(label, sizeof label, "detect() %.2f ms", t.total);
+        ImGui::PlotLines("##detect", history_.detect_ms.data(), history_.count, offset, label, 0.0f,
+                         std::max(most, 1.0f) * 1.1f, size);
+        std::snprintf(label, sizeof label, "drawing %.2f ms", static_cast<double>(last_draw_ms_));
+        ImGui::PlotLines("##draw", history_.draw_ms.data(), history_.count, offset, label, 0.0f,
+                         std::max(most, 1.0f) * 1.1f, size);
     }
 }
 

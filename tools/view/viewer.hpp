@@ -95,9 +95,8 @@ private:
     std::string status_;
     std::chrono::steady_clock::time_point status_time_{};
     History history_;
-    float last_draw_ms_ = 0;
-    unsigned timer_queries_[2] = {0, 0};
-    int timer_frame_ = 0;
+    float last_draw_ms_ = 0;      ///< the scene's drawing in the last frame, until the driver finished
+    bool draw_measured_ = false;
 };
 
 } // namespace kdet::view
