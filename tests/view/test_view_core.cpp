@@ -418,6 +418,38 @@ TEST(ViewSession, FiftySwitchesOfSceneAndMethodKeepMemoryBounded) {
         << "resident set grew from " << resident_after_warm_up << " to " << most_resident << " bytes";
 }
 
+TEST(ViewSession, OpensEveryKindOfSource) {
+    // What `kdet view` takes: a scene file, a recording, a folder of frames, mesh files; each shows
+    // the pairs of a Detector of its own.
+    const auto dir = temp_dir("sources");
+    write_tetgen(make_box_mesh(3, 3, 3, 1.0), (dir / "box").string());
+    std::ofstream(dir / "two.scene") << "kdet-scene 1\nframes 4\nobject a\n  file box.node\nobject b\n  file box.node\n"
+                                        "  translate 1.5 0.5 0\n  key 0 move 0 0 0\n  key 3 move 1 0 0\n";
+    ViewSource scene_file;
+    scene_file.scene = (dir / "two.scene").string();
+    write_recording(*open_view_source(procedural(2000, 5)), (dir / "run.kdetrec").string());
+    ViewSource recording;
+    recording.scene = (dir / "run.kdetrec").string();
+    std::filesystem::create_directories(dir / "frames");
+    for (int f = 0; f < 3; ++f) {
+        TetMesh frame = make_box_mesh(2, 2, 2, 1.0);
+        for (std::size_t i = 0; i < frame.positions.size(); i += 3) frame.positions[i] += 0.1 * f;
+        write_vtk(frame, (dir / "frames" / ("frame_" + std::to_string(f) + ".vtk")).string());
+    }
+    ViewSource folder;
+    folder.scene = (dir / "frames").string();
+    for (const ViewSource& source : {scene_file, recording, folder, octopus_pair()}) {
+        SCOPED_TRACE(source.meshes.empty() ? source.scene : source.meshes[0]);
+        ViewSession session(source, DetectorOptions{}, true);
+        session.set_frame(session.num_frames() - 1);
+        session.update();
+        EXPECT_EQ(session.result().pairs, reference_pairs(session.scene(), session.frame(), true));
+        EXPECT_EQ(session.faces().size(), session.scene().num_objects());
+    }
+    EXPECT_EQ(ViewSession(scene_file, DetectorOptions{}, false).num_frames(), 4);
+    EXPECT_EQ(ViewSession(folder, DetectorOptions{}, false).num_frames(), 3);
+}
+
 TEST(ViewSession, AFailedOpenKeepsTheSceneShown) {
     ViewSession session(procedural(2000, 5), DetectorOptions{}, false);
     session.update();
