@@ -91,12 +91,7 @@ void Viewer::draw_panel(float width, float height) {
     panel_selection();
     panel_display();
     panel_benchmark();
-    if (ImGui::CollapsingHeader("Mouse and keys")) {
-        ImGui::TextWrapped("Left drag: orbit. Right or middle drag, or shift + left drag: pan. Wheel: zoom.\n"
-                           "Space: play/pause. Left/right: step. R: reset camera. F: frame the colliding tets. "
-                           "P: screenshot. W: wireframe. C: clipping plane. H: colliding tets only. N: contact "
-                           "normals. Tab: hide this panel. Esc: quit.");
-    }
+    if (ImGui::CollapsingHeader("Mouse and keys")) ImGui::TextWrapped("%s", controls_help());
     ImGui::PopItemWidth();
     ImGui::End();
 }
@@ -144,7 +139,8 @@ void Viewer::panel_scene() {
         }
     } else if (uses_resolution(source)) {
         int resolution = source.request.resolution;
-        if (ImGui::SliderInt("resolution", &resolution, 1, 4)) {
+        ImGui::SliderInt("resolution", &resolution, 1, 4);
+        if (ImGui::IsItemDeactivatedAfterEdit()) {
             source.request.resolution = resolution;
             open_source(source);
         }
@@ -155,10 +151,12 @@ void Viewer::panel_scene() {
     const Scene& scene = session_.scene();
     for (std::size_t o = 0; o < scene.num_objects(); ++o) {
         const Color c = object_color(o);
+        ImGui::PushID(static_cast<int>(o));
         ImGui::ColorButton("##color", ImVec4(c.r, c.g, c.b, 1.0f), ImGuiColorEditFlags_NoTooltip, ImVec2(12, 12));
         ImGui::SameLine();
         ImGui::Text("object %zu: %zu tets, %zu surface triangles", o, scene.rest_mesh(o).num_tets(),
                     session_.faces()[o].boundary.size() / 3);
+        ImGui::PopID();
     }
 }
 

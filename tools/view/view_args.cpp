@@ -24,12 +24,6 @@ counts, stage times and memory, a frame-time plot and a benchmark button.
 SCENE is anything `kdet bench` opens: procedural (default), a thesis scene, a .scene file, a
 .kdetrec recording or a folder of per-frame meshes. A [B] are mesh files as in `kdet collide`.
 
-mouse and keys: left drag orbits, right or middle drag (or shift + left) pans, the wheel zooms, a
-  click selects a tet (the panel lists the tets it collides with); space plays and pauses,
-  left/right step a frame, R resets the camera, F frames the colliding tets, P saves a screenshot,
-  W wireframe, C clipping plane, H colliding tets only, N contact normals, Tab hides the panel,
-  Esc quits.
-
 scene options:
   --self               self-collision of every object (as `kdet bench -s yes`)
   --res N, -r N        resolution 1-4 of the thesis scenes (default 1)
@@ -40,6 +34,30 @@ scene options:
 
 detector options:
 )";
+
+const char* controls = "left drag orbits, right or middle drag (or shift + left) pans, the wheel zooms, a click "
+                       "selects a tet (the panel lists the tets it collides with); space plays and pauses, left/right "
+                       "step a frame, R resets the camera, F frames the colliding tets, P saves a screenshot, W "
+                       "wireframe, C clipping plane, H colliding tets only, N contact normals, Tab hides the panel, "
+                       "Esc quits.";
+
+/// @brief @p text broken into lines of at most @p width characters, each after @p indent.
+std::string wrapped(const std::string& text, std::size_t width, const std::string& indent) {
+    std::string out, line;
+    std::size_t start = 0;
+    while (start < text.size()) {
+        std::size_t end = text.find(' ', start);
+        if (end == std::string::npos) end = text.size();
+        const std::string word = text.substr(start, end - start);
+        if (!line.empty() && indent.size() + line.size() + 1 + word.size() > width) {
+            out += indent + line + "\n";
+            line.clear();
+        }
+        line += (line.empty() ? "" : " ") + word;
+        start = end + 1;
+    }
+    return out + indent + line + "\n";
+}
 
 const char* display_help = R"(
 display options (the panel changes them too):
@@ -117,7 +135,12 @@ std::array<float, 4> clip_plane(const DisplaySettings& display, const Bounds& sc
     return plane;
 }
 
-std::string view_help() { return std::string(help_text) + cli::detector_options_help() + display_help; }
+const char* controls_help() { return controls; }
+
+std::string view_help() {
+    return std::string(help_text) + cli::detector_options_help() + display_help + "\nmouse and keys:\n" +
+           wrapped(controls, 100, "  ");
+}
 
 ViewConfig parse_view_args(int argc, char** argv, int first) {
     ViewConfig config;

@@ -59,6 +59,9 @@ bool names_a_scene(const std::string& argument);
 /// @brief Parses `argv[first..argc)`; throws cli::UsageError naming the flag and what it accepts.
 ViewConfig parse_view_args(int argc, char** argv, int first);
 
+/// @brief What the mouse and the keys do, in one paragraph (the panel shows it too).
+const char* controls_help();
+
 /// @brief The text of `kdet view --help`.
 std::string view_help();
 

@@ -90,7 +90,6 @@ Viewer::Viewer(ViewSession& session, const ViewConfig& config, bool visible) : s
     glfwSetKeyCallback(window_, on_key);
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
-    imgui_ready_ = true;
     renderer_ = std::make_unique<Renderer>();
     session_.set_frame(config.frame);
 }
@@ -98,11 +97,9 @@ Viewer::Viewer(ViewSession& session, const ViewConfig& config, bool visible) : s
 Viewer::~Viewer() {
     bench_job_.reset();
     renderer_.reset();
-    if (imgui_ready_) {
-        ImGui_ImplOpenGL3_Shutdown();
-        ImGui_ImplGlfw_Shutdown();
-        ImGui::DestroyContext();
-    }
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
     glfwDestroyWindow(window_);
     glfwTerminate();
 }
@@ -300,8 +297,8 @@ void Viewer::run() {
         glViewport(0, 0, fb_width, fb_height);
         glClearColor(0.09f, 0.09f, 0.10f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        // Drawing is timed to its end: the scene, the uploads above included, finishes before the
-        // next detection starts, so that a software renderer does not run beside it.
+        // Drawing is timed to its end (glFinish), which also keeps a software renderer from running
+        // beside the next detection.
         const auto draw_start = std::chrono::steady_clock::now();
         const int fb_scene_x = static_cast<int>(static_cast<float>(scene_x) * scale);
         renderer_->draw(camera_, fb_scene_x, 0, fb_width - fb_scene_x, fb_height, config_.display, scene_box_);

@@ -76,7 +76,6 @@ private:
     ViewSession& session_;
     ViewConfig config_;
     GLFWwindow* window_ = nullptr;
-    bool imgui_ready_ = false;
     std::unique_ptr<Renderer> renderer_;
     OrbitCamera camera_;
     Bounds scene_box_;            ///< the box the camera and the clipping plane were set up with
