@@ -350,7 +350,9 @@ void Viewer::panel_benchmark() {
         bench_job_ = std::make_unique<BenchJob>(session_.source(), bench_config_of(session_, bench_runs_, bench_dir_));
     }
     ImGui::EndDisabled();
+    ImGui::PushTextWrapPos(0.0f);
     ImGui::TextDisabled("every frame, %d run(s), no drawing; the CSV files of kdet bench", bench_runs_);
+    ImGui::PopTextWrapPos();
     if (bench_job_) {
         ImGui::ProgressBar(bench_job_->progress());
         if (ImGui::Button("stop")) bench_job_->stop();
