@@ -5,6 +5,9 @@ set -euo pipefail
 # ninja-build: the generator scikit-build-core uses for it, the same one for every pip call.
 packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3 python3-venv python3-dev ninja-build clang
   libclang-rt-14-dev tetgen)
+# `kdet view`: GLFW, Dear ImGui (with its GLFW and OpenGL 3 backends), libepoxy, libpng; its tests draw
+# under Xvfb with Mesa's software renderer (llvmpipe).
+packages+=(pkg-config libglfw3-dev libimgui-dev libepoxy-dev libpng-dev xvfb xauth libgl1-mesa-dri)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

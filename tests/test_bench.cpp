@@ -296,8 +296,15 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     config.last_frame = 3;
     config.self = true;
     const auto scene = open_scene("procedural", config.request);
-    ProgressBar progress(false, config.runs, 3);
+    std::vector<std::pair<int, int>> reported;
+    const BenchProgress progress = [&](int run, int frame_index) {
+        reported.emplace_back(run, frame_index);
+        return true;
+    };
     const BenchOutcome outcome = run_benchmark(config, *scene, progress);
+    const std::vector<std::pair<int, int>> every_frame = {{0, 0}, {0, 1}, {0, 2}, {1, 0}, {1, 1}, {1, 2}};
+    EXPECT_EQ(reported, every_frame);
+    EXPECT_FALSE(outcome.stopped);
 
     const std::vector<std::string> thesis_keys = {"scene name",        "resolution", "algorithm", "block size",
                                                   "overlap test",      "self collisions", "hashing algorithm",
@@ -343,13 +350,25 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     EXPECT_NE(brute.stem.find("_gpu_sat_none_g128_"), std::string::npos) << brute.stem;
 }
 
+TEST(BenchRunner, ProgressCanStopIt) {
+    BenchConfig config;
+    config.request.procedural = ProceduralSceneOptions{400, 4};
+    config.runs = 3;
+    const auto scene = open_scene("procedural", config.request);
+    int frames_allowed = 6;
+    const BenchOutcome outcome = run_benchmark(config, *scene, [&](int, int) { return frames_allowed-- > 0; });
+    EXPECT_TRUE(outcome.stopped);
+    ASSERT_EQ(outcome.runs.size(), 2u);
+    EXPECT_EQ(outcome.runs[0].size(), 4u);
+    EXPECT_EQ(outcome.runs[1].size(), 2u);
+}
+
 TEST(BenchRunner, FilesHoldAveragesAndRuns) {
     BenchConfig config;
     config.request.procedural = ProceduralSceneOptions{600, 5};
     config.runs = 3;
     const auto scene = open_scene("procedural", config.request);
-    ProgressBar progress(false, config.runs, 5);
-    const BenchOutcome outcome = run_benchmark(config, *scene, progress);
+    const BenchOutcome outcome = run_benchmark(config, *scene, [](int, int) { return true; });
     const auto dir = temp_dir("files") / "nested";
     const BenchFiles files = write_bench_files(dir.string(), outcome.stem, outcome.header, outcome.runs);
     EXPECT_EQ(files.averages, (dir / (outcome.stem + ".csv")).string());

@@ -204,7 +204,26 @@ TEST(Cli, HelpAndVersion) {
     EXPECT_EQ(help.exit_code, 0);
     EXPECT_NE(help.out.find("--pairs FILE"), std::string::npos);
     EXPECT_EQ(kdet_cli("bench --help").exit_code, 0);
+    EXPECT_NE(kdet_cli("--help").out.find("view [SCENE | A [B]]"), std::string::npos);
 }
+
+#ifdef KDET_VIEWER_LEFT_OUT
+TEST(Cli, ViewSaysItWasNotBuilt) {
+    for (const char* arguments : {"view", "view --tets 1000 --screenshot x.png", "view --help"}) {
+        const Outcome r = kdet_cli(arguments);
+        EXPECT_EQ(r.exit_code, 1) << arguments;
+        EXPECT_NE(r.out.find("built without the viewer"), std::string::npos) << r.out;
+        EXPECT_EQ(line_count(r.out), 1u) << r.out;
+    }
+}
+#else
+TEST(Cli, ViewHelpNamesItsOptions) {
+    const Outcome help = kdet_cli("view --help");
+    EXPECT_EQ(help.exit_code, 0) << help.out;
+    for (const char* option : {"--screenshot FILE", "--size WxH", "--method M", "--clip AXIS", "--profile"})
+        EXPECT_NE(help.out.find(option), std::string::npos) << option;
+}
+#endif
 
 #endif
 

@@ -61,6 +61,11 @@ std::string bench_method_name(Method method) {
 
 std::string bench_help() { return help_text(); }
 
+const std::vector<std::string>& bench_block_sizes() {
+    static const std::vector<std::string> sizes = {"16", "32", "64", "128", "256"};
+    return sizes;
+}
+
 BenchConfig parse_bench_args(int argc, char** argv, int first) {
     BenchConfig config;
     std::vector<std::string> scene;
@@ -74,7 +79,7 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     parser.option("-c", "method", [&](const std::string& v) { config.options.method = parse_option<Method>("-c", v); });
     parser.option("-o", "test", [&](const std::string& v) { config.options.narrow_phase = parse_option<NarrowPhase>("-o", v); });
     parser.option("-g", "block size", [&](const std::string& v) {
-        config.options.block_size = std::stoi(parse_choice("-g", v, {"16", "32", "64", "128", "256"}));
+        config.options.block_size = std::stoi(parse_choice("-g", v, bench_block_sizes()));
     });
     parser.option("-n", "runs", [&](const std::string& v) { config.runs = static_cast<int>(parse_integer("-n", v, 1, 20)); });
     parser.option("-s", "yes|no", [&](const std::string& v) {

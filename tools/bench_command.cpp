@@ -89,7 +89,11 @@ int run_bench(int argc, char** argv) {
         throw Error("bench: --backend cuda is not available here: " + reason);
     const std::unique_ptr<Scene> scene = open_bench_scene(config);
     ProgressBar progress(!config.quiet, config.runs, last_frame_of(config, *scene) - config.first_frame + 1);
-    const BenchOutcome outcome = run_benchmark(config, *scene, progress);
+    const BenchOutcome outcome = run_benchmark(config, *scene, [&](int run, int frame_index) {
+        progress.update(run, frame_index);
+        return true;
+    });
+    progress.finish();
     const BenchFiles files = write_bench_files(config.output_dir, outcome.stem, outcome.header, outcome.runs);
     print_report(config, *scene, outcome, files);
     return exit_ok;

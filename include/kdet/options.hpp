@@ -73,7 +73,7 @@ struct DetectorOptions {
     HashFunction hash = HashFunction::djb2;
     /// CPU threads; 0 leaves OpenMP's default.
     int threads = 0;
-    /// CUDA block size (threads per block).
+    /// CUDA block size (threads per block), 1-1024; capped per kernel at what the kernel can launch with.
     int block_size = 128;
     /// Tet ids per grid bucket before an overflow bucket is chained.
     std::uint32_t bucket_capacity = 32;
