@@ -48,6 +48,7 @@ def main() -> None:
     parser.add_argument("--tets", type=int, default=100_000, help="tets of both grids together")
     parser.add_argument("--frames", type=int, default=30)
     parser.add_argument("--threads", type=int)
+    parser.add_argument("--test", default=kdet.Detector().options["test"], help="narrow-phase test (kdet.TESTS)")
     parser.add_argument("--out", help="also write the report to this Markdown file")
     args = parser.parse_args()
 
@@ -55,11 +56,12 @@ def main() -> None:
     grid = tet_grid((side, side, 2 * side))
     a_vertices = turned(grid.vertices, 0.3)
     b_rest = turned(grid.vertices, -0.2) + [0.5 * side + 0.37, 0.21, 0.0]  # half of B beside A
-    detector = kdet.Detector(threads=args.threads)
+    detector = kdet.Detector(threads=args.threads, test=args.test)
     detector.add_object(a_vertices, grid.tets)
     moving = detector.add_object(b_rest, grid.tets)
     tets = 2 * grid.num_tets
 
+    load_before = os.getloadavg()[0]
     rows = []
     for frame in range(args.frames + 3):
         # B slides along z through A, half way in at the middle frame.
@@ -76,6 +78,7 @@ def main() -> None:
             rows.append((1e3 * (end - middle), result.times.total, 1e3 * (middle - start), 1e3 * (copy_end - copy_start),
                          len(result.pairs)))
 
+    load_after = os.getloadavg()[0]
     wall = [r[0] for r in rows]
     library = [r[1] for r in rows]
     overhead = [r[0] - r[1] for r in rows]
@@ -84,11 +87,13 @@ def main() -> None:
         "# Python binding overhead per detect(), CPU backend",
         "",
         f"- Machine: {detector.device_name}, {os.cpu_count()} cores, {platform.platform()}; "
-        f"Python {platform.python_version()}, NumPy {np.__version__}.",
+        f"Python {platform.python_version()}, NumPy {np.__version__}; load average (1 min) {load_before:.1f} before, "
+        f"{load_after:.1f} after: the cores were shared with other work.",
         f"- kdet {kdet.version()}; detector threads: {detector.options['threads'] or 'all'}.",
         f"- Command: `python3 {' '.join(sys.argv)}` (bench/python_overhead.py, package built by `pip install .`).",
         f"- Workload: two tet grids of {grid.num_tets:,} tets each ({tets:,} in all), one sliding through the "
-        f"other over {args.frames} frames (3 warm-up frames dropped); float32 positions; method kdet, test sat.",
+        f"other over {args.frames} frames (3 warm-up frames dropped); float32 positions; method {detector.options['method']}, "
+        f"test {detector.options['test']}. Both times are taken for the same call, frame after frame, in this process.",
         "",
         "| per frame | median | min | max |",
         "|---|---:|---:|---:|",

@@ -4,6 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
+source scripts/compiler-cache.sh
 bash scripts/build.sh
 # The Python package (import kdet) in .venv; the main job does not need it, so a failure only warns.
 if [[ ! -x .venv/bin/python ]] || ! .venv/bin/python -c "import kdet" 2>/dev/null; then

@@ -19,8 +19,11 @@ python3 -m venv "$venv"
 python=("$venv/bin/python")
 pip=("${python[@]}" -m pip --disable-pip-version-check)
 "${pip[@]}" install -q --timeout 60 pytest meshio matplotlib
+# Warnings are errors here as in build/ (the bindings are held to them too), which also keeps the library's
+# compile commands equal to build/'s for a compiler cache (scripts/compiler-cache.sh).
+settings=(--config-settings=build-dir=build-python/cmake --config-settings=cmake.define.KDET_WARNINGS_AS_ERRORS=ON)
 
-"${pip[@]}" wheel -q --timeout 60 . -w build-python/dist --config-settings=build-dir=build-python/cmake
+"${pip[@]}" wheel -q --timeout 60 . -w build-python/dist "${settings[@]}"
 "${python[@]}" - build-python/dist <<'PY'
 import pathlib, sys, zipfile
 wheel, = pathlib.Path(sys.argv[1]).glob("kdet-*.whl")
@@ -32,6 +35,6 @@ if missing or stray:
     sys.exit(f"{wheel.name}: missing {missing}, not part of the package {stray}")
 print(f"{wheel.name}: {len(names)} files, stubs and extension included, nothing else")
 PY
-"${pip[@]}" install -q . --config-settings=build-dir=build-python/cmake
+"${pip[@]}" install -q . "${settings[@]}"
 echo "== the Python package's tests"
 "${python[@]}" -m pytest -rs python/tests "$@"

@@ -9,6 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
+source scripts/compiler-cache.sh
 
 # Presets (CMakePresets.json): asan builds into build-sanitize/ (viewer off), release into build/.
 cmake --preset asan >/dev/null

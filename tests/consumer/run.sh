@@ -40,7 +40,15 @@ installed)
   kdet="$work/prefix/bin/kdet"
   ;;
 subdirectory)
-  env "${cuda_path[@]}" "$cmake" -S "$source/tests/consumer" -B "$work/build" -DKDET_SOURCE_DIR="$source" >/dev/null
+  # kdet is compiled again inside the consumer, with the build type and warning flags of BUILD: the same
+  # compile commands, which a compiler cache (scripts/test.sh sets ccache when it exists) answers.
+  settings=()
+  for name in CMAKE_BUILD_TYPE KDET_WARNINGS_AS_ERRORS; do
+    value="$(sed -n "s/^$name:[A-Z]*=//p" "$build/CMakeCache.txt")"
+    [[ -n "$value" ]] && settings+=("-D$name=$value")
+  done
+  env "${cuda_path[@]}" "$cmake" -S "$source/tests/consumer" -B "$work/build" -DKDET_SOURCE_DIR="$source" \
+    "${settings[@]}" >/dev/null
   kdet="$build/kdet"
   ;;
 *)
