@@ -9,7 +9,8 @@
 
 namespace kdet {
 
-CpuExec::CpuExec(int threads, int /*block_size*/) : threads_(threads > 0 ? threads : omp_get_max_threads()) {}
+CpuExec::CpuExec(const DetectorOptions& options)
+    : threads_(options.threads > 0 ? options.threads : omp_get_max_threads()) {}
 
 std::size_t CpuExec::sort_unique(std::uint64_t* keys, std::size_t n) const {
     if (n > 1 << 14 && threads_ > 1)

@@ -2,6 +2,8 @@
 /// @file cpu_exec.hpp
 /// @brief The CPU execution layer: OpenMP loops over the same per-element functors the CUDA layer launches.
 
+#include <kdet/options.hpp>
+
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -55,8 +57,10 @@ public:
     using buffer = HostBuffer<T>;
     using stage_timer = CpuStageTimer;
 
-    /// @brief threads = 0 keeps OpenMP's default; block_size only matters on the GPU.
-    CpuExec(int threads, int block_size);
+    /// @brief options.threads = 0 keeps OpenMP's default; the block size and stream only matter on the GPU.
+    explicit CpuExec(const DetectorOptions& options);
+
+    stage_timer make_stage_timer() const { return stage_timer(); }
 
     /// @brief Runs f(i) for every i in [0, n) on all threads.
     template <class F>

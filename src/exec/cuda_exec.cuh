@@ -2,8 +2,11 @@
 /// @file cuda_exec.cuh
 /// @brief The CUDA execution layer: launches the same per-element functors as CpuExec, with CUB for
 /// sorting, unique and scans, and CUDA events for stage times. Plain device allocations, kept and grown.
+/// Every launch, copy and CUB call goes to the stream of DetectorOptions::cuda_stream (the default
+/// stream when none is given), so a frame runs in order after the caller's own work on that stream.
 
 #include <kdet/error.hpp>
+#include <kdet/options.hpp>
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
@@ -11,6 +14,7 @@
 #include <cuda_runtime.h>
 
 #include <cstdint>
+#include <cstring>
 #include <string>
 
 namespace kdet {
@@ -54,10 +58,38 @@ private:
     std::size_t capacity_ = 0;
 };
 
+/// @brief Page-locked host memory, kept and grown: copies from the device land here without the
+/// driver's extra staging copy, and a buffer that has grown allocates nothing in later frames.
+class PinnedBuffer {
+public:
+    PinnedBuffer() = default;
+    PinnedBuffer(const PinnedBuffer&) = delete;
+    PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+    ~PinnedBuffer() { cudaFreeHost(data_); }
+
+    /// @brief At least `bytes` of pinned memory; the old contents are not kept.
+    unsigned char* reserve(std::size_t bytes) {
+        if (bytes > capacity_) {
+            unsigned char* old = data_;
+            data_ = nullptr;
+            capacity_ = 0;
+            cuda_check(cudaFreeHost(old), "cudaFreeHost");
+            cuda_check(cudaMallocHost(reinterpret_cast<void**>(&data_), bytes), "cudaMallocHost");
+            capacity_ = bytes;
+        }
+        return data_;
+    }
+    std::size_t capacity_bytes() const { return capacity_; }
+
+private:
+    unsigned char* data_ = nullptr;
+    std::size_t capacity_ = 0;
+};
+
 /// @brief Times one stage on the GPU with a pair of events.
 class CudaStageTimer {
 public:
-    CudaStageTimer() {
+    explicit CudaStageTimer(cudaStream_t stream) : stream_(stream) {
         cuda_check(cudaEventCreate(&begin_), "cudaEventCreate");
         cuda_check(cudaEventCreate(&end_), "cudaEventCreate");
     }
@@ -67,9 +99,9 @@ public:
     }
     CudaStageTimer(const CudaStageTimer&) = delete;
     CudaStageTimer& operator=(const CudaStageTimer&) = delete;
-    void start() { cuda_check(cudaEventRecord(begin_), "cudaEventRecord"); }
+    void start() { cuda_check(cudaEventRecord(begin_, stream_), "cudaEventRecord"); }
     double stop_ms() {
-        cuda_check(cudaEventRecord(end_), "cudaEventRecord");
+        cuda_check(cudaEventRecord(end_, stream_), "cudaEventRecord");
         cuda_check(cudaEventSynchronize(end_), "cudaEventSynchronize");
         float ms = 0;
         cuda_check(cudaEventElapsedTime(&ms, begin_, end_), "cudaEventElapsedTime");
@@ -77,6 +109,7 @@ public:
     }
 
 private:
+    cudaStream_t stream_;
     cudaEvent_t begin_{}, end_{};
 };
 
@@ -92,11 +125,14 @@ public:
     using buffer = DeviceBuffer<T>;
     using stage_timer = CudaStageTimer;
 
-    CudaExec(int /*threads*/, int block_size) : block_size_(block_size) {
+    explicit CudaExec(const DetectorOptions& options)
+        : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
         int devices = 0;
         if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0)
             throw Error("backend 'cuda' needs a CUDA device, and none is available");
     }
+
+    stage_timer make_stage_timer() const { return stage_timer(stream_); }
 
     template <class F>
     void for_each(std::uint64_t n, const F& f) const {
@@ -104,7 +140,7 @@ public:
         const int block = launchable_block_size<F>();
         const std::uint64_t wanted = (n + block - 1) / block;
         const auto blocks = static_cast<unsigned>(wanted < (1u << 30) ? wanted : (1u << 30));
-        for_each_kernel<<<blocks, block>>>(n, f);
+        for_each_kernel<<<blocks, block, 0, stream_>>>(n, f);
         cuda_check(cudaGetLastError(), "kernel launch");
     }
 
@@ -126,12 +162,14 @@ public:
         sorted_.resize_discard(n);
         unique_count_.resize_discard(1);
         std::size_t sort_bytes = 0, unique_bytes = 0;
-        cub::DeviceRadixSort::SortKeys(nullptr, sort_bytes, keys, sorted_.data(), n);
-        cub::DeviceSelect::Unique(nullptr, unique_bytes, sorted_.data(), keys, unique_count_.data(), n);
+        cub::DeviceRadixSort::SortKeys(nullptr, sort_bytes, keys, sorted_.data(), n, 0, 64, stream_);
+        cub::DeviceSelect::Unique(nullptr, unique_bytes, sorted_.data(), keys, unique_count_.data(), n, stream_);
         temp_.resize_discard(sort_bytes > unique_bytes ? sort_bytes : unique_bytes);
-        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), sort_bytes, keys, sorted_.data(), n), "radix sort");
-        cuda_check(cub::DeviceSelect::Unique(temp_.data(), unique_bytes, sorted_.data(), keys, unique_count_.data(), n),
-                   "unique");
+        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), sort_bytes, keys, sorted_.data(), n, 0, 64, stream_),
+                   "radix sort");
+        cuda_check(
+            cub::DeviceSelect::Unique(temp_.data(), unique_bytes, sorted_.data(), keys, unique_count_.data(), n, stream_),
+            "unique");
         unsigned long long count = 0;
         download(&count, unique_count_.data(), 1);
         return static_cast<std::size_t>(count);
@@ -142,27 +180,36 @@ public:
         std::uint32_t last = 0, last_offset = 0;
         download(&last, in + n - 1, 1);
         std::size_t bytes = 0;
-        cub::DeviceScan::ExclusiveSum(nullptr, bytes, in, out, n);
+        cub::DeviceScan::ExclusiveSum(nullptr, bytes, in, out, n, stream_);
         temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, in, out, n), "exclusive scan");
+        cuda_check(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, in, out, n, stream_), "exclusive scan");
         download(&last_offset, out + n - 1, 1);
         return std::uint64_t{last_offset} + last;
     }
 
+    /// @brief Enqueues a copy from the library's own pageable host memory, which the driver stages
+    /// before returning: the source may be reused at once.
     template <class T>
     void upload(T* device, const T* host, std::size_t n) const {
-        if (n) cuda_check(cudaMemcpy(device, host, n * sizeof(T), cudaMemcpyHostToDevice), "upload");
+        if (n) cuda_check(cudaMemcpyAsync(device, host, n * sizeof(T), cudaMemcpyHostToDevice, stream_), "upload");
     }
+    /// @brief Copies to the host through pinned memory; waits for the stream (a host synchronisation).
     template <class T>
     void download(T* host, const T* device, std::size_t n) const {
-        if (n) cuda_check(cudaMemcpy(host, device, n * sizeof(T), cudaMemcpyDeviceToHost), "download");
+        if (!n) return;
+        unsigned char* staging = staging_.reserve(n * sizeof(T));
+        cuda_check(cudaMemcpyAsync(staging, device, n * sizeof(T), cudaMemcpyDeviceToHost, stream_), "download");
+        synchronize();
+        std::memcpy(static_cast<void*>(host), staging, n * sizeof(T));
     }
     /// @brief Copies within device memory.
     template <class T>
     void copy(T* destination, const T* source, std::size_t n) const {
-        if (n) cuda_check(cudaMemcpy(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice), "device copy");
+        if (n)
+            cuda_check(cudaMemcpyAsync(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice, stream_),
+                       "device copy");
     }
-    void synchronize() const { cuda_check(cudaDeviceSynchronize(), "synchronize"); }
+    void synchronize() const { cuda_check(cudaStreamSynchronize(stream_), "synchronize"); }
 
     std::string device_name() const {
         int device = 0;
@@ -172,13 +219,15 @@ public:
         return properties.name;
     }
 
-    /// @brief Bytes of the scratch buffers CUB needs, for memory reports.
+    /// @brief Bytes of the scratch buffers CUB needs, for memory reports (device memory only).
     std::size_t scratch_bytes() const {
         return temp_.capacity_bytes() + sorted_.capacity_bytes() + unique_count_.capacity_bytes();
     }
 
 private:
     int block_size_;
+    cudaStream_t stream_;
+    mutable PinnedBuffer staging_;
     mutable DeviceBuffer<unsigned char> temp_;
     mutable DeviceBuffer<std::uint64_t> sorted_;
     mutable DeviceBuffer<unsigned long long> unique_count_;

@@ -123,6 +123,9 @@ Detector::Detector(const DetectorOptions& options) : impl_(std::make_unique<Impl
     if (options.block_size < 1 || options.block_size > 1024)
         throw Error("block size " + std::to_string(options.block_size) + " out of range [1, 1024]");
     if (options.bucket_capacity < 1) throw Error("bucket capacity must be at least 1");
+    if (options.cuda_stream && options.backend != Backend::cuda)
+        throw Error("option cuda_stream is set, but the backend is '" + std::string(to_string(options.backend)) +
+                    "': a CUDA stream needs backend 'cuda'");
     impl_->pipeline = options.backend == Backend::cuda ? make_cuda_pipeline(options) : make_cpu_pipeline(options);
 }
 

@@ -33,7 +33,8 @@ class Pipeline final : public PipelineBase {
 
 public:
     explicit Pipeline(const DetectorOptions& options)
-        : exec_(options.threads, options.block_size), options_(options) {}
+        : exec_(options), total_timer_(exec_.make_stage_timer()), stage_timer_(exec_.make_stage_timer()),
+          options_(options) {}
 
     void set_topology(const SceneTopology& topology) override {
         topology_ = topology;
