@@ -86,31 +86,40 @@ private:
     std::size_t capacity_ = 0;
 };
 
-/// @brief Times one stage on the GPU with a pair of events.
-class CudaStageTimer {
+/// @brief Stage times from events recorded on the stream as the frame is enqueued. Recording costs
+/// no synchronisation; the times are read once, when the frame's last mark has completed.
+class CudaStageClock {
 public:
-    explicit CudaStageTimer(cudaStream_t stream) : stream_(stream) {
-        cuda_check(cudaEventCreate(&begin_), "cudaEventCreate");
-        cuda_check(cudaEventCreate(&end_), "cudaEventCreate");
+    static constexpr int mark_count = 8;
+
+    explicit CudaStageClock(cudaStream_t stream) : stream_(stream) {
+        for (cudaEvent_t& e : events_) cuda_check(cudaEventCreate(&e), "cudaEventCreate");
     }
-    ~CudaStageTimer() {
-        cudaEventDestroy(begin_);
-        cudaEventDestroy(end_);
+    ~CudaStageClock() {
+        for (cudaEvent_t e : events_) cudaEventDestroy(e);
     }
-    CudaStageTimer(const CudaStageTimer&) = delete;
-    CudaStageTimer& operator=(const CudaStageTimer&) = delete;
-    void start() { cuda_check(cudaEventRecord(begin_, stream_), "cudaEventRecord"); }
-    double stop_ms() {
-        cuda_check(cudaEventRecord(end_, stream_), "cudaEventRecord");
-        cuda_check(cudaEventSynchronize(end_), "cudaEventSynchronize");
+    CudaStageClock(const CudaStageClock&) = delete;
+    CudaStageClock& operator=(const CudaStageClock&) = delete;
+
+    void begin_frame() { recorded_ = 0; }
+    void mark(int k) {
+        cuda_check(cudaEventRecord(events_[k], stream_), "cudaEventRecord");
+        recorded_ |= 1u << k;
+    }
+    /// @brief Waits for mark k (a host synchronisation when the stream is still busy).
+    void wait(int k) { cuda_check(cudaEventSynchronize(events_[k]), "cudaEventSynchronize"); }
+    /// @brief Milliseconds from mark `from` to mark `to`, 0 when either was not recorded this frame.
+    double between_ms(int from, int to) const {
+        if (!(recorded_ >> from & 1u) || !(recorded_ >> to & 1u)) return 0;
         float ms = 0;
-        cuda_check(cudaEventElapsedTime(&ms, begin_, end_), "cudaEventElapsedTime");
+        cuda_check(cudaEventElapsedTime(&ms, events_[from], events_[to]), "cudaEventElapsedTime");
         return ms;
     }
 
 private:
     cudaStream_t stream_;
-    cudaEvent_t begin_{}, end_{};
+    cudaEvent_t events_[mark_count]{};
+    unsigned recorded_ = 0;
 };
 
 template <class F>
@@ -123,7 +132,7 @@ class CudaExec {
 public:
     template <class T>
     using buffer = DeviceBuffer<T>;
-    using stage_timer = CudaStageTimer;
+    using stage_clock = CudaStageClock;
 
     explicit CudaExec(const DetectorOptions& options)
         : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
@@ -132,7 +141,7 @@ public:
             throw Error("backend 'cuda' needs a CUDA device, and none is available");
     }
 
-    stage_timer make_stage_timer() const { return stage_timer(stream_); }
+    stage_clock make_stage_clock() const { return stage_clock(stream_); }
 
     template <class F>
     void for_each(std::uint64_t n, const F& f) const {
@@ -177,14 +186,17 @@ public:
 
     std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
         if (n == 0) return 0;
-        std::uint32_t last = 0, last_offset = 0;
-        download(&last, in + n - 1, 1);
         std::size_t bytes = 0;
         cub::DeviceScan::ExclusiveSum(nullptr, bytes, in, out, n, stream_);
         temp_.resize_discard(bytes);
         cuda_check(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, in, out, n, stream_), "exclusive scan");
-        download(&last_offset, out + n - 1, 1);
-        return std::uint64_t{last_offset} + last;
+        // The total is the last offset plus the last input: both read back with one wait.
+        auto* last = reinterpret_cast<std::uint32_t*>(staging_.reserve(2 * sizeof(std::uint32_t)));
+        cuda_check(cudaMemcpyAsync(last, in + n - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost, stream_), "download");
+        cuda_check(cudaMemcpyAsync(last + 1, out + n - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost, stream_),
+                   "download");
+        wait_for_stream();
+        return std::uint64_t{last[0]} + last[1];
     }
 
     /// @brief Enqueues a copy from the library's own pageable host memory, which the driver stages
@@ -199,7 +211,7 @@ public:
         if (!n) return;
         unsigned char* staging = staging_.reserve(n * sizeof(T));
         cuda_check(cudaMemcpyAsync(staging, device, n * sizeof(T), cudaMemcpyDeviceToHost, stream_), "download");
-        synchronize();
+        wait_for_stream();
         std::memcpy(static_cast<void*>(host), staging, n * sizeof(T));
     }
     /// @brief Copies within device memory.
@@ -209,7 +221,8 @@ public:
             cuda_check(cudaMemcpyAsync(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice, stream_),
                        "device copy");
     }
-    void synchronize() const { cuda_check(cudaStreamSynchronize(stream_), "synchronize"); }
+    /// @brief Times the host has waited for the device so far: once per download, scan and sort.
+    std::uint64_t host_waits() const { return host_waits_; }
 
     std::string device_name() const {
         int device = 0;
@@ -225,9 +238,15 @@ public:
     }
 
 private:
+    void wait_for_stream() const {
+        ++host_waits_;
+        cuda_check(cudaStreamSynchronize(stream_), "synchronize");
+    }
+
     int block_size_;
     cudaStream_t stream_;
     mutable PinnedBuffer staging_;
+    mutable std::uint64_t host_waits_ = 0;
     mutable DeviceBuffer<unsigned char> temp_;
     mutable DeviceBuffer<std::uint64_t> sorted_;
     mutable DeviceBuffer<unsigned long long> unique_count_;
