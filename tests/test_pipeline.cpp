@@ -216,7 +216,9 @@ TEST(Detector, CountsTheTimesTheHostWaitsForTheBackend) {
         EXPECT_LE(colliding_frame, to_host ? 10u : 8u);
         // Each regrow reruns a stage and reads its counters again; once grown, every frame waits as often.
         EXPECT_EQ(first_frame, colliding_frame + regrows);
+        const std::size_t grown_bytes = detector.memory_bytes();
         EXPECT_EQ(detector.detect().counts.host_waits, colliding_frame);
+        EXPECT_EQ(detector.memory_bytes(), grown_bytes); // nothing allocated once grown
         // Objects apart, self-collision off: only the object boxes are read.
         const TetMesh far = moved(a, 0.0, 50.0, 0.0, 0.0);
         detector.set_self_collision(0, false);
