@@ -9,9 +9,12 @@
 
 namespace kdet {
 
-CpuExec::CpuExec(int threads, int /*block_size*/) : threads_(threads > 0 ? threads : omp_get_max_threads()) {}
+CpuExec::CpuExec(const DetectorOptions& options)
+    : threads_(options.threads > 0 ? options.threads : omp_get_max_threads()) {}
 
 std::size_t CpuExec::sort_unique(std::uint64_t* keys, std::size_t n) const {
+    if (n == 0) return 0;
+    ++host_waits_;
     if (n > 1 << 14 && threads_ > 1)
         __gnu_parallel::sort(keys, keys + n, __gnu_parallel::multiway_mergesort_tag(static_cast<__gnu_parallel::_ThreadIndex>(threads_)));
     else
@@ -20,6 +23,8 @@ std::size_t CpuExec::sort_unique(std::uint64_t* keys, std::size_t n) const {
 }
 
 std::uint64_t CpuExec::exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
+    if (n == 0) return 0;
+    ++host_waits_;
     // Two passes over per-thread blocks: block sums, then each block scans from its offset.
     const int blocks = std::max(1, std::min<int>(threads_, static_cast<int>(n / 4096)));
     std::vector<std::uint64_t> block_sum(static_cast<std::size_t>(blocks) + 1, 0);
