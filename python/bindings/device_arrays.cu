@@ -30,7 +30,7 @@ DeviceScratch::~DeviceScratch() {
 }
 
 const float* DeviceScratch::gather(const void* source, bool is_double, std::size_t rows, std::int64_t row_stride,
-                                   std::int64_t column_stride) {
+                                   std::int64_t column_stride, void* stream) {
     if (3 * rows > capacity_) {
         if (data_) check(cudaFree(data_), "cudaFree");
         data_ = nullptr;
@@ -41,10 +41,11 @@ const float* DeviceScratch::gather(const void* source, bool is_double, std::size
     if (rows == 0) return data_;
     const unsigned block = 256;
     const auto blocks = static_cast<unsigned>((rows + block - 1) / block);
+    const auto on = static_cast<cudaStream_t>(stream);
     if (is_double)
-        gather_xyz<<<blocks, block>>>(static_cast<const double*>(source), rows, row_stride, column_stride, data_);
+        gather_xyz<<<blocks, block, 0, on>>>(static_cast<const double*>(source), rows, row_stride, column_stride, data_);
     else
-        gather_xyz<<<blocks, block>>>(static_cast<const float*>(source), rows, row_stride, column_stride, data_);
+        gather_xyz<<<blocks, block, 0, on>>>(static_cast<const float*>(source), rows, row_stride, column_stride, data_);
     check(cudaGetLastError(), "the gather kernel");
     return data_;
 }

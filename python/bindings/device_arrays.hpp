@@ -18,9 +18,10 @@ public:
     DeviceScratch& operator=(const DeviceScratch&) = delete;
 
     /// @brief Copies rows x 3 float32 or float64 values (strides in elements) into float32 x y z per row,
-    /// on the legacy default stream, which the detector's work follows. Throws kdet::Error on a CUDA error.
+    /// on @p stream (the detector's, DetectorOptions::cuda_stream), so that the detector reads them after
+    /// the copy. Throws kdet::Error on a CUDA error.
     const float* gather(const void* source, bool is_double, std::size_t rows, std::int64_t row_stride,
-                        std::int64_t column_stride);
+                        std::int64_t column_stride, void* stream);
 
 private:
     float* data_ = nullptr;

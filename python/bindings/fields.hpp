@@ -36,7 +36,8 @@ constexpr auto fields_of<FrameCounts>() {
                            Field{"colliding_pairs", &C::colliding_pairs}, Field{"colliding_tets", &C::colliding_tets},
                            Field{"buffer_regrows", &C::buffer_regrows}, Field{"grid_cells", &C::grid_cells},
                            Field{"grid_slots", &C::grid_slots},
-                           Field{"grid_overflow_buckets", &C::grid_overflow_buckets});
+                           Field{"grid_overflow_buckets", &C::grid_overflow_buckets},
+                           Field{"host_waits", &C::host_waits});
 }
 
 template <>

@@ -59,10 +59,37 @@ std::uint32_t positive_u32(const char* argument, std::int64_t value) {
     return static_cast<std::uint32_t>(value);
 }
 
+/// A CUDA stream as the GPU libraries hand it out: None (the default stream), a cudaStream_t as an int, or
+/// a stream object with __cuda_stream__ (the CUDA stream protocol), .cuda_stream (PyTorch, Warp) or .ptr
+/// (CuPy).
+void* cuda_stream_handle(nb::handle stream) {
+    if (stream.is_none()) return nullptr;
+    nb::object value = nb::borrow(stream);
+    if (nb::hasattr(stream, "__cuda_stream__")) {
+        value = stream.attr("__cuda_stream__")();
+        if (!nb::isinstance<nb::tuple>(value) || nb::len(value) != 2)
+            throw nb::type_error("cuda_stream: __cuda_stream__() must return (version, handle)");
+        value = value[1];
+    } else if (nb::hasattr(stream, "cuda_stream")) {
+        value = stream.attr("cuda_stream");
+    } else if (nb::hasattr(stream, "ptr")) {
+        value = stream.attr("ptr");
+    }
+    if (!PyLong_Check(value.ptr()))
+        throw nb::type_error(("cuda_stream: expected None, a cudaStream_t as an int or a CUDA stream object, got " +
+                              type_label(stream)).c_str());
+    const unsigned long long handle = PyLong_AsUnsignedLongLong(value.ptr());
+    if (PyErr_Occurred()) {
+        PyErr_Clear();
+        throw Error("cuda_stream: " + nb::cast<std::string>(nb::repr(value)) + " is not a stream handle");
+    }
+    return reinterpret_cast<void*>(static_cast<std::uintptr_t>(handle));
+}
+
 DetectorOptions make_options(const std::string& backend, const std::string& method, const std::string& test,
                              const std::string& hash, std::optional<std::int64_t> threads, bool contacts,
                              std::int64_t block_size, std::int64_t bucket_capacity,
-                             std::int64_t initial_candidate_capacity, bool results_to_host) {
+                             std::int64_t initial_candidate_capacity, nb::handle cuda_stream, bool results_to_host) {
     DetectorOptions options;
     options.backend = parse_option<Backend>("backend", backend);
     options.method = parse_option<Method>("method", method);
@@ -76,6 +103,7 @@ DetectorOptions make_options(const std::string& backend, const std::string& meth
         throw Error("initial_candidate_capacity: expected 0 (sized from the tets) or a positive number, got " +
                     std::to_string(initial_candidate_capacity));
     options.initial_candidate_capacity = static_cast<std::size_t>(initial_candidate_capacity);
+    options.cuda_stream = cuda_stream_handle(cuda_stream);
     options.results_to_host = results_to_host;
     return options;
 }
@@ -231,7 +259,8 @@ void set_device_positions(PyDetector& self, ObjectId id, const Coordinates& c) {
     if (c.stream) synchronize_cuda_stream(c.stream);
     const float* xyz = c.contiguous() && !c.is_double
                            ? static_cast<const float*>(c.data)
-                           : self.scratch.gather(c.data, c.is_double, c.rows, c.row_stride, c.column_stride);
+                           : self.scratch.gather(c.data, c.is_double, c.rows, c.row_stride, c.column_stride,
+                                                 self.detector.options().cuda_stream);
     self.detector.set_positions_on_device(id, xyz, c.rows);
 #else
     (void)self;
@@ -306,6 +335,7 @@ nb::dict options_dict(const DetectorOptions& o) {
     d["block_size"] = o.block_size;
     d["bucket_capacity"] = o.bucket_capacity;
     d["initial_candidate_capacity"] = o.initial_candidate_capacity;
+    d["cuda_stream"] = o.cuda_stream ? nb::cast(reinterpret_cast<std::uintptr_t>(o.cuda_stream)) : nb::none();
     d["results_to_host"] = o.results_to_host;
     return d;
 }
@@ -476,9 +506,11 @@ NB_MODULE(_kdet, m) {
             "__init__",
             [](PyDetector* self, const std::string& backend, const std::string& method, const std::string& test,
                const std::string& hash, std::optional<std::int64_t> threads, bool contacts, std::int64_t block_size,
-               std::int64_t bucket_capacity, std::int64_t initial_candidate_capacity, bool results_to_host) {
-                const DetectorOptions options = make_options(backend, method, test, hash, threads, contacts, block_size,
-                                                             bucket_capacity, initial_candidate_capacity, results_to_host);
+               std::int64_t bucket_capacity, std::int64_t initial_candidate_capacity, nb::handle cuda_stream,
+               bool results_to_host) {
+                const DetectorOptions options =
+                    make_options(backend, method, test, hash, threads, contacts, block_size, bucket_capacity,
+                                 initial_candidate_capacity, cuda_stream, results_to_host);
                 nb::gil_scoped_release release;
                 new (self) PyDetector(options);
             },
@@ -486,10 +518,12 @@ NB_MODULE(_kdet, m) {
             "test"_a = to_string(defaults.narrow_phase), "hash"_a = to_string(defaults.hash), "threads"_a = nb::none(),
             "contacts"_a = defaults.contacts, "block_size"_a = defaults.block_size,
             "bucket_capacity"_a = defaults.bucket_capacity,
-            "initial_candidate_capacity"_a = defaults.initial_candidate_capacity,
+            "initial_candidate_capacity"_a = defaults.initial_candidate_capacity, "cuda_stream"_a = nb::none(),
             "results_to_host"_a = defaults.results_to_host,
             "Names (backend, method, test, hash) are those of kdet.BACKENDS, METHODS, TESTS and HASHES, in any case, "
-            "'-' or '_'. threads=None uses all cores. contacts=True adds depth and direction per pair. "
+            "'-' or '_'. threads=None uses all cores. contacts=True adds depth and direction per pair. cuda_stream "
+            "(backend='cuda'): the stream all of the detector's GPU work runs on, as an int or a stream object "
+            "(PyTorch, CuPy, Warp, __cuda_stream__); None is the default stream. "
             "results_to_host=False keeps results on the device (detect(device_results=True)).")
         .def("add_object",
              [](PyDetector& self, const TetMesh& mesh) {

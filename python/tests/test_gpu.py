@@ -109,6 +109,22 @@ def test_gpu_positions_give_the_cpu_pairs(scene, layout):
     np.testing.assert_array_equal(detector.detect().pairs[:, [1, 3]], expected)
 
 
+def test_the_detector_runs_on_the_callers_stream(scene):
+    bunny, other, expected = scene
+    runtime = cuda_runtime()
+    stream = ctypes.c_void_p()
+    assert runtime.cudaStreamCreateWithFlags(ctypes.byref(stream), 1) == 0  # cudaStreamNonBlocking
+    try:
+        detector, moving = gpu_detector(bunny, cuda_stream=stream.value)
+        assert detector.options["cuda_stream"] == stream.value
+        # float64 with strides: the binding's gather kernel runs too, and must run on that stream.
+        for frame in range(3):
+            detector.set_positions(moving, CudaArray(np.repeat(other.vertices, 2, axis=0)[::2]))
+            np.testing.assert_array_equal(detector.detect().pairs[:, [1, 3]], expected, err_msg=f"frame {frame}")
+    finally:
+        runtime.cudaStreamDestroy(stream)
+
+
 def test_device_results_stay_on_the_gpu(scene):
     bunny, other, expected = scene
     detector, moving = gpu_detector(bunny, contacts=True, results_to_host=False)

@@ -113,11 +113,32 @@ def test_detector_arguments_are_checked(octopus):
         ({"method": 3}, TypeError, "method"),
         ({"contacts": "yes"}, TypeError, "contacts"),
         ({"tests": "sat"}, TypeError, "tests"),
+        ({"cuda_stream": 1}, kdet.Error, "option cuda_stream is set, but the backend is 'cpu'"),
+        ({"cuda_stream": -1}, kdet.Error, "cuda_stream: -1 is not a stream handle"),
+        ({"cuda_stream": "stream"}, TypeError, "cuda_stream: expected None, a cudaStream_t as an int or a CUDA stream"),
     ],
 )
 def test_bad_options(options, error, message):
     with pytest.raises(error, match=message):
         kdet.Detector(**options)
+
+
+def test_cuda_stream_objects_are_read_as_the_gpu_libraries_hand_them_out():
+    class Protocol:  # the CUDA stream protocol
+        def __cuda_stream__(self):
+            return (0, 0)
+
+    class Torch:  # torch.cuda.Stream, warp.Stream
+        cuda_stream = 7
+
+    class CuPy:  # cupy.cuda.Stream
+        ptr = 9
+
+    assert kdet.Detector(cuda_stream=Protocol()).options["cuda_stream"] is None  # the default stream
+    # A handle that was read is refused on the CPU backend, which proves it was read.
+    for stream in (Torch(), CuPy()):
+        with pytest.raises(kdet.Error, match="option cuda_stream is set"):
+            kdet.Detector(cuda_stream=stream)
 
 
 def test_bad_meshes_for_collide(octopus):
