@@ -33,7 +33,7 @@ thesis options (any order):
   -r N                 model resolution 1-4 (default 1)
   -c M                 method: kdet (default), kdet_no_pairs, gpu (brute force, loop),
                        gpu_no_loop (brute force, one work item per pair)
-  -o T                 overlap test: sat (default), sat_no_edges, sat_mtv, gjk, fast
+  -o T                 overlap test: sat (default), sat_no_edges, sat_mtv, gjk, fast, exact
   -g N                 CUDA block size: 16, 32, 64, 128 (default) or 256
   -n N                 runs 1-20 (default 10)
   -s yes|y|no|n        self-collisions of every object (default no)
@@ -81,7 +81,7 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
             if (name == m.flag) config.options.method = m.method;
     });
     parser.option("-o", "test", [&](const std::string& v) {
-        parse(parse_choice("-o", v, {"sat", "sat_no_edges", "sat_mtv", "gjk", "fast"}), config.options.narrow_phase);
+        parse(parse_choice("-o", v, {"sat", "sat_no_edges", "sat_mtv", "gjk", "fast", "exact"}), config.options.narrow_phase);
     });
     parser.option("-g", "block size", [&](const std::string& v) {
         config.options.block_size = std::stoi(parse_choice("-g", v, {"16", "32", "64", "128", "256"}));

@@ -89,7 +89,7 @@ void add_detector_options(ArgParser& parser, DetectorOptions& options) {
     parser.option("--test", "test", [&](const std::string& v) {
         if (!parse(v, options.narrow_phase))
             throw UsageError("invalid value '" + v + "' for --test: expected " +
-                             join_choices({"sat", "sat_no_edges", "sat_mtv", "gjk", "fast"}));
+                             join_choices({"sat", "sat_no_edges", "sat_mtv", "gjk", "fast", "exact"}));
     });
     parser.option("--hash", "hash", [&](const std::string& v) {
         if (!parse(v, options.hash))
@@ -112,7 +112,7 @@ void add_detector_options(ArgParser& parser, DetectorOptions& options) {
 
 const char* detector_options_help() {
     return R"(  --method M           kdet (default), kdet_no_pairs, brute_force_loop, brute_force_pairs
-  --test T             narrow phase: sat (default), sat_no_edges, sat_mtv, gjk, fast
+  --test T             narrow phase: sat (default), sat_no_edges, sat_mtv, gjk, fast, exact
   --hash H             grid hash: djb2 (default), fnv-1a, simple, morton
   --backend B          cpu (default) or cuda
   --threads N          CPU threads (default: all)
@@ -184,7 +184,8 @@ int run_collide(int argc, char** argv) {
                   << to_string(options.hash) << "\", \"backend\": \"" << to_string(options.backend)
                   << "\", \"candidates\": " << c.candidates << ", \"unique_candidates\": " << c.unique_candidates
                   << ", \"colliding_pairs\": " << c.colliding_pairs << ", \"colliding_tets\": " << c.colliding_tets
-                  << ", \"buffer_regrows\": " << c.buffer_regrows << ", \"times_ms\": {\"bounding_boxes\": "
+                  << ", \"buffer_regrows\": " << c.buffer_regrows << ", \"exact_stage_pairs\": " << c.exact_stage_pairs
+                  << ", \"times_ms\": {\"bounding_boxes\": "
                   << json_number(t.bounding_boxes) << ", \"populate_grid\": " << json_number(t.populate_grid)
                   << ", \"find_candidates\": " << json_number(t.find_candidates)
                   << ", \"sort_unique\": " << json_number(t.sort_unique)
@@ -209,6 +210,8 @@ int run_collide(int argc, char** argv) {
     if (options.method != Method::kdet_no_pairs)
         std::printf("colliding pairs   %llu\n", static_cast<unsigned long long>(c.colliding_pairs));
     std::printf("colliding tets    %llu\n", static_cast<unsigned long long>(c.colliding_tets));
+    if (options.narrow_phase == NarrowPhase::exact)
+        std::printf("exact stage       %llu pairs\n", static_cast<unsigned long long>(c.exact_stage_pairs));
     std::printf("times (ms)        boxes %.3f, populate %.3f, candidates %.3f, sort+unique %.3f, narrow %.3f\n",
                 t.bounding_boxes, t.populate_grid, t.find_candidates, t.sort_unique, t.narrow_phase);
     std::printf("total             %.3f ms\n", t.total);

@@ -26,6 +26,7 @@ enum class NarrowPhase {
     sat_mtv,      ///< 44-axis SAT that also returns depth and direction
     gjk,          ///< GJK with a signed-volumes distance sub-algorithm
     fast,         ///< Ganovelli-Ponchio-Rocchini face-plane test
+    exact,        ///< exact for the float coordinates (filtered: float, then double, then exact sums)
 };
 
 /// @brief Hash function of the hierarchical grid.
