@@ -276,6 +276,53 @@ TEST(ExactTest, ClearPairsStayInTheFloatFilter) {
     EXPECT_TRUE(stage);
 }
 
+/// Flat tets in the plane z = 0 touching at a point of an edge, the first tet's first vertex (the exact
+/// test's origin) about 2^-45 from the origin, with bits down to 2^-60: differences to it need more
+/// bits than a double holds, and round differently in each binade, so the plane test's double bound is
+/// what keeps touching from reading as apart. Moved by one unit across the edge, the pair separates or
+/// overlaps.
+TEST(ExactTest, CoplanarContactsAgainstATinyOrigin) {
+    std::uint32_t state = 2024;
+    const auto integer = [&](int lo, int hi) {
+        state = state * 1664525u + 1013904223u;
+        return lo + static_cast<int>((state >> 8) % static_cast<std::uint32_t>(hi - lo + 1));
+    };
+    const auto at = [](long long x, long long y, int exponent) {
+        return vec3{std::ldexp(static_cast<float>(x), exponent), std::ldexp(static_cast<float>(y), exponent), 0.0f};
+    };
+    int checked = 0;
+    while (checked < 3000) {
+        // Edge p q of the first tet, its origin side; the second tet on the other side, touching at m.
+        const long long px = 2 * integer(-1000, 1000), py = 2 * integer(-1000, 1000);
+        const long long qx = 2 * integer(-1000, 1000), qy = 2 * integer(-1000, 1000);
+        const long long nx = qy - py, ny = px - qx; // normal of the edge
+        const long long origin_side = -(nx * px + ny * py); // n . (0 - p)
+        if (origin_side == 0) continue;
+        const long long sign = origin_side > 0 ? -1 : 1; // toward the far side
+        const long long mx = (px + qx) / 2, my = (py + qy) / 2;
+        long long w[2][2];
+        for (auto& v : w)
+            do {
+                v[0] = integer(-1000, 1000);
+                v[1] = integer(-1000, 1000);
+            } while (sign * (nx * v[0] + ny * v[1]) <= 0);
+        if (w[0][0] * w[1][1] - w[0][1] * w[1][0] == 0) continue;
+        const long long step_x = std::llabs(nx) >= std::llabs(ny) ? sign * (nx > 0 ? 1 : -1) : 0;
+        const long long step_y = step_x == 0 ? sign * (ny > 0 ? 1 : -1) : 0;
+        for (int move = -1; move <= 1; ++move) {
+            const vec3 a[4] = {at(integer(-32768, 32768), integer(-32768, 32768), -60), at(px, py, -10), at(qx, qy, -10),
+                               at(px, py, -10)};
+            vec3 b[4] = {at(mx, my, -10), at(mx + w[0][0], my + w[0][1], -10), at(mx + w[1][0], my + w[1][1], -10),
+                         at(mx, my, -10)};
+            for (vec3& v : b) v = v + at(move * step_x, move * step_y, -10);
+            const bool expected = move <= 0;
+            EXPECT_EQ(kdet::tets_intersect_exact(a, b), expected) << checked << " move " << move;
+            EXPECT_EQ(kdet::tets_intersect_exact(b, a), expected) << checked << " move " << move;
+        }
+        ++checked;
+    }
+}
+
 /// Zero-volume tets, with answers known by construction.
 TEST(ExactTest, DegenerateTets) {
     const auto tet = [](vec3 p, vec3 q, vec3 r, vec3 t) { return Tet{{p, q, r, t}}; };

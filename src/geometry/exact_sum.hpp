@@ -64,10 +64,7 @@ public:
     static constexpr int k_limbs = 28;
     static constexpr int k_lowest_exponent = -447; ///< 3 * -149: the unit of the integer
 
-    KDET_HD ExactSum() {
-        KDET_NO_UNROLL
-        for (int k = 0; k < k_limbs; ++k) limb_[k] = 0;
-    }
+    KDET_HD ExactSum() {}
 
     /// @brief Adds (or subtracts) x * y exactly.
     KDET_HD void add_product(float x_value, float y_value, bool subtract) {
@@ -86,20 +83,22 @@ public:
         add_bits((xy & 0xffffffu) * z.m, offset, negative);
     }
 
-    /// @brief -1, 0 or +1: the sign of the exact sum. Propagates the carries (the value is unchanged).
+    /// @brief -1, 0 or +1: the sign of the exact sum. Propagates the carries through the limbs that
+    /// were added to (the value is unchanged).
     KDET_HD int sign() {
+        if (highest_ < lowest_) return 0; // nothing added
         KDET_NO_UNROLL
-        for (int k = 0; k + 1 < k_limbs; ++k) {
+        for (int k = lowest_; k < highest_; ++k) {
             // Keep the limb's residue modulo 2^32 in [0, 2^32) and move the rest (a multiple of 2^32,
             // so the division is exact) into the next limb.
             const std::int64_t low = static_cast<std::int64_t>(static_cast<std::uint64_t>(limb_[k]) & 0xffffffffu);
             limb_[k + 1] += (limb_[k] - low) / (std::int64_t{1} << 32);
             limb_[k] = low;
         }
-        // The lower limbs are now non-negative and together below one unit of the top limb.
-        if (limb_[k_limbs - 1] != 0) return limb_[k_limbs - 1] > 0 ? 1 : -1;
+        // The limbs below `highest_` are now non-negative and together below one unit of it.
+        if (limb_[highest_] != 0) return limb_[highest_] > 0 ? 1 : -1;
         KDET_NO_UNROLL
-        for (int k = k_limbs - 2; k >= 0; --k)
+        for (int k = highest_ - 1; k >= lowest_; --k)
             if (limb_[k] != 0) return 1;
         return 0;
     }
@@ -113,11 +112,24 @@ private:
         const std::uint64_t high = (value >> 32) << shift;        // < 2^47, in units of limb k + 1
         const auto to_limb_k = static_cast<std::int64_t>(low & 0xffffffffu);
         const auto to_limb_k1 = static_cast<std::int64_t>((low >> 32) + high);
+        widen_to(k);
         limb_[k] += negative ? -to_limb_k : to_limb_k;
         limb_[k + 1] += negative ? -to_limb_k1 : to_limb_k1;
     }
 
+    /// @brief Makes limbs k and k + 1 part of the range in use, clearing the limbs that join it: only
+    /// the limbs a sum touches are ever written or read.
+    KDET_HD void widen_to(int k) {
+        if (highest_ < lowest_) {
+            lowest_ = highest_ = k;
+            limb_[k] = 0;
+        }
+        while (lowest_ > k) limb_[--lowest_] = 0;
+        while (highest_ < k + 1) limb_[++highest_] = 0;
+    }
+
     std::int64_t limb_[k_limbs];
+    int lowest_ = 1, highest_ = 0; ///< the limbs in use, lowest_ .. highest_ (none at first)
 };
 
 /// @brief Exact sign of the 2x2 determinant (p1 - p0)_u (q1 - q0)_v - (p1 - p0)_v (q1 - q0)_u in the
@@ -137,14 +149,38 @@ KDET_HD inline int sign_det2_exact(vec3 p0, vec3 p1, vec3 q0, vec3 q1, int u, in
     return sum.sign();
 }
 
-/// @brief Exact sign of det(p1 - p0, q1 - q0, r1 - r0) (rows): 48 products of three floats.
+/// @brief The coordinate in which the difference to - from is non-zero when it is the only one; -1
+/// when two or more are; 3 when none is.
+KDET_HD inline int single_coordinate(vec3 from, vec3 to) {
+    const bool x = from.x != to.x, y = from.y != to.y, z = from.z != to.z;
+    return int{x} + int{y} + int{z} > 1 ? -1 : (x ? 0 : (y ? 1 : (z ? 2 : 3)));
+}
+
+/// @brief Exact sign of det(p1 - p0, q1 - q0, r1 - r0) (rows): 48 products of three floats, or one
+/// 2x2 determinant when a row has a single non-zero coordinate c (det(p, q, r) = r_c (p x q)_c, and
+/// the rows may be rotated), which is common in meshes moved along a coordinate axis.
 KDET_HD inline int sign_det3_exact(vec3 p0, vec3 p1, vec3 q0, vec3 q1, vec3 r0, vec3 r1) {
+    const vec3 rows[3][2] = {{p0, p1}, {q0, q1}, {r0, r1}};
+    KDET_NO_UNROLL
+    for (int row = 2; row >= 0; --row) {
+        const int c = single_coordinate(rows[row][0], rows[row][1]);
+        if (c == 3) return 0;
+        if (c < 0) continue;
+        const vec3* u = rows[(row + 1) % 3];
+        const vec3* v = rows[(row + 2) % 3];
+        const int sign = component(rows[row][1], c) > component(rows[row][0], c) ? 1 : -1;
+        return sign * sign_det2_exact(u[0], u[1], v[0], v[1], (c + 1) % 3, (c + 2) % 3);
+    }
     const vec3 p[2] = {p0, p1}, q[2] = {q0, q1}, r[2] = {r0, r1};
     ExactSum sum;
     KDET_NO_UNROLL
     for (int s = 0; s < 6; ++s) {
-        // The permutations (a, b, c) of (x, y, z): cyclic ones for s < 3, the odd ones subtracted.
+        // The permutations (a, b, c) of (x, y, z): cyclic ones for s < 3, the odd ones subtracted. A term
+        // with a zero difference (equal coordinates, common in meshes moved along an axis) adds nothing.
         const int a = s % 3, b = (a + (s < 3 ? 1 : 2)) % 3, c = 3 - a - b;
+        if (component(p0, a) == component(p1, a) || component(q0, b) == component(q1, b) ||
+            component(r0, c) == component(r1, c))
+            continue;
         KDET_NO_UNROLL
         for (int i = 0; i < 2; ++i)
             KDET_NO_UNROLL

@@ -31,11 +31,12 @@ namespace kdet::narrow {
 // ---- Error bounds. u is the unit roundoff (2^-24 for float, 2^-53 for double); ||.||_1 and
 // ||.||_inf are the 1- and max-norms of the computed (rounded) vectors. For rows p, q, x that are each
 // one rounded difference of input points, the computed (p x q) . x differs from det(P, Q, X) of the
-// exact differences by at most 8u(1 + 25u) ||p||_1 ||q||_1 ||x||_inf (6 terms, each through 3 roundings
-// of its inputs and at most 5 of the arithmetic), plus, in float only, eta (2.001 ||x||_1 + 3.001) for
-// products that underflow (eta = 2^-150). A gap (difference of two projections, rounded once) is
-// therefore certain beyond twice that, with (1 + 2u) for its own rounding; the constants below add
-// the roundings of computing the bound itself, with room to spare.
+// exact differences by at most 8u(1 + 11u) ||p||_1 ||q||_1 ||x||_inf (6 terms, each through 3 roundings
+// of its inputs and at most 5 of the arithmetic: gamma_8 / (1 - u)^3), plus, in float only,
+// eta (2.001 ||x||_1 + 3.001) for products that underflow (eta = 2^-150). A gap (difference of two
+// projections, rounded once) therefore has the exact gap's sign beyond 2(1 + u) times that; the
+// constants below also cover the roundings of computing the bound itself, (1 - u)^7, with room to
+// spare.
 
 /// @brief Gap bound factor in float: 16u(1 + 64u), u = 2^-24; times ||p||_1 ||q||_1 max|x|.
 constexpr float k_float_gap_bound = 0x1p-20f * (1.0f + 0x1p-18f);
@@ -141,7 +142,8 @@ KDET_HD inline dvec3 cross(dvec3 a, dvec3 b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 KDET_HD inline double norm1(dvec3 v) { return fabs(v.x) + fabs(v.y) + fabs(v.z); }
-KDET_HD inline double norm_inf(dvec3 v) { return fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z))); }
+KDET_HD inline double max_d(double a, double b) { return a > b ? a : b; }
+KDET_HD inline double norm_inf(dvec3 v) { return max_d(fabs(v.x), max_d(fabs(v.y), fabs(v.z))); }
 KDET_HD inline double component(dvec3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
 
 /// @brief One of the 12 edges of the pair as its two input points: 0..5 of a, 6..11 of b.
@@ -168,6 +170,32 @@ KDET_HD inline int sign_det3(Segment p, Segment q, Segment r) {
 /// @brief Exact sign of the 2-D determinant of two differences in the coordinates (u, v).
 KDET_HD inline int sign_det2(Segment p, Segment q, int u, int v) {
     return exact::sign_det2_exact(p.from, p.to, q.from, q.to, u, v);
+}
+
+/// @brief Whether a + b == c + d exactly for floats: each sum as its double and the exact rounding
+/// error of that double (Knuth's TwoSum), a pair that only the same real number gives.
+KDET_HD inline bool sums_equal(float a, float b, float c, float d) {
+    const double s = double{a} + b, t = double{c} + d;
+    const double sb = s - a, tb = t - c;
+    return s == t && (a - (s - sb)) + (b - sb) == (c - (t - tb)) + (d - tb);
+}
+
+/// @brief Whether two differences of float points are exactly parallel (or zero): equal or opposite
+/// differences (a shared edge, an exactly translated copy) by a few exact sums, otherwise all three
+/// components of their cross product exactly 0.
+KDET_HD inline bool parallel_exactly(Segment p, Segment q) {
+    bool equal = true, opposite = true;
+    KDET_NO_UNROLL
+    for (int k = 0; k < 3; ++k) {
+        const float p0 = component(p.from, k), p1 = component(p.to, k), q0 = component(q.from, k), q1 = component(q.to, k);
+        equal = equal && sums_equal(p1, q0, q1, p0);    // p1 - p0 == q1 - q0
+        opposite = opposite && sums_equal(p1, q1, q0, p0); // p1 - p0 == q0 - q1
+    }
+    if (equal || opposite) return true;
+    KDET_NO_UNROLL
+    for (int k = 0; k < 3; ++k)
+        if (sign_det2(p, q, (k + 1) % 3, (k + 2) % 3) != 0) return false;
+    return true;
 }
 
 /// @brief Projections of an axis in double, with the bound on the error of a difference between a
@@ -222,7 +250,7 @@ KDET_HD inline double translated_extent(const vec3 a[4], const vec3 b[4]) {
     const dvec3 origin = widen(a[0]);
     double extent = 0.0;
     KDET_NO_UNROLL
-    for (int i = 0; i < 4; ++i) extent = fmax(extent, fmax(norm_inf(widen(a[i]) - origin), norm_inf(widen(b[i]) - origin)));
+    for (int i = 0; i < 4; ++i) extent = max_d(extent, max_d(norm_inf(widen(a[i]) - origin), norm_inf(widen(b[i]) - origin)));
     return extent;
 }
 
@@ -239,6 +267,9 @@ KDET_HD inline bool axis_separates_exactly(const vec3 a[4], const vec3 b[4], int
     }
     const dvec3 dp = widen(p.to) - widen(p.from), dq = widen(q.to) - widen(q.from);
     const dvec3 n = cross(dp, dq), origin = widen(a[0]);
+    // Edges that are exactly parallel (translated copies, a shared edge) give an axis that never
+    // separates. Three exact 2x2 determinants prove it, where the gaps would need two 3x3 ones.
+    if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0 && parallel_exactly(p, q)) return false;
     ExactProjections s;
     KDET_NO_UNROLL
     for (int i = 0; i < 4; ++i) {
