@@ -15,7 +15,7 @@ namespace kdet::cli {
 struct BenchConfig {
     std::string scene = "procedural";
     SceneRequest request;                       ///< -r, and --tets / --scene-frames for "procedural"
-    DetectorOptions options;                    ///< -c, -o, -h, -g, --backend, --threads
+    DetectorOptions options;                    ///< -c, -o (default sat, as in the thesis), -h, -g, --backend, --threads
     int runs = 10;                              ///< -n
     bool self = false;                          ///< -s
     std::string output_dir = "exports/benchmark_data"; ///< -d

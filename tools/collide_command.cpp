@@ -89,7 +89,7 @@ void add_detector_options(ArgParser& parser, DetectorOptions& options) {
     parser.option("--test", "test", [&](const std::string& v) {
         if (!parse(v, options.narrow_phase))
             throw UsageError("invalid value '" + v + "' for --test: expected " +
-                             join_choices({"sat", "sat_no_edges", "sat_mtv", "gjk", "fast", "exact"}));
+                             join_choices({"exact", "sat", "sat_no_edges", "sat_mtv", "gjk", "fast"}));
     });
     parser.option("--hash", "hash", [&](const std::string& v) {
         if (!parse(v, options.hash))
@@ -112,7 +112,7 @@ void add_detector_options(ArgParser& parser, DetectorOptions& options) {
 
 const char* detector_options_help() {
     return R"(  --method M           kdet (default), kdet_no_pairs, brute_force_loop, brute_force_pairs
-  --test T             narrow phase: sat (default), sat_no_edges, sat_mtv, gjk, fast, exact
+  --test T             narrow phase: exact (default), sat, sat_no_edges, sat_mtv, gjk, fast
   --hash H             grid hash: djb2 (default), fnv-1a, simple, morton
   --backend B          cpu (default) or cuda
   --threads N          CPU threads (default: all)

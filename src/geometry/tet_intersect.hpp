@@ -22,7 +22,7 @@
 namespace kdet {
 
 /// @brief Separating axis test over the 44 axes (4 + 4 face normals, 36 edge cross products).
-/// Edge pairs within sqrt(eps) of parallel are skipped (they add no usable axis); the default test.
+/// Edge pairs within sqrt(eps) of parallel are skipped (they add no usable axis).
 KDET_HD inline bool tets_intersect_sat(const vec3 a[4], const vec3 b[4]) {
     return narrow::sat_intersect(a, b, true);
 }
@@ -61,7 +61,7 @@ KDET_HD inline bool tets_intersect_fast(const vec3 a[4], const vec3 b[4]) { retu
 /// @brief Exact: true iff the closed tets share a point, for the float coordinates given (CGAL's
 /// do_intersect with exact predicates gives the same answer), zero-volume tets included. A float
 /// separating-axis test with proven error bounds decides almost every pair; the rest go to an exact
-/// stage (exact_test.hpp), and then `exact_stage` is set to true (it is never cleared).
+/// stage (exact_test.hpp), and then `exact_stage` is set to true (it is never cleared). The default test.
 KDET_HD inline bool tets_intersect_exact(const vec3 a[4], const vec3 b[4], bool& exact_stage) {
     return narrow::exact_intersect(a, b, exact_stage);
 }
