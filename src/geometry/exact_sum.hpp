@@ -132,47 +132,51 @@ private:
     int lowest_ = 1, highest_ = 0; ///< the limbs in use, lowest_ .. highest_ (none at first)
 };
 
-/// @brief Exact sign of the 2x2 determinant (p1 - p0)_u (q1 - q0)_v - (p1 - p0)_v (q1 - q0)_u in the
-/// coordinates u and v (0, 1, 2): 8 products of two floats.
-KDET_HD inline int sign_det2_exact(vec3 p0, vec3 p1, vec3 q0, vec3 q1, int u, int v) {
-    const vec3 p[2] = {p0, p1}, q[2] = {q0, q1};
-    ExactSum sum;
+/// @brief Adds (subtract: subtracts) the 2x2 determinant (p1 - p0)_u (q1 - q0)_v - (p1 - p0)_v (q1 - q0)_u
+/// in the coordinates u and v (0, 1, 2), p and q given as their two points: 8 products of two floats.
+KDET_HD inline void add_det2(ExactSum& sum, const vec3 p[2], const vec3 q[2], int u, int v, bool subtract) {
     KDET_NO_UNROLL
     for (int i = 0; i < 2; ++i)
         KDET_NO_UNROLL
         for (int j = 0; j < 2; ++j) {
             // Point 0 of a difference enters with a minus sign: the term's sign flips once per point 0.
-            const bool flip = (i == 0) != (j == 0);
+            const bool flip = ((i == 0) != (j == 0)) != subtract;
             sum.add_product(component(p[i], u), component(q[j], v), flip);
             sum.add_product(component(p[i], v), component(q[j], u), !flip);
         }
+}
+
+/// @brief Exact sign of the 2x2 determinant of p1 - p0 and q1 - q0 in the coordinates u and v.
+KDET_HD inline int sign_det2_exact(vec3 p0, vec3 p1, vec3 q0, vec3 q1, int u, int v) {
+    const vec3 p[2] = {p0, p1}, q[2] = {q0, q1};
+    ExactSum sum;
+    add_det2(sum, p, q, u, v, false);
     return sum.sign();
 }
 
 /// @brief The coordinate in which the difference to - from is non-zero when it is the only one; -1
 /// when two or more are; 3 when none is.
-KDET_HD inline int single_coordinate(vec3 from, vec3 to) {
-    const bool x = from.x != to.x, y = from.y != to.y, z = from.z != to.z;
+KDET_HD inline int single_coordinate(const vec3 points[2]) {
+    const bool x = points[0].x != points[1].x, y = points[0].y != points[1].y, z = points[0].z != points[1].z;
     return int{x} + int{y} + int{z} > 1 ? -1 : (x ? 0 : (y ? 1 : (z ? 2 : 3)));
 }
 
-/// @brief Exact sign of det(p1 - p0, q1 - q0, r1 - r0) (rows): 48 products of three floats, or one
-/// 2x2 determinant when a row has a single non-zero coordinate c (det(p, q, r) = r_c (p x q)_c, and
-/// the rows may be rotated), which is common in meshes moved along a coordinate axis.
+/// @brief Exact sign of det(p1 - p0, q1 - q0, r1 - r0) (rows): 48 products of three floats, or 8
+/// products of two when a row has a single non-zero coordinate c (det(p, q, r) = r_c (p x q)_c, the
+/// rows rotated as needed), which is common in meshes moved along a coordinate axis.
 KDET_HD inline int sign_det3_exact(vec3 p0, vec3 p1, vec3 q0, vec3 q1, vec3 r0, vec3 r1) {
-    const vec3 rows[3][2] = {{p0, p1}, {q0, q1}, {r0, r1}};
+    const vec3 p[2] = {p0, p1}, q[2] = {q0, q1}, r[2] = {r0, r1};
+    const vec3* rows[3] = {p, q, r};
+    ExactSum sum;
     KDET_NO_UNROLL
     for (int row = 2; row >= 0; --row) {
-        const int c = single_coordinate(rows[row][0], rows[row][1]);
+        const int c = single_coordinate(rows[row]);
         if (c == 3) return 0;
         if (c < 0) continue;
-        const vec3* u = rows[(row + 1) % 3];
-        const vec3* v = rows[(row + 2) % 3];
-        const int sign = component(rows[row][1], c) > component(rows[row][0], c) ? 1 : -1;
-        return sign * sign_det2_exact(u[0], u[1], v[0], v[1], (c + 1) % 3, (c + 2) % 3);
+        const bool falling = component(rows[row][1], c) < component(rows[row][0], c);
+        add_det2(sum, rows[(row + 1) % 3], rows[(row + 2) % 3], (c + 1) % 3, (c + 2) % 3, falling);
+        return sum.sign();
     }
-    const vec3 p[2] = {p0, p1}, q[2] = {q0, q1}, r[2] = {r0, r1};
-    ExactSum sum;
     KDET_NO_UNROLL
     for (int s = 0; s < 6; ++s) {
         // The permutations (a, b, c) of (x, y, z): cyclic ones for s < 3, the odd ones subtracted. A term
