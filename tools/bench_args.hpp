@@ -8,14 +8,19 @@
 #include <kdet/scenes.hpp>
 
 #include <string>
+#include <vector>
 
 namespace kdet::cli {
+
+/// @brief The detector options `kdet bench` starts from: the library's, except the test, which is the
+/// thesis's default (sat) so that its files compare with the thesis's.
+DetectorOptions bench_default_options();
 
 /// @brief Everything `kdet bench` was asked to do.
 struct BenchConfig {
     std::string scene = "procedural";
     SceneRequest request;                       ///< -r, and --tets / --scene-frames for "procedural"
-    DetectorOptions options;                    ///< -c, -o (default sat, as in the thesis), -h, -g, --backend, --threads
+    DetectorOptions options = bench_default_options(); ///< -c, -o, -h, -g, --backend, --threads
     int runs = 10;                              ///< -n
     bool self = false;                          ///< -s
     std::string output_dir = "exports/benchmark_data"; ///< -d
@@ -31,9 +36,12 @@ struct BenchConfig {
 BenchConfig parse_bench_args(int argc, char** argv, int first);
 
 /// @brief The thesis's name for a method (`-c`): kdet, kdet_no_pairs, gpu, gpu_no_loop.
-const char* bench_method_name(Method method);
+std::string bench_method_name(Method method);
+
+/// @brief The CUDA block sizes `-g` accepts, as in the thesis.
+const std::vector<std::string>& bench_block_sizes();
 
 /// @brief The text of `kdet bench --help`.
-const char* bench_help();
+std::string bench_help();
 
 } // namespace kdet::cli
