@@ -379,4 +379,39 @@ TEST(ExactTest, PipelineCountsPairsThatReachedTheExactStage) {
     EXPECT_EQ(count(Method::kdet, NarrowPhase::sat), 0u);
 }
 
+/// Zero-volume tets (which only ReadOptions::allow_degenerate lets in from files) go through the whole
+/// pipeline and are decided exactly: a flat tet touched at one interior point by a solid tet, and a
+/// collinear tet touched at one point, collide; the same solid tets moved 2^-20 away do not, although
+/// that gap is below the float tests' tolerance (sat still reports them).
+TEST(ExactTest, PipelineDecidesZeroVolumeTetsExactly) {
+    const auto one_tet = [](std::vector<double> xyz) {
+        TetMesh mesh;
+        mesh.positions = std::move(xyz);
+        mesh.tets = {0, 1, 2, 3};
+        return mesh;
+    };
+    const auto moved = [](TetMesh mesh, int axis, double by) {
+        for (std::size_t v = 0; v < mesh.num_vertices(); ++v) mesh.positions[3 * v + axis] += by;
+        return mesh;
+    };
+    const auto pairs = [](const TetMesh& a, const TetMesh& b, NarrowPhase test) {
+        DetectorOptions options;
+        options.narrow_phase = test;
+        return kdet::collide(a, b, options).size();
+    };
+    const double gap = std::ldexp(1.0, -20);
+    // In the plane x + y + z = 1, and a tet on its side of the plane with one vertex in the flat tet.
+    const TetMesh flat = one_tet({1, 0, 0, 0, 1, 0, 0, 0, 1, 0.25, 0.25, 0.5});
+    const TetMesh on_flat = one_tet({0.5, 0.25, 0.25, 1.5, 0.25, 0.25, 0.5, 1.25, 0.25, 0.5, 0.25, 1.25});
+    const TetMesh line = one_tet({0, 0, 0, 1, 1, 1, 0.5, 0.5, 0.5, 0.25, 0.25, 0.25});
+    const TetMesh on_line = one_tet({0.75, 0.75, 0.75, 1.75, 0.75, 0.75, 0.75, 1.75, 0.75, 0.75, 0.75, -0.25});
+    EXPECT_EQ(pairs(flat, on_flat, NarrowPhase::exact), 1u);
+    EXPECT_EQ(pairs(flat, moved(on_flat, 0, gap), NarrowPhase::exact), 0u);
+    EXPECT_EQ(pairs(flat, moved(on_flat, 0, gap), NarrowPhase::sat), 1u);
+    EXPECT_EQ(pairs(line, on_line, NarrowPhase::exact), 1u);
+    EXPECT_EQ(pairs(line, moved(on_line, 0, gap), NarrowPhase::exact), 0u);
+    EXPECT_EQ(pairs(line, moved(on_line, 0, gap), NarrowPhase::sat), 1u);
+    EXPECT_EQ(pairs(flat, line, NarrowPhase::exact), 1u); // the line crosses the plane at (1, 1, 1) / 3
+}
+
 } // namespace
