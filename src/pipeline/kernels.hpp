@@ -67,14 +67,16 @@ KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<
 
 /// @brief The predicate every method applies to a pair that may collide: adjacency, boxes, narrow phase.
 /// The lower stored id always goes first so every method sees the same floating-point computation.
-KDET_HD inline bool tets_collide(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u) {
+/// `exact_stage` is set when the pair reached the exact stage of NarrowPhase::exact.
+KDET_HD inline bool tets_collide(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u,
+                                 bool& exact_stage) {
     const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
     if (s.tet_object[first] == s.tet_object[second] && share_vertex(s.tets[first], s.tets[second])) return false;
     if (!boxes_overlap(s.info[first].box, s.info[second].box)) return false;
     vec3 a[4], b[4];
     load_tet(s, first, a);
     load_tet(s, second, b);
-    return tets_intersect(test, a, b);
+    return tets_intersect(test, a, b, exact_stage);
 }
 
 /// @brief Stage 1: box of each tet; no size and no layer yet.
@@ -310,26 +312,31 @@ struct NoPairsKernel {
     NarrowPhase test;
     std::uint32_t* colliding;
     unsigned long long* tests_run;
+    unsigned long long* exact_stage_pairs;
 
     struct TestAndFlag {
         const NoPairsKernel* kernel;
         std::uint32_t t;
         unsigned long long tests;
+        unsigned long long exact_stage;
         KDET_HD void operator()(std::uint32_t u) {
             std::uint32_t* flags = kernel->colliding;
             if (atomic_load_acquire(&flags[t]) && atomic_load_acquire(&flags[u])) return;
             ++tests;
-            if (tets_collide(kernel->scene, kernel->test, t, u)) {
+            bool reached_exact = false;
+            if (tets_collide(kernel->scene, kernel->test, t, u, reached_exact)) {
                 atomic_store_relaxed(&flags[t], 1u);
                 atomic_store_relaxed(&flags[u], 1u);
             }
+            exact_stage += reached_exact;
         }
     };
 
     KDET_HD void operator()(std::uint64_t i) const {
-        TestAndFlag visit{this, static_cast<std::uint32_t>(i), 0};
+        TestAndFlag visit{this, static_cast<std::uint32_t>(i), 0, 0};
         for_each_larger_neighbour(scene, grid, params, layer_mask, visit.t, visit);
         if (visit.tests) atomic_fetch_add(tests_run, visit.tests);
+        if (visit.exact_stage) atomic_fetch_add(exact_stage_pairs, visit.exact_stage);
     }
 };
 
@@ -339,18 +346,24 @@ struct BruteForceLoopKernel {
     NarrowPhase test;
     const std::uint32_t* object_tet_begin; ///< [object_count + 1]
     KeyAppender out;
+    unsigned long long* exact_stage_pairs;
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto t = static_cast<std::uint32_t>(i);
         const std::uint32_t object = scene.tet_object[t];
         KeyBatch batch(&out);
+        unsigned long long exact_stage = 0;
         for (std::uint32_t other = object; other < scene.object_count; ++other) {
             if (!pair_is_active(scene, object, other)) continue;
             const std::uint32_t begin = other == object ? t + 1 : object_tet_begin[other];
-            for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u)
-                if (tets_collide(scene, test, t, u)) batch.push(pair_key(t, u));
+            for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u) {
+                bool reached_exact = false;
+                if (tets_collide(scene, test, t, u, reached_exact)) batch.push(pair_key(t, u));
+                exact_stage += reached_exact;
+            }
         }
         batch.flush();
+        if (exact_stage) atomic_fetch_add(exact_stage_pairs, exact_stage);
     }
 };
 
@@ -364,6 +377,7 @@ struct BruteForcePairsKernel {
     const std::uint32_t* block_objects;    ///< [2 * block_count]
     std::uint32_t block_count;
     KeyAppender out;
+    unsigned long long* exact_stage_pairs;
 
     KDET_HD void operator()(std::uint64_t work) const {
         std::uint32_t b = 0;
@@ -388,7 +402,9 @@ struct BruteForcePairsKernel {
         }
         const auto t = static_cast<std::uint32_t>(object_tet_begin[oa] + i);
         const auto u = static_cast<std::uint32_t>(object_tet_begin[ob] + j);
-        if (tets_collide(scene, test, t, u)) out.push(pair_key(t, u));
+        bool reached_exact = false;
+        if (tets_collide(scene, test, t, u, reached_exact)) out.push(pair_key(t, u));
+        if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull);
     }
 };
 
@@ -399,13 +415,16 @@ struct NarrowPhaseKernel {
     const std::uint64_t* keys;
     std::uint32_t* hit;
     std::uint32_t* colliding;
+    unsigned long long* exact_stage_pairs;
 
     KDET_HD void operator()(std::uint64_t k) const {
         const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
         vec3 a[4], b[4];
         load_tet(scene, t, a);
         load_tet(scene, u, b);
-        const bool collides = tets_intersect(test, a, b);
+        bool reached_exact = false;
+        const bool collides = tets_intersect(test, a, b, reached_exact);
+        if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
         hit[k] = collides ? 1u : 0u;
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);

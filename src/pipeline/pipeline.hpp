@@ -17,6 +17,7 @@ namespace kdet {
 struct FrameCounters {
     unsigned long long candidates;
     unsigned long long tests_run;
+    unsigned long long exact_stage_pairs; ///< pairs that reached the exact stage of NarrowPhase::exact
     std::uint32_t grid_failure;
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
@@ -310,6 +311,7 @@ void Pipeline<Exec>::append_candidates_growing(const Launch& launch, FrameCounts
         launch(candidate_appender());
         const FrameCounters after = read_counters();
         counts.candidates = after.candidates;
+        counts.exact_stage_pairs = after.exact_stage_pairs; // brute force tests while it appends
         if (after.candidates <= candidates_.size()) return;
         candidates_.resize_discard(after.candidates + after.candidates / 4);
         ++counts.buffer_regrows;
@@ -357,10 +359,12 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
                 exec_.for_each(block_begin.back(),
                                BruteForcePairsKernel{scene_view(), options_.narrow_phase, object_tet_begin_.data(),
                                                      blocks_begin_.data(), block_objects_.data(),
-                                                     static_cast<std::uint32_t>(block_objects.size() / 2), out});
+                                                     static_cast<std::uint32_t>(block_objects.size() / 2), out,
+                                                     &counters_.data()->exact_stage_pairs});
             else
                 exec_.for_each(tets_.size(), BruteForceLoopKernel{scene_view(), options_.narrow_phase,
-                                                                  object_tet_begin_.data(), out});
+                                                                  object_tet_begin_.data(), out,
+                                                                  &counters_.data()->exact_stage_pairs});
         },
         counts);
 }
@@ -371,8 +375,11 @@ template <class Exec>
 void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& result) {
     hit_.resize_discard(unique);
     position_.resize_discard(unique);
+    const bool exact = options_.narrow_phase == NarrowPhase::exact;
+    if (exact) reset_counters();
     exec_.for_each(unique, NarrowPhaseKernel{scene_view(), options_.narrow_phase, candidates_.data(), hit_.data(),
-                                             colliding_.data()});
+                                             colliding_.data(), &counters_.data()->exact_stage_pairs});
+    if (exact) result.counts.exact_stage_pairs = read_counters().exact_stage_pairs;
     const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), unique);
     out_keys_.resize_discard(colliding);
     exec_.for_each(unique, CompactKernel{candidates_.data(), hit_.data(), position_.data(), out_keys_.data()});
@@ -464,8 +471,11 @@ void Pipeline<Exec>::detect(const std::vector<PositionUpload>& uploads, const st
                 reset_counters();
                 exec_.for_each(tets_.size(), NoPairsKernel{scene_view(), grid, params_, layer_mask_,
                                                            options_.narrow_phase, colliding_.data(),
-                                                           &counters_.data()->tests_run});
-                counts.candidates = counts.unique_candidates = read_counters().tests_run;
+                                                           &counters_.data()->tests_run,
+                                                           &counters_.data()->exact_stage_pairs});
+                const FrameCounters after = read_counters();
+                counts.candidates = counts.unique_candidates = after.tests_run;
+                counts.exact_stage_pairs = after.exact_stage_pairs;
             }
         } else {
             brute_force(counts);
