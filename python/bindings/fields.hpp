@@ -34,6 +34,7 @@ constexpr auto fields_of<FrameCounts>() {
     using C = FrameCounts;
     return std::make_tuple(Field{"candidates", &C::candidates}, Field{"unique_candidates", &C::unique_candidates},
                            Field{"colliding_pairs", &C::colliding_pairs}, Field{"colliding_tets", &C::colliding_tets},
+                           Field{"exact_stage_pairs", &C::exact_stage_pairs},
                            Field{"buffer_regrows", &C::buffer_regrows}, Field{"grid_cells", &C::grid_cells},
                            Field{"grid_slots", &C::grid_slots},
                            Field{"grid_overflow_buckets", &C::grid_overflow_buckets},

@@ -26,8 +26,9 @@ def main() -> None:
     parser.add_argument("a", nargs="?", type=Path, default=default_model("octopus-low.mesh"))
     parser.add_argument("b", nargs="?", type=Path, default=default_model("octopus-low.mesh"))
     parser.add_argument("--frames", type=int, default=10)
-    parser.add_argument("--method", default="kdet", choices=kdet.METHODS)
-    parser.add_argument("--test", default="sat", choices=kdet.TESTS)
+    defaults = kdet.Detector().options  # the library's own defaults
+    parser.add_argument("--method", default=defaults["method"], choices=kdet.METHODS)
+    parser.add_argument("--test", default=defaults["test"], choices=kdet.TESTS)
     args = parser.parse_args()
 
     a, b = kdet.read_tet_mesh(args.a), kdet.read_tet_mesh(args.b)
