@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Configures and builds kdet into build/ (CUDA is added automatically when nvcc is found).
+# Configures and builds kdet into build/ with the `release` preset of CMakePresets.json (CUDA is added
+# automatically when nvcc is found). Extra arguments go to the configure step, e.g. -DKDET_WARNINGS_AS_ERRORS=ON.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-export PATH="$PATH:/usr/local/cuda/bin"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
-cmake --build build -j"$(nproc)"
+cmake --preset release "$@" >/dev/null
+cmake --build --preset release -j"$(nproc)"

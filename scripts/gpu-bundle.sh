@@ -4,7 +4,7 @@
 # (made here), the shared libraries it needs beyond the C/C++ runtimes, the models and the prepared
 # meshes of the thesis scenes. The bundle is a git-ignored folder that the device tool carries.
 #
-# usage: scripts/gpu-bundle.sh            builds build-gpu/ and fills .gpu-bundle/
+# usage: scripts/gpu-bundle.sh            builds build-gpu/ (preset cuda) and fills .gpu-bundle/
 # then, with the device tool, one call per part:
 #   run(command="bash scripts/gpu-session.sh checks", carry=[".gpu-bundle"]), then matrix, then scaling
 set -euo pipefail
@@ -17,7 +17,7 @@ cache_dir="${KDET_CACHE_DIR:-$HOME/.cache/kdet}"
 exclude="$(git -C "$repo" rev-parse --absolute-git-dir)/info/exclude"
 mkdir -p "$(dirname "$exclude")"
 grep -qx '/.gpu-bundle/' "$exclude" 2>/dev/null || echo '/.gpu-bundle/' >>"$exclude"
-cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKDET_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=90 >/dev/null
+(cd "$repo" && cmake --preset cuda -B "$build" >/dev/null)
 cmake --build "$build" -j"$(nproc)" --target kdet_cli kdet_tests
 
 # The thesis scenes read their models and prepared meshes; prepare any that are missing.

@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
 # Installs what kdet needs to build and test on Debian (run as root). Skips apt when all is there.
 set -euo pipefail
-packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3 clang libclang-rt-14-dev tetgen)
+# python3-venv and python3-dev: the Python package is built (headers) and tested in a virtual environment;
+# ninja-build: the generator scikit-build-core uses for it, the same one for every pip call; ccache: the
+# test command's later builds of the library (Python package, consumer) reuse the first one's objects.
+packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3 python3-venv python3-dev ninja-build ccache
+  clang libclang-rt-14-dev tetgen)
 # `kdet view`: GLFW, Dear ImGui (with its GLFW and OpenGL 3 backends), libepoxy, libpng; its tests draw
 # under Xvfb with Mesa's software renderer (llvmpipe).
 packages+=(pkg-config libglfw3-dev libimgui-dev libepoxy-dev libpng-dev xvfb xauth libgl1-mesa-dri)

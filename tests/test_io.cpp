@@ -278,6 +278,23 @@ TEST(IoRoundTrip, BunnyThroughBothFormats) {
     expect_same_mesh(kdet::read_tet_mesh(dir.file_path("bunny.mesh")), bunny);
 }
 
+TEST(IoRoundTrip, WriterChosenByExtensionReadsBack) {
+    TempDir dir;
+    for (const char* name : {"small.mesh", "small.msh", "small.vtk", "small", "small2.node", "small3.ele"})
+        for (const bool binary : {false, true}) {
+            const std::string path = dir.file_path(name);
+            kdet::write_tet_mesh(two_tets(), path, kdet::WriteOptions{binary});
+            expect_same_mesh(kdet::read_tet_mesh(path), two_tets());
+        }
+    // The binary flag reaches the formats that have a binary form.
+    kdet::write_tet_mesh(two_tets(), dir.file_path("ascii.msh"));
+    kdet::write_tet_mesh(two_tets(), dir.file_path("binary.msh"), kdet::WriteOptions{true});
+    EXPECT_NE(fs::file_size(dir.file_path("ascii.msh")), fs::file_size(dir.file_path("binary.msh")));
+    const std::string message = error_message([&] { kdet::write_tet_mesh(two_tets(), dir.file_path("out.obj")); });
+    EXPECT_EQ(message.rfind(dir.file_path("out.obj") + ": cannot write mesh format", 0), 0u) << message;
+    EXPECT_FALSE(fs::exists(dir.file_path("out.obj")));
+}
+
 TEST(IoRoundTrip, WritersRefuseInvalidMeshes) {
     TempDir dir;
     kdet::TetMesh mesh = two_tets();

@@ -98,6 +98,17 @@ void write_gmsh(const TetMesh& mesh, const std::string& path, const GmshFormat& 
 /// or the file cannot be written.
 void write_vtk(const TetMesh& mesh, const std::string& path, const VtkFormat& format = {});
 
+/// @brief How write_tet_mesh writes formats that have a binary form (Gmsh, VTK).
+struct WriteOptions {
+    bool binary = false;
+};
+
+/// @brief Writes a mesh in the format that read_tet_mesh chooses for the extension of @p path:
+/// ".mesh" MEDIT, ".msh" Gmsh 4.1, ".vtk" VTK 5.1 (binary when @p options say so), and ".node",
+/// ".ele" or no extension TetGen (`name.node` + `name.ele`). Coordinates read back exactly.
+/// @throws Error for any other extension, an invalid mesh or a file that cannot be written.
+void write_tet_mesh(const TetMesh& mesh, const std::string& path, const WriteOptions& options = {});
+
 /// @brief Checks a mesh built in memory with the same rules the readers apply: whole vertices and
 /// tetrahedra, finite coordinates, indices in range, at least one tetrahedron, and no zero-volume
 /// tetrahedra unless @p options allows them.

@@ -1,5 +1,6 @@
 /// @file read_mesh.cpp
-/// @brief The TetGen and MEDIT readers, the reader chosen by extension, and validate_tet_mesh.
+/// @brief The TetGen and MEDIT readers, the reader and the writer chosen by extension, and
+/// validate_tet_mesh.
 
 #include "io/text_reader.hpp"
 
@@ -307,6 +308,17 @@ TetMesh read_tet_mesh(const std::string& path, const ReadOptions& options) {
     throw Error(path + ": unsupported mesh format " + excerpt(extension) +
                 "; supported: .mesh (MEDIT ASCII), .msh (Gmsh 2.2/4.1), .vtk (legacy VTK), .node/.ele or a name "
                 "without extension (TetGen)");
+}
+
+void write_tet_mesh(const TetMesh& mesh, const std::string& path, const WriteOptions& options) {
+    const std::string extension = std::filesystem::path(path).extension().string();
+    if (extension == ".mesh") return write_medit(mesh, path);
+    if (extension == ".msh") return write_gmsh(mesh, path, GmshFormat{GmshVersion::v4_1, options.binary});
+    if (extension == ".vtk") return write_vtk(mesh, path, VtkFormat{VtkVersion::v5_1, options.binary});
+    if (extension.empty() || extension == ".node" || extension == ".ele") return write_tetgen(mesh, tetgen_stem(path));
+    throw Error(path + ": cannot write mesh format " + excerpt(extension) +
+                "; supported: .mesh (MEDIT), .msh (Gmsh 4.1), .vtk (legacy VTK 5.1), .node/.ele or a name without "
+                "extension (TetGen)");
 }
 
 void validate_tet_mesh(const TetMesh& mesh, const std::string& source, const ReadOptions& options) {

@@ -1,0 +1,581 @@
+// The kdet._kdet extension module: the library's API with NumPy arrays in and out. The pure-Python
+// part of the package (python/src/kdet/__init__.py) re-exports it and adds collide() and collide_self().
+#include "arrays.hpp"
+#include "fields.hpp"
+#ifdef KDET_HAS_CUDA
+#include "device_arrays.hpp"
+#endif
+
+#include <kdet/kdet.hpp>
+
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+namespace kdet::python {
+
+namespace {
+
+using namespace nb::literals;
+
+// ---------------------------------------------------------------------------------------------
+// Options: every name goes through the library's one table (kdet::parse, kdet::option_names), so a
+// new method, test, hash or backend appears here without a change to this file.
+
+std::string join_names(const std::vector<std::string>& names) {
+    std::string out;
+    for (std::size_t i = 0; i < names.size(); ++i) out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+    return out;
+}
+
+template <class Option>
+Option parse_option(const char* argument, const std::string& text) {
+    Option value{};
+    if (!kdet::parse(text, value))
+        throw Error("invalid value '" + text + "' for " + argument + ": expected " + join_names(option_names<Option>()));
+    return value;
+}
+
+template <class Option>
+nb::tuple names_of() {
+    nb::list names;
+    for (const std::string& name : option_names<Option>()) names.append(name);
+    return nb::tuple(names);
+}
+
+std::uint32_t positive_u32(const char* argument, std::int64_t value) {
+    if (value < 1 || value > 0xffffffffll)
+        throw Error(std::string(argument) + ": expected a positive number below 2^32, got " + std::to_string(value));
+    return static_cast<std::uint32_t>(value);
+}
+
+/// A CUDA stream as the GPU libraries hand it out: None (the default stream), a cudaStream_t as an int, or
+/// a stream object with __cuda_stream__ (the CUDA stream protocol), .cuda_stream (PyTorch, Warp) or .ptr
+/// (CuPy).
+void* cuda_stream_handle(nb::handle stream) {
+    if (stream.is_none()) return nullptr;
+    nb::object value = nb::borrow(stream);
+    if (nb::hasattr(stream, "__cuda_stream__")) {
+        value = stream.attr("__cuda_stream__")();
+        if (!nb::isinstance<nb::tuple>(value) || nb::len(value) != 2)
+            throw nb::type_error("cuda_stream: __cuda_stream__() must return (version, handle)");
+        value = value[1];
+    } else if (nb::hasattr(stream, "cuda_stream")) {
+        value = stream.attr("cuda_stream");
+    } else if (nb::hasattr(stream, "ptr")) {
+        value = stream.attr("ptr");
+    }
+    if (!PyLong_Check(value.ptr()))
+        throw nb::type_error(("cuda_stream: expected None, a cudaStream_t as an int or a CUDA stream object, got " +
+                              type_label(stream)).c_str());
+    const unsigned long long handle = PyLong_AsUnsignedLongLong(value.ptr());
+    if (PyErr_Occurred()) {
+        PyErr_Clear();
+        throw Error("cuda_stream: " + nb::cast<std::string>(nb::repr(value)) + " is not a stream handle");
+    }
+    return reinterpret_cast<void*>(static_cast<std::uintptr_t>(handle));
+}
+
+DetectorOptions make_options(const std::string& backend, const std::string& method, const std::string& test,
+                             const std::string& hash, std::optional<std::int64_t> threads, bool contacts,
+                             std::int64_t block_size, std::int64_t bucket_capacity,
+                             std::int64_t initial_candidate_capacity, nb::handle cuda_stream, bool results_to_host) {
+    DetectorOptions options;
+    options.backend = parse_option<Backend>("backend", backend);
+    options.method = parse_option<Method>("method", method);
+    options.narrow_phase = parse_option<NarrowPhase>("test", test);
+    options.hash = parse_option<HashFunction>("hash", hash);
+    options.threads = threads ? static_cast<int>(std::min<std::uint32_t>(positive_u32("threads", *threads), 1u << 20)) : 0;
+    options.contacts = contacts;
+    options.block_size = static_cast<int>(std::min<std::uint32_t>(positive_u32("block_size", block_size), 1u << 20));
+    options.bucket_capacity = positive_u32("bucket_capacity", bucket_capacity);
+    if (initial_candidate_capacity < 0)
+        throw Error("initial_candidate_capacity: expected 0 (sized from the tets) or a positive number, got " +
+                    std::to_string(initial_candidate_capacity));
+    options.initial_candidate_capacity = static_cast<std::size_t>(initial_candidate_capacity);
+    options.cuda_stream = cuda_stream_handle(cuda_stream);
+    options.results_to_host = results_to_host;
+    return options;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes
+
+/// A view of @p count rows of @p Columns values owned by the Python object @p owner.
+template <class Scalar, std::size_t Columns>
+nb::ndarray<nb::numpy, Scalar, nb::shape<-1, static_cast<nb::ssize_t>(Columns)>> rows_view(Scalar* data, std::size_t count,
+                                                                                          nb::handle owner) {
+    return {data, {count, Columns}, owner};
+}
+
+TetMesh mesh_from_arrays(nb::handle vertices, nb::handle tets, bool allow_degenerate, const char* vertices_name,
+                         const char* tets_name, const std::string& source) {
+    const Coordinates c = coordinates(vertices, vertices_name);
+    if (c.on_device) throw nb::type_error((std::string(vertices_name) + ": a mesh's vertices must be in host memory").c_str());
+    const TetIndices t = tet_indices(tets, tets_name);
+    TetMesh mesh;
+    mesh.positions.resize(3 * c.rows);
+    if (c.is_double) {
+        std::vector<double> storage;
+        const double* xyz = contiguous_host(c, storage);
+        std::copy(xyz, xyz + 3 * c.rows, mesh.positions.begin());
+    } else {
+        std::vector<float> storage;
+        const float* xyz = contiguous_host(c, storage);
+        std::copy(xyz, xyz + 3 * c.rows, mesh.positions.begin());
+    }
+    mesh.tets.assign(t.data, t.data + 4 * t.rows);
+    validate_tet_mesh(mesh, source, ReadOptions{allow_degenerate});
+    return mesh;
+}
+
+nb::object import_meshio(const char* what) {
+    try {
+        return nb::module_::import_("meshio");
+    } catch (const nb::python_error&) {
+        PyErr_SetString(PyExc_ImportError, (std::string(what) + " needs meshio: pip install meshio").c_str());
+        throw nb::python_error();
+    }
+}
+
+TetMesh from_meshio(nb::handle mesh, bool allow_degenerate) {
+    if (!nb::hasattr(mesh, "points") || !nb::hasattr(mesh, "cells"))
+        throw nb::type_error(("mesh: expected a meshio.Mesh, got " + type_label(mesh)).c_str());
+    nb::list tets;
+    std::string types;
+    const nb::object numpy = nb::module_::import_("numpy");
+    for (nb::handle block : mesh.attr("cells")) {
+        const std::string type = nb::cast<std::string>(block.attr("type"));
+        types += (types.empty() ? "" : ", ") + type;
+        // A quadratic tet's first four nodes are its corners.
+        if (type == "tetra" || type == "tetra10")
+            tets.append(numpy.attr("asarray")(block.attr("data"))[nb::make_tuple(nb::slice(nb::none(), nb::none(), nb::none()), nb::slice(0, 4, 1))]);
+    }
+    if (tets.size() == 0)
+        throw Error("from_meshio: the mesh has no tetra cells (it has: " + (types.empty() ? "no cells" : types) + ")");
+    const nb::object all = tets.size() == 1 ? nb::object(tets[0]) : numpy.attr("concatenate")(tets);
+    return mesh_from_arrays(mesh.attr("points"), all, allow_degenerate, "mesh.points", "mesh.cells (tetra)", "meshio mesh");
+}
+
+nb::object to_meshio(nb::handle self) {
+    const nb::object meshio = import_meshio("TetMesh.to_meshio()");
+    TetMesh& mesh = nb::cast<TetMesh&>(self);
+    // Copies: the meshio mesh must not change when this TetMesh does.
+    const nb::object points = nb::cast(rows_view<double, 3>(mesh.positions.data(), mesh.num_vertices(), self)).attr("copy")();
+    // int64 cells, as meshio's own readers make them (some of its writers reject unsigned types).
+    const nb::object cells =
+        nb::cast(rows_view<std::uint32_t, 4>(mesh.tets.data(), mesh.num_tets(), self)).attr("astype")("int64");
+    nb::list blocks;
+    blocks.append(nb::make_tuple("tetra", cells));
+    return meshio.attr("Mesh")(points, blocks);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Detection results
+
+/// What detect() returns on the host: the library's FrameResult, copied once out of the detector so that
+/// it stays valid after the next frame; its arrays are views of this copy.
+struct Frame {
+    FrameResult result;
+    bool contacts_enabled = false;
+};
+
+/// What detect(device_results=True) returns: DLPack arrays of the detector's own buffers (valid until the
+/// next detect()) and the frame's counts and times.
+struct DeviceFrame {
+    nb::object pair_keys, colliding, contacts;
+    FrameCounts counts;
+    StageTimes times;
+    std::size_t memory_bytes = 0;
+};
+
+template <class Scalar>
+nb::object device_view(const Scalar* data, std::initializer_list<std::size_t> shape, nb::handle owner, int device_type,
+                       int device_id) {
+    // A zero-sized export still needs an address: DLPack consumers reject null data pointers.
+    static Scalar empty{};
+    const Scalar* address = data ? data : &empty;
+    // array_api: an object with __dlpack__ and __dlpack_device__ (and the buffer protocol on the host).
+    return nb::cast(nb::ndarray<nb::array_api, Scalar>(const_cast<Scalar*>(address), shape, owner, {},
+                                                       nb::dtype<Scalar>(), device_type, device_id));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The detector
+
+/// A Detector and what the binding keeps beside it. Every call holds `mutex` with the GIL released, so
+/// that detect() can run while other Python threads work, and two threads never use the detector at once.
+struct PyDetector {
+    explicit PyDetector(const DetectorOptions& options) : detector(options) {}
+    Detector detector;
+    std::mutex mutex;
+#ifdef KDET_HAS_CUDA
+    DeviceScratch scratch;
+#endif
+};
+
+ObjectId object_id(PyDetector& self, std::int64_t object) {
+    if (object < 0 || static_cast<std::uint64_t>(object) >= self.detector.object_count())
+        throw Error("object id " + std::to_string(object) + " out of range (" +
+                    std::to_string(self.detector.object_count()) + " objects)");
+    return static_cast<ObjectId>(object);
+}
+
+ObjectId add_object(PyDetector& self, nb::handle vertices, nb::handle tets) {
+    const Coordinates c = coordinates(vertices, "vertices");
+    if (c.on_device)
+        throw nb::type_error("vertices: add_object reads the rest shape on the host; give set_positions the device array");
+    const TetIndices t = tet_indices(tets, "tets");
+    std::vector<double> doubles;
+    std::vector<float> floats;
+    nb::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(self.mutex);
+    if (c.is_double) return self.detector.add_object(contiguous_host(c, doubles), c.rows, t.data, t.rows);
+    return self.detector.add_object(contiguous_host(c, floats), c.rows, t.data, t.rows);
+}
+
+void set_device_positions(PyDetector& self, ObjectId id, const Coordinates& c) {
+#ifdef KDET_HAS_CUDA
+    if (self.detector.options().backend != Backend::cuda)
+        throw Error("positions: a CUDA array needs a detector with backend='cuda'; this one runs on the " +
+                    std::string(to_string(self.detector.options().backend)));
+    const int device = current_cuda_device();
+    const int holder = c.device_id >= 0 ? c.device_id : cuda_device_of(c.data);
+    if (holder >= 0 && holder != device)
+        throw Error("positions: the array lives on CUDA device " + std::to_string(holder) +
+                    ", the detector runs on device " + std::to_string(device));
+    nb::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(self.mutex);
+    if (c.stream) synchronize_cuda_stream(c.stream);
+    const float* xyz = c.contiguous() && !c.is_double
+                           ? static_cast<const float*>(c.data)
+                           : self.scratch.gather(c.data, c.is_double, c.rows, c.row_stride, c.column_stride,
+                                                 self.detector.options().cuda_stream);
+    self.detector.set_positions_on_device(id, xyz, c.rows);
+#else
+    (void)self;
+    (void)id;
+    (void)c;
+    throw Error("positions: a CUDA array needs kdet built with its CUDA backend (this build has none)");
+#endif
+}
+
+void set_positions(PyDetector& self, std::int64_t object, nb::handle positions) {
+    const ObjectId id = object_id(self, object);
+    const Coordinates c = coordinates(positions, "positions");
+    if (c.on_device) return set_device_positions(self, id, c);
+    std::vector<double> doubles;
+    std::vector<float> floats;
+    nb::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(self.mutex);
+    if (c.is_double)
+        self.detector.set_positions(id, contiguous_host(c, doubles), c.rows);
+    else
+        self.detector.set_positions(id, contiguous_host(c, floats), c.rows);
+}
+
+nb::object detect(nb::handle handle, bool device_results) {
+    PyDetector& self = nb::cast<PyDetector&>(handle);
+    const DetectorOptions& options = self.detector.options();
+    if (!device_results && !options.results_to_host)
+        throw Error("detect: this detector keeps its results on the device (results_to_host=False); call "
+                    "detect(device_results=True)");
+    std::unique_ptr<Frame> frame;
+    auto device_frame = std::make_unique<DeviceFrame>();
+    DeviceResults buffers;
+    {
+        nb::gil_scoped_release release;
+        std::lock_guard<std::mutex> lock(self.mutex);
+        const FrameResult& result = self.detector.detect();
+        if (device_results) {
+            buffers = self.detector.device_results();
+            device_frame->counts = result.counts;
+            device_frame->times = result.times;
+            device_frame->memory_bytes = result.memory_bytes;
+        } else {
+            frame = std::make_unique<Frame>(Frame{result, options.contacts});
+        }
+    }
+    if (frame) return nb::cast(frame.release(), nb::rv_policy::take_ownership);
+
+    int device_type = nb::device::cpu::value, device_id = 0;
+#ifdef KDET_HAS_CUDA
+    if (options.backend == Backend::cuda) {
+        device_type = nb::device::cuda::value;
+        device_id = current_cuda_device();
+    }
+#endif
+    device_frame->pair_keys = device_view(buffers.pair_keys, {buffers.pair_count}, handle, device_type, device_id);
+    device_frame->colliding = device_view(buffers.colliding, {buffers.tet_count}, handle, device_type, device_id);
+    device_frame->contacts = buffers.contacts
+                                 ? device_view(reinterpret_cast<const float*>(buffers.contacts), {buffers.pair_count, 4},
+                                               handle, device_type, device_id)
+                                 : nb::none();
+    return nb::cast(device_frame.release(), nb::rv_policy::take_ownership);
+}
+
+nb::dict options_dict(const DetectorOptions& o) {
+    nb::dict d;
+    d["backend"] = to_string(o.backend);
+    d["method"] = to_string(o.method);
+    d["test"] = to_string(o.narrow_phase);
+    d["hash"] = to_string(o.hash);
+    d["threads"] = o.threads ? nb::cast(o.threads) : nb::none();
+    d["contacts"] = o.contacts;
+    d["block_size"] = o.block_size;
+    d["bucket_capacity"] = o.bucket_capacity;
+    d["initial_candidate_capacity"] = o.initial_candidate_capacity;
+    d["cuda_stream"] = o.cuda_stream ? nb::cast(reinterpret_cast<std::uintptr_t>(o.cuda_stream)) : nb::none();
+    d["results_to_host"] = o.results_to_host;
+    return d;
+}
+
+/// Calls @p f with the lock held and the GIL released.
+template <class F>
+auto locked(PyDetector& self, F&& f) {
+    nb::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(self.mutex);
+    return f();
+}
+
+} // namespace
+
+} // namespace kdet::python
+
+NB_MODULE(_kdet, m) {
+    using namespace kdet;
+    using namespace kdet::python;
+    m.doc() = "kdet's extension module; use the kdet package, which re-exports it.";
+
+    nb::exception<Error> error(m, "Error", PyExc_ValueError);
+    error.attr("__doc__") = "Bad input to kdet (a file, an array, an index, a coordinate, an option): the "
+                            "library's one-line message. A ValueError.";
+
+    m.attr("BACKENDS") = names_of<Backend>();
+    m.attr("METHODS") = names_of<Method>();
+    m.attr("TESTS") = names_of<NarrowPhase>();
+    m.attr("HASHES") = names_of<HashFunction>();
+    m.attr("__version__") = KDET_VERSION_STRING;
+    m.def("version", &kdet::version, "The version, with the git commit the library was built from when known.");
+    m.def(
+        "cuda_available", [] { return kdet::cuda_available(); },
+        "True when the CUDA backend can run here (built with it, and a GPU present).");
+    m.def(
+        "cuda_unavailable_reason",
+        []() -> std::optional<std::string> {
+            std::string reason;
+            if (kdet::cuda_available(&reason)) return std::nullopt;
+            return reason;
+        },
+        "Why the CUDA backend cannot run here, or None when it can.");
+
+    nb::class_<TetMesh>(m, "TetMesh",
+                        "A tetrahedral mesh: vertices (n, 3) float64 and tets (m, 4) uint32, 0-based. Both are views "
+                        "of the mesh's own memory (no copies).")
+        .def(
+            "__init__",
+            [](TetMesh* self, nb::handle vertices, nb::handle tets, bool allow_degenerate) {
+                new (self) TetMesh(mesh_from_arrays(vertices, tets, allow_degenerate, "vertices", "tets", "TetMesh"));
+            },
+            "vertices"_a, "tets"_a, nb::kw_only(), "allow_degenerate"_a = false,
+            "Copies and checks the arrays as the readers check files (finite coordinates, indices in range, "
+            "no zero-volume tets unless allow_degenerate).")
+        .def_prop_ro(
+            "vertices",
+            [](nb::handle self) {
+                TetMesh& mesh = nb::cast<TetMesh&>(self);
+                return rows_view<double, 3>(mesh.positions.data(), mesh.num_vertices(), self);
+            },
+            "Vertex coordinates, (n, 3) float64.")
+        .def_prop_ro(
+            "tets",
+            [](nb::handle self) {
+                TetMesh& mesh = nb::cast<TetMesh&>(self);
+                return rows_view<std::uint32_t, 4>(mesh.tets.data(), mesh.num_tets(), self);
+            },
+            "Vertex indices of each tetrahedron, (m, 4) uint32.")
+        .def_prop_ro("num_vertices", &TetMesh::num_vertices)
+        .def_prop_ro("num_tets", &TetMesh::num_tets)
+        .def("to_meshio", &to_meshio, "A meshio.Mesh with one 'tetra' cell block (needs meshio).")
+        .def("__repr__", [](const TetMesh& mesh) {
+            return "TetMesh(" + std::to_string(mesh.num_vertices()) + " vertices, " + std::to_string(mesh.num_tets()) +
+                   " tets)";
+        });
+
+    m.def(
+        "read_tet_mesh",
+        [](const std::filesystem::path& path, bool allow_degenerate) {
+            nb::gil_scoped_release release;
+            return kdet::read_tet_mesh(path.string(), ReadOptions{allow_degenerate});
+        },
+        "path"_a, nb::kw_only(), "allow_degenerate"_a = false,
+        "Reads a tet mesh, the format chosen by the extension: .mesh (MEDIT), .msh (Gmsh 2.2/4.1), .vtk (legacy VTK), "
+        ".node/.ele or no extension (TetGen). Bad input raises kdet.Error naming the file and line.");
+    m.def(
+        "write_tet_mesh",
+        [](const TetMesh& mesh, const std::filesystem::path& path, bool binary) {
+            nb::gil_scoped_release release;
+            kdet::write_tet_mesh(mesh, path.string(), WriteOptions{binary});
+        },
+        "mesh"_a, "path"_a, nb::kw_only(), "binary"_a = false,
+        "Writes a tet mesh in the format its extension names (as read_tet_mesh reads it); binary applies to .msh "
+        "and .vtk.");
+    m.def("from_meshio", &from_meshio, "mesh"_a, nb::kw_only(), "allow_degenerate"_a = false,
+          "A TetMesh from a meshio.Mesh: its points and its 'tetra' (and 'tetra10' corner) cells.");
+
+    bind_fields<FrameCounts>(m, "FrameCounts", "Sizes of one detection.");
+    bind_fields<StageTimes>(m, "StageTimes", "Milliseconds spent in each stage of one detection.");
+
+    nb::class_<Frame>(m, "FrameResult", "The result of one detect(), valid for as long as it is kept.")
+        .def_prop_ro(
+            "pairs",
+            [](nb::handle self) {
+                FrameResult& r = nb::cast<Frame&>(self).result;
+                static_assert(sizeof(TetPair) == 4 * sizeof(std::uint32_t), "TetPair is read as four uint32");
+                return rows_view<std::uint32_t, 4>(reinterpret_cast<std::uint32_t*>(r.pairs.data()), r.pairs.size(), self);
+            },
+            "Colliding pairs, (k, 4) uint32 rows (object_a, tet_a, object_b, tet_b), sorted and unique. Empty for "
+            "method 'kdet_no_pairs'.")
+        .def_prop_ro(
+            "contacts",
+            [](nb::handle self) -> nb::object {
+                Frame& f = nb::cast<Frame&>(self);
+                if (!f.contacts_enabled) return nb::none();
+                static_assert(sizeof(Contact) == 4 * sizeof(float), "Contact is read as four float32");
+                return nb::cast(rows_view<float, 4>(reinterpret_cast<float*>(f.result.contacts.data()),
+                                                    f.result.contacts.size(), self));
+            },
+            "Per pair (depth, nx, ny, nz) float32: moving tet b by depth along n separates the pair. None unless the "
+            "detector was made with contacts=True.")
+        .def_prop_ro(
+            "colliding",
+            [](nb::handle self) {
+                FrameResult& r = nb::cast<Frame&>(self).result;
+                nb::list flags;
+                for (std::vector<std::uint8_t>& object : r.colliding)
+                    flags.append(nb::ndarray<nb::numpy, bool, nb::ndim<1>>(reinterpret_cast<bool*>(object.data()),
+                                                                          {object.size()}, self));
+                return flags;
+            },
+            "Per object, a bool array with one flag per tet: True when the tet collides.")
+        .def_prop_ro(
+            "counts", [](const Frame& f) { return f.result.counts; }, "Sizes of this detection (FrameCounts).")
+        .def_prop_ro(
+            "times", [](const Frame& f) { return f.result.times; }, "Milliseconds per stage (StageTimes).")
+        .def_prop_ro(
+            "memory_bytes", [](const Frame& f) { return f.result.memory_bytes; }, "Bytes held by the detector's buffers.")
+        .def_prop_ro(
+            "grid_bytes", [](const Frame& f) { return f.result.grid_bytes; }, "Of which the grid's hash table.")
+        .def_prop_ro(
+            "candidate_bytes", [](const Frame& f) { return f.result.candidate_bytes; },
+            "Of which the candidate pair buffer.")
+        .def("__repr__", [](const Frame& f) {
+            return "FrameResult(" + std::to_string(f.result.pairs.size()) + " pairs, " +
+                   std::to_string(f.result.counts.colliding_tets) + " colliding tets, " +
+                   std::to_string(f.result.times.total) + " ms)";
+        });
+
+    nb::class_<DeviceFrame>(m, "DeviceFrameResult",
+                            "The result of detect(device_results=True): DLPack arrays of the detector's own buffers "
+                            "(GPU memory on the CUDA backend), valid until the next detect(). Tets are numbered "
+                            "globally: object o's tet i is Detector.first_tet(o) + i.")
+        .def_ro("pair_keys", &DeviceFrame::pair_keys,
+                "uint64 (k,): (global_a << 32) | global_b per colliding pair, global_a < global_b, sorted.")
+        .def_ro("colliding", &DeviceFrame::colliding, "uint32 (tets,): nonzero where the global tet collides.")
+        .def_ro("contacts", &DeviceFrame::contacts, "float32 (k, 4) (depth, nx, ny, nz), or None without contacts.")
+        .def_ro("counts", &DeviceFrame::counts)
+        .def_ro("times", &DeviceFrame::times)
+        .def_ro("memory_bytes", &DeviceFrame::memory_bytes);
+
+    const DetectorOptions defaults;
+    nb::class_<PyDetector>(m, "Detector",
+                           "Finds colliding tets frame after frame, keeping its buffers between frames: add objects, "
+                           "then per frame set_positions() for those that moved and detect(). Pairs of different "
+                           "objects are checked, self-collision is off, until switched.")
+        .def(
+            "__init__",
+            [](PyDetector* self, const std::string& backend, const std::string& method, const std::string& test,
+               const std::string& hash, std::optional<std::int64_t> threads, bool contacts, std::int64_t block_size,
+               std::int64_t bucket_capacity, std::int64_t initial_candidate_capacity, nb::handle cuda_stream,
+               bool results_to_host) {
+                const DetectorOptions options =
+                    make_options(backend, method, test, hash, threads, contacts, block_size, bucket_capacity,
+                                 initial_candidate_capacity, cuda_stream, results_to_host);
+                nb::gil_scoped_release release;
+                new (self) PyDetector(options);
+            },
+            nb::kw_only(), "backend"_a = to_string(defaults.backend), "method"_a = to_string(defaults.method),
+            "test"_a = to_string(defaults.narrow_phase), "hash"_a = to_string(defaults.hash), "threads"_a = nb::none(),
+            "contacts"_a = defaults.contacts, "block_size"_a = defaults.block_size,
+            "bucket_capacity"_a = defaults.bucket_capacity,
+            "initial_candidate_capacity"_a = defaults.initial_candidate_capacity, "cuda_stream"_a = nb::none(),
+            "results_to_host"_a = defaults.results_to_host,
+            "Names (backend, method, test, hash) are those of kdet.BACKENDS, METHODS, TESTS and HASHES, in any case, "
+            "'-' or '_'. threads=None uses all cores. contacts=True adds depth and direction per pair. cuda_stream "
+            "(backend='cuda'): the stream all of the detector's GPU work runs on, as an int or a stream object "
+            "(PyTorch, CuPy, Warp, __cuda_stream__); None is the default stream. "
+            "results_to_host=False keeps results on the device (detect(device_results=True)).")
+        .def("add_object",
+             [](PyDetector& self, const TetMesh& mesh) {
+                 return locked(self, [&] { return self.detector.add_object(mesh); });
+             },
+             "mesh"_a, "Adds a TetMesh; returns its object id.")
+        .def("add_object", &add_object, "vertices"_a, "tets"_a,
+             "Adds an object from its rest-shape vertices (n, 3) float32/float64 and tets (m, 4) integers; returns its "
+             "object id.")
+        .def("set_positions", &set_positions, "object"_a, "positions"_a,
+             "Replaces an object's vertex positions: (n, 3) float32/float64, any strides; on the CUDA backend also a GPU "
+             "array (__dlpack__ or __cuda_array_interface__), which never passes through the host.")
+        .def(
+            "set_self_collision",
+            [](PyDetector& self, std::int64_t object, bool enabled) {
+                const ObjectId id = object_id(self, object);
+                locked(self, [&] { self.detector.set_self_collision(id, enabled); });
+            },
+            "object"_a, "enabled"_a = true, "Switches self-collision of one object (off by default).")
+        .def(
+            "set_pair_collision",
+            [](PyDetector& self, std::int64_t a, std::int64_t b, bool enabled) {
+                const ObjectId ia = object_id(self, a), ib = object_id(self, b);
+                locked(self, [&] { self.detector.set_pair_collision(ia, ib, enabled); });
+            },
+            "a"_a, "b"_a, "enabled"_a, "Switches collision between two different objects (on by default).")
+        .def("detect", &detect, "device_results"_a = false,
+             nb::sig("def detect(self, device_results: bool = False) -> FrameResult | DeviceFrameResult"),
+             "Runs one detection (without the GIL). Returns a FrameResult, or with device_results=True a "
+             "DeviceFrameResult of DLPack arrays in the backend's memory.")
+        .def(
+            "first_tet",
+            [](PyDetector& self, std::int64_t object) { return self.detector.first_tet(object_id(self, object)); },
+            "object"_a, "Global id of the object's first tet (see DeviceFrameResult).")
+        .def(
+            "tet_count",
+            [](PyDetector& self, std::int64_t object) { return self.detector.tet_count(object_id(self, object)); },
+            "object"_a)
+        .def_prop_ro("object_count", [](PyDetector& self) { return self.detector.object_count(); })
+        .def_prop_ro(
+            "memory_bytes", [](PyDetector& self) { return locked(self, [&] { return self.detector.memory_bytes(); }); },
+            "Bytes held by the detector's buffers (device memory on the CUDA backend).")
+        .def_prop_ro(
+            "device_name", [](PyDetector& self) { return self.detector.device_name(); },
+            "The CPU model or GPU name the detector runs on.")
+        .def_prop_ro(
+            "options", [](PyDetector& self) { return options_dict(self.detector.options()); },
+            "The detector's settings, names as the library spells them.")
+        .def("__repr__", [](PyDetector& self) {
+            const DetectorOptions& o = self.detector.options();
+            return std::string("Detector(backend='") + to_string(o.backend) + "', method='" + to_string(o.method) +
+                   "', test='" + to_string(o.narrow_phase) + "', hash='" + to_string(o.hash) + "', " +
+                   std::to_string(self.detector.object_count()) + " objects)";
+        });
+}

@@ -1,0 +1,36 @@
+"""The examples in python/examples run and say what they should."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def run(script: str, models: Path, *args: str) -> str:
+    environment = dict(os.environ, KDET_DATA_DIR=str(models))
+    done = subprocess.run([sys.executable, str(EXAMPLES / script), *args], env=environment, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+def test_moving_meshes_prints_each_frame(models):
+    lines = run("moving_meshes.py", models, "--frames", "5").splitlines()
+    pairs = [int(re.search(r"(\d+) pairs", line).group(1)) for line in lines]
+    assert len(pairs) == 5
+    # B starts and ends clear of A and passes through it in the middle.
+    assert pairs[0] == pairs[-1] == 0 and pairs[2] > 100
+
+
+def test_draw_collisions_writes_a_picture(models, tmp_path):
+    pytest.importorskip("matplotlib", reason="the drawing example needs matplotlib")
+    out = tmp_path / "collisions.png"
+    printed = run("draw_collisions.py", models, "--out", str(out))
+    assert re.match(r"\d+ colliding pairs", printed) and int(printed.split()[0]) > 100
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
