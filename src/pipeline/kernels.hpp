@@ -153,25 +153,58 @@ struct TetSizeKernel {
     }
 };
 
-/// @brief Stage 2: picks each relevant tet's layer and inserts it into every cell its box overlaps.
+/// @brief Stage 2, before populating: picks each relevant tet's layer and counts, per layer, the
+/// cells the tets there will be inserted into, so that the host can size the table before filling it.
+/// One work item per chunk of tets; neighbouring tets (spatial order) mostly share a layer, so a
+/// count is added atomically only when the layer changes along the chunk.
+struct GridPlanKernel {
+    SceneView scene;
+    GridParams params;
+    std::uint32_t chunk;
+    unsigned long long* layer_entries; ///< [max_grid_layers]
+    std::uint32_t* layer_mask;
+
+    KDET_HD void operator()(std::uint64_t c) const {
+        const std::uint64_t begin = c * chunk;
+        const std::uint64_t end = begin + chunk < scene.tet_count ? begin + chunk : scene.tet_count;
+        int run_layer = -1;
+        unsigned long long run_entries = 0;
+        std::uint32_t mask = 0;
+        for (std::uint64_t t = begin; t < end; ++t) {
+            TetInfo& info = scene.info[t];
+            if (info.layer < 0) continue;
+            const int layer = layer_of(params, info.diameter);
+            info.layer = layer;
+            const CellRange r = cell_range(params, info.box, layer);
+            if (layer != run_layer) {
+                if (run_entries) atomic_fetch_add(&layer_entries[run_layer], run_entries);
+                run_layer = layer;
+                run_entries = 0;
+            }
+            run_entries += static_cast<unsigned long long>(r.hi[0] - r.lo[0] + 1) * (r.hi[1] - r.lo[1] + 1) *
+                           (r.hi[2] - r.lo[2] + 1);
+            mask |= 1u << layer;
+        }
+        if (run_entries) atomic_fetch_add(&layer_entries[run_layer], run_entries);
+        if (mask) atomic_fetch_or(layer_mask, mask);
+    }
+};
+
+/// @brief Stage 2: inserts each relevant tet into every cell its box overlaps on its layer. Once an
+/// insert has failed (the table must grow), the remaining tets give up at once: the pass reruns anyway.
 struct PopulateKernel {
     SceneView scene;
     GridView grid;
     GridParams params;
-    std::uint32_t* layer_mask;
 
     KDET_HD void operator()(std::uint64_t t) const {
-        TetInfo& info = scene.info[t];
-        if (info.layer < 0) return;
-        const int layer = layer_of(params, info.diameter);
-        info.layer = layer;
-        const std::uint32_t bit = 1u << layer;
-        if (!(atomic_load_acquire(layer_mask) & bit)) atomic_fetch_or(layer_mask, bit);
-        const CellRange r = cell_range(params, info.box, layer);
+        const TetInfo& info = scene.info[t];
+        if (info.layer < 0 || atomic_load_acquire(grid.failure)) return;
+        const CellRange r = cell_range(params, info.box, info.layer);
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
-                    if (!grid_insert(grid, make_cell(x, y, z, layer), static_cast<std::uint32_t>(t))) return;
+                    if (!grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t))) return;
     }
 };
 

@@ -24,6 +24,7 @@ struct FrameCounters {
     std::uint32_t cells_claimed;
     std::uint32_t min_size; ///< float_to_ordered, over the relevant tets
     std::uint32_t max_size;
+    unsigned long long layer_entries[max_grid_layers]; ///< cell entries the relevant tets need, per layer
 };
 
 template <class Exec>
@@ -119,6 +120,7 @@ private:
 
     bool compute_bounds_and_culling(const std::vector<std::uint8_t>& pair_enabled);
     bool size_relevant_tets();
+    void plan_grid();
     GridView populate(FrameCounts& counts);
     template <class Launch>
     void append_candidates_growing(const Launch& launch, FrameCounts& counts);
@@ -138,6 +140,7 @@ private:
     std::uint32_t stamp_ = 0;
     std::size_t relevant_estimate_ = 0;
     vec3 grid_origin_{};
+    vec3 grid_extent_{}; ///< of the region that is gridded (the boxes of the objects that can collide)
 
     buffer<TetIndices> tets_;
     buffer<std::uint32_t> tet_object_;
@@ -212,12 +215,15 @@ bool Pipeline<Exec>::compute_bounds_and_culling(const std::vector<std::uint8_t>&
 
     const float inf = std::numeric_limits<float>::infinity();
     grid_origin_ = vec3{inf, inf, inf};
+    vec3 grid_top{-inf, -inf, -inf};
     relevant_estimate_ = 0;
     for (std::size_t o = 0; o < objects; ++o) {
         if (!involved[o]) continue;
         grid_origin_ = min_v(grid_origin_, boxes[o].lo);
+        grid_top = max_v(grid_top, boxes[o].hi);
         relevant_estimate_ += topology_.object_tet_begin[o + 1] - topology_.object_tet_begin[o];
     }
+    grid_extent_ = grid_top - grid_origin_;
     return true;
 }
 
@@ -248,14 +254,45 @@ bool Pipeline<Exec>::size_relevant_tets() {
     return true;
 }
 
+/// @brief Stage 2: each relevant tet's layer, and a table large enough for the cells they need.
+/// A cell holds at least one entry and lies in the gridded region, so per layer the occupied cells
+/// are at most the entries and at most the region's cells; the table gets a quarter more slots than
+/// that bound (probing stays short), and the overflow pool one bucket per bucket_capacity entries,
+/// which holds every chain whatever the cells' fill. Both only grow, so a scene that keeps its size
+/// sizes them once.
+template <class Exec>
+void Pipeline<Exec>::plan_grid() {
+    reset_counters();
+    FrameCounters* c = counters_.data();
+    constexpr std::uint32_t chunk = 256;
+    exec_.for_each((tets_.size() + chunk - 1) / chunk,
+                   GridPlanKernel{scene_view(), params_, chunk, c->layer_entries, &c->layer_mask});
+    const FrameCounters plan = read_counters();
+    layer_mask_ = plan.layer_mask;
+
+    double cells = 0.0, entries = 0.0;
+    for (int layer = 0; layer < params_.layer_count; ++layer) {
+        const double n = static_cast<double>(plan.layer_entries[layer]);
+        if (n == 0.0) continue;
+        const double cell = std::ldexp(static_cast<double>(params_.cell_size0), layer);
+        double region = 1.0;
+        for (int a = 0; a < 3; ++a) region *= std::floor(static_cast<double>(component(grid_extent_, a)) / cell) + 2.0;
+        cells += std::min(n, region);
+        entries += n;
+    }
+    const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
+    std::uint32_t wanted_slots = 1024;
+    while (wanted_slots < 1.25 * cells && wanted_slots < (1u << 30)) wanted_slots *= 2;
+    const double wanted_pool = std::min(std::ceil(entries / capacity) + 1.0, static_cast<double>(1u << 30));
+    slot_count_ = std::max(slot_count_, wanted_slots);
+    overflow_capacity_ = std::max(overflow_capacity_, static_cast<std::uint32_t>(wanted_pool));
+}
+
 /// @brief Stage 2: fills the hash table; grows it and reruns when probing or the overflow pool fails.
 template <class Exec>
 GridView Pipeline<Exec>::populate(FrameCounts& counts) {
+    plan_grid();
     const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
-    std::uint32_t wanted_slots = 1024;
-    while (wanted_slots < relevant_estimate_ / 8 && wanted_slots < (1u << 30)) wanted_slots *= 2;
-    slot_count_ = std::max(slot_count_, wanted_slots);
-    overflow_capacity_ = std::max(overflow_capacity_, slot_count_ / 4);
     for (;;) {
         const std::size_t buckets = static_cast<std::size_t>(slot_count_) + overflow_capacity_;
         if (headers_.size() != buckets) {
@@ -274,10 +311,9 @@ GridView Pipeline<Exec>::populate(FrameCounts& counts) {
         while ((1u << slot_bits) < slot_count_) ++slot_bits;
         GridView grid{headers_.data(), ids_.data(), &c->overflow_used, &c->grid_failure, &c->cells_claimed,
                       slot_count_, slot_bits, capacity, overflow_capacity_, stamp_, 64u, options_.hash};
-        exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, params_, &c->layer_mask});
+        exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, params_});
         const FrameCounters after = read_counters();
         if (!after.grid_failure) {
-            layer_mask_ = after.layer_mask;
             counts.grid_cells = after.cells_claimed;
             counts.grid_slots = slot_count_;
             counts.grid_overflow_buckets = after.overflow_used;
