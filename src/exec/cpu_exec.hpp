@@ -63,8 +63,8 @@ public:
         for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
     }
 
-    /// @brief Sorts keys[0, n) ascending and removes repeats; returns the unique count.
-    std::size_t sort_unique(std::uint64_t* keys, std::size_t n) const;
+    /// @brief Sorts keys[0, n) ascending.
+    void sort(std::uint64_t* keys, std::size_t n) const;
 
     /// @brief out[i] = sum of in[0, i); returns the total.
     std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const;

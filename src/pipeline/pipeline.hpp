@@ -126,7 +126,8 @@ private:
     void append_candidates_growing(const Launch& launch, FrameCounts& counts);
     void find_candidates(const GridView& grid, FrameCounts& counts);
     void brute_force(FrameCounts& counts);
-    void narrow_phase_and_compact(std::size_t unique, FrameResult& result);
+    std::size_t narrow_phase(std::size_t candidates);
+    void contacts_and_pairs(std::size_t colliding, FrameResult& result);
     void count_and_copy_flags(bool any, FrameResult& result);
     KeyAppender candidate_appender() {
         return KeyAppender{candidates_.data(), candidates_.size(), &counters_.data()->candidates};
@@ -350,7 +351,7 @@ void Pipeline<Exec>::append_candidates_growing(const Launch& launch, FrameCounts
     }
 }
 
-/// @brief Stage 3: candidate pairs with duplicates.
+/// @brief Stage 3: candidate pairs, each written once.
 template <class Exec>
 void Pipeline<Exec>::find_candidates(const GridView& grid, FrameCounts& counts) {
     ensure_candidate_capacity(relevant_estimate_);
@@ -399,25 +400,31 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
         counts);
 }
 
-/// @brief Stage 5: the narrow phase once per unique candidate; then (stage 6) the colliding pairs
-/// under the caller's tet ids in sorted order, and their contacts.
+/// @brief Stage 5: the narrow phase once per candidate (they are unique, see LargerNeighbourFilter, so
+/// they need no sorting); the colliding pairs are compacted and renamed to the caller's tet ids.
+/// Returns their number.
 template <class Exec>
-void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& result) {
-    hit_.resize_discard(unique);
-    position_.resize_discard(unique);
-    exec_.for_each(unique, NarrowPhaseKernel{scene_view(), options_.narrow_phase, candidates_.data(), hit_.data(),
-                                             colliding_.data()});
-    const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), unique);
+std::size_t Pipeline<Exec>::narrow_phase(std::size_t candidates) {
+    hit_.resize_discard(candidates);
+    position_.resize_discard(candidates);
+    exec_.for_each(candidates, NarrowPhaseKernel{scene_view(), options_.narrow_phase, candidates_.data(), hit_.data(),
+                                                 colliding_.data()});
+    const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), candidates);
     out_keys_.resize_discard(colliding);
-    exec_.for_each(unique, CompactKernel{candidates_.data(), hit_.data(), position_.data(), out_keys_.data()});
+    exec_.for_each(candidates, CompactKernel{candidates_.data(), hit_.data(), position_.data(), out_keys_.data()});
     exec_.for_each(colliding, UserPairKernel{user_id_.data(), out_keys_.data()});
-    exec_.sort_unique(out_keys_.data(), colliding); // renaming keeps pairs distinct: only the order changes
+    colliding_count_ = colliding;
+    return colliding;
+}
+
+/// @brief Stage 6: contacts of the sorted colliding pairs, and the pairs copied out when results go
+/// to the host.
+template <class Exec>
+void Pipeline<Exec>::contacts_and_pairs(std::size_t colliding, FrameResult& result) {
     if (options_.contacts) {
         out_contacts_.resize_discard(colliding);
         exec_.for_each(colliding, ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), out_contacts_.data()});
     }
-
-    colliding_count_ = colliding;
     result.counts.colliding_pairs = colliding;
     if (!options_.results_to_host) return;
     std::vector<std::uint64_t> keys(colliding);
@@ -487,7 +494,6 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
     result.times.bounding_boxes = stage.stop_ms();
 
     if (any) {
-        std::size_t unique = 0;
         if (grid_method) {
             stage.start();
             const GridView grid = populate(counts);
@@ -509,13 +515,16 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
             result.times.find_candidates = stage.stop_ms();
         }
         if (method != Method::kdet_no_pairs) {
+            counts.unique_candidates = counts.candidates;
             stage.start();
-            unique = exec_.sort_unique(candidates_.data(), counts.candidates);
-            counts.unique_candidates = unique;
+            const std::size_t colliding = narrow_phase(counts.candidates);
+            result.times.narrow_phase = stage.stop_ms();
+            stage.start();
+            exec_.sort(out_keys_.data(), colliding); // the deterministic output order
             result.times.sort_unique = stage.stop_ms();
             stage.start();
-            narrow_phase_and_compact(unique, result);
-            result.times.narrow_phase = stage.stop_ms();
+            contacts_and_pairs(colliding, result);
+            result.times.narrow_phase += stage.stop_ms();
         }
     }
 
