@@ -52,8 +52,8 @@ struct StageTimes {
 
 /// @brief Sizes of one detection.
 struct FrameCounts {
-    std::uint64_t candidates = 0;        ///< candidate pairs written (each pair once)
-    std::uint64_t unique_candidates = 0; ///< pairs the narrow phase runs on
+    std::uint64_t candidates = 0;        ///< candidate pairs found (boxes overlap, not adjacent), each once
+    std::uint64_t unique_candidates = 0; ///< of which the face-plane pre-test could not reject: the narrow phase runs on these
     std::uint64_t colliding_pairs = 0;
     std::uint64_t colliding_tets = 0;    ///< tets flagged as colliding, all objects together
     std::uint32_t buffer_regrows = 0;    ///< times a buffer grew and its stage reran this frame

@@ -4,6 +4,7 @@
 /// in an OpenMP loop and the CUDA layer runs as a kernel. Views hold raw pointers and counts only.
 
 #include "geometry/enclosing_sphere.hpp"
+#include "geometry/face_planes.hpp"
 #include "geometry/tet_intersect.hpp"
 #include "grid/bucket_table.hpp"
 
@@ -35,6 +36,7 @@ struct SceneView {
     const TetIndices* tets;
     const std::uint32_t* tet_object;
     TetInfo* info;
+    TetPlanes* planes; ///< per tet, for the pre-test; computed for the tets that can collide this frame
     const std::uint8_t* pair_active; ///< [object_count * object_count]; diagonal = self-collision
     const Aabb* object_boxes;
     std::uint32_t tet_count;
@@ -65,16 +67,25 @@ KDET_HD inline std::uint64_t pair_key(std::uint32_t t, std::uint32_t u) {
 KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
 KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
 
-/// @brief The predicate every method applies to a pair that may collide: adjacency, boxes, narrow phase.
-/// The lower stored id always goes first so every method sees the same floating-point computation.
+/// @brief The decision for a pair whose boxes overlap and that is not adjacent: the face-plane
+/// pre-test where it is sure (the same answer as every test, see face_planes.hpp), else the test.
+/// The lower stored id goes first, so every method sees the same floating-point computation.
+KDET_HD inline bool candidate_collides(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second) {
+    vec3 a[4], b[4];
+    load_tet(s, first, a);
+    load_tet(s, second, b);
+    const PlaneVerdict verdict = face_plane_pretest(s.planes[first], a, s.planes[second], b, false);
+    if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
+    return tets_intersect(test, a, b);
+}
+
+/// @brief The predicate every method applies to a pair that may collide: adjacency, boxes, then
+/// candidate_collides.
 KDET_HD inline bool tets_collide(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u) {
     const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
     if (s.tet_object[first] == s.tet_object[second] && share_vertex(s.tets[first], s.tets[second])) return false;
     if (!boxes_overlap(s.info[first].box, s.info[second].box)) return false;
-    vec3 a[4], b[4];
-    load_tet(s, first, a);
-    load_tet(s, second, b);
-    return tets_intersect(test, a, b);
+    return candidate_collides(s, test, first, second);
 }
 
 /// @brief Stage 1: box of each tet; no size and no layer yet.
@@ -146,10 +157,21 @@ struct TetSizeKernel {
         load_tet(scene, static_cast<std::uint32_t>(t), v);
         info.diameter = enclosing_sphere_diameter(v);
         info.layer = 0;
+        scene.planes[t] = tet_planes(v);
         // Reading first keeps the atomics few: after the first tets, almost none widens the range.
         const std::uint32_t size = float_to_ordered(info.diameter);
         if (size < atomic_load_acquire(min_size)) atomic_min(min_size, size);
         if (size > atomic_load_acquire(max_size)) atomic_max(max_size, size);
+    }
+};
+
+/// @brief Stage 1, brute-force methods only: the face planes of every tet (they test every pair).
+struct TetPlanesKernel {
+    SceneView scene;
+    KDET_HD void operator()(std::uint64_t t) const {
+        vec3 v[4];
+        load_tet(scene, static_cast<std::uint32_t>(t), v);
+        scene.planes[t] = tet_planes(v);
     }
 };
 
@@ -304,13 +326,16 @@ struct KeyBatch {
     }
 };
 
-/// @brief Stage 3 (kdet): writes candidate pairs, duplicates included.
+/// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the face-plane pre-test cannot
+/// prove separated (those it can are only counted): a rejected pair is never written, sorted or
+/// loaded again.
 struct FindCandidatesKernel {
     SceneView scene;
     GridView grid;
     GridParams params;
     std::uint32_t layer_mask;
     KeyAppender out;
+    unsigned long long* rejected; ///< pairs the pre-test proved separated
 
     struct Emit {
         const SceneView* scene;
@@ -318,18 +343,31 @@ struct FindCandidatesKernel {
         std::uint32_t t;
         TetIndices tet;
         std::uint32_t object;
-        KDET_HD void operator()(std::uint32_t u) const {
-            if (scene->tet_object[u] == object && share_vertex(tet, scene->tets[u])) return;
+        vec3 vertices[4];
+        TetPlanes planes;
+        unsigned long long rejected;
+        KDET_HD void operator()(std::uint32_t u) {
+            const TetIndices other = scene->tets[u];
+            if (scene->tet_object[u] == object && share_vertex(tet, other)) return;
+            vec3 w[4];
+            for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
+            if (face_plane_pretest(planes, vertices, scene->planes[u], w, true) == PlaneVerdict::separated) {
+                ++rejected;
+                return;
+            }
             batch->push(pair_key(t, u));
         }
     };
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto t = static_cast<std::uint32_t>(i);
+        if (scene.info[t].layer < 0) return;
         KeyBatch batch(&out);
-        Emit emit{&scene, &batch, t, scene.tets[t], scene.tet_object[t]};
+        Emit emit{&scene, &batch, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
+        load_tet(scene, t, emit.vertices);
         for_each_larger_neighbour(scene, grid, params, layer_mask, t, emit);
         batch.flush();
+        if (emit.rejected) atomic_fetch_add(rejected, emit.rejected);
     }
 };
 
@@ -425,7 +463,7 @@ struct BruteForcePairsKernel {
     }
 };
 
-/// @brief Stage 5: runs the narrow phase once per unique candidate and flags colliding tets.
+/// @brief Stage 5: decides each candidate once (candidate_collides) and flags colliding tets.
 struct NarrowPhaseKernel {
     SceneView scene;
     NarrowPhase test;
@@ -435,10 +473,7 @@ struct NarrowPhaseKernel {
 
     KDET_HD void operator()(std::uint64_t k) const {
         const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
-        vec3 a[4], b[4];
-        load_tet(scene, t, a);
-        load_tet(scene, u, b);
-        const bool collides = tets_intersect(test, a, b);
+        const bool collides = candidate_collides(scene, test, t, u);
         hit[k] = collides ? 1u : 0u;
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);

@@ -17,6 +17,7 @@ namespace kdet {
 struct FrameCounters {
     unsigned long long candidates;
     unsigned long long tests_run;
+    unsigned long long rejected; ///< candidate pairs the face-plane pre-test proved separated
     std::uint32_t grid_failure;
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
@@ -53,6 +54,7 @@ public:
         exec_.upload(object_tet_begin_.data(), topology.object_tet_begin.data(), topology.object_tet_begin.size());
         positions_.resize_discard(topology.vertex_count);
         info_.resize_discard(tets);
+        planes_.resize_discard(tets);
         colliding_.resize_discard(tets);
         user_colliding_.resize_discard(tets);
         user_flags_set_ = true; // new memory: unknown until cleared
@@ -85,7 +87,7 @@ public:
     std::size_t memory_bytes() const override {
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
                user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() +
-               info_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
+               info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                bounds_.capacity_bytes() + object_boxes_.capacity_bytes() + pair_active_.capacity_bytes() +
                headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + hit_.capacity_bytes() + position_.capacity_bytes() +
@@ -99,7 +101,7 @@ public:
 
 private:
     SceneView scene_view() {
-        return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), pair_active_.data(),
+        return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), pair_active_.data(),
                          object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
                          static_cast<std::uint32_t>(bounds_.size())};
     }
@@ -123,7 +125,7 @@ private:
     void plan_grid();
     GridView populate(FrameCounts& counts);
     template <class Launch>
-    void append_candidates_growing(const Launch& launch, FrameCounts& counts);
+    FrameCounters append_candidates_growing(const Launch& launch, FrameCounts& counts);
     void find_candidates(const GridView& grid, FrameCounts& counts);
     void brute_force(FrameCounts& counts);
     std::size_t narrow_phase(std::size_t candidates);
@@ -150,6 +152,7 @@ private:
     buffer<std::uint32_t> stored_id_; ///< caller's global id -> stored tet
     buffer<vec3> positions_;
     buffer<TetInfo> info_;
+    buffer<TetPlanes> planes_;
     buffer<std::uint32_t> colliding_;      ///< per stored tet
     buffer<std::uint32_t> user_colliding_; ///< per tet in the caller's numbering
     buffer<ObjectBounds> bounds_;
@@ -337,15 +340,16 @@ void Pipeline<Exec>::ensure_candidate_capacity(std::size_t relevant_tets) {
 
 /// @brief Runs a stage that appends to the candidate buffer until the buffer held everything: an
 /// overflowing run still counts what it needed, so the buffer grows to that size and the stage reruns.
+/// Returns the counters of the last run.
 template <class Exec>
 template <class Launch>
-void Pipeline<Exec>::append_candidates_growing(const Launch& launch, FrameCounts& counts) {
+FrameCounters Pipeline<Exec>::append_candidates_growing(const Launch& launch, FrameCounts& counts) {
     for (;;) {
         reset_counters();
         launch(candidate_appender());
         const FrameCounters after = read_counters();
         counts.candidates = after.candidates;
-        if (after.candidates <= candidates_.size()) return;
+        if (after.candidates <= candidates_.size()) return after;
         candidates_.resize_discard(after.candidates + after.candidates / 4);
         ++counts.buffer_regrows;
     }
@@ -355,11 +359,14 @@ void Pipeline<Exec>::append_candidates_growing(const Launch& launch, FrameCounts
 template <class Exec>
 void Pipeline<Exec>::find_candidates(const GridView& grid, FrameCounts& counts) {
     ensure_candidate_capacity(relevant_estimate_);
-    append_candidates_growing(
+    const FrameCounters after = append_candidates_growing(
         [&](const KeyAppender& out) {
-            exec_.for_each(tets_.size(), FindCandidatesKernel{scene_view(), grid, params_, layer_mask_, out});
+            exec_.for_each(tets_.size(), FindCandidatesKernel{scene_view(), grid, params_, layer_mask_, out,
+                                                              &counters_.data()->rejected});
         },
         counts);
+    counts.unique_candidates = counts.candidates;
+    counts.candidates += after.rejected;
 }
 
 /// @brief Both brute-force methods: every pair of enabled objects is tested, colliding pairs appended.
@@ -386,6 +393,7 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
         exec_.upload(block_objects_.data(), block_objects.data(), block_objects.size());
     }
     if (candidates_.size() == 0) candidates_.resize_discard(4096);
+    exec_.for_each(tets_.size(), TetPlanesKernel{scene_view()});
     append_candidates_growing(
         [&](const KeyAppender& out) {
             if (options_.method == Method::brute_force_pairs)
@@ -515,9 +523,9 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
             result.times.find_candidates = stage.stop_ms();
         }
         if (method != Method::kdet_no_pairs) {
-            counts.unique_candidates = counts.candidates;
+            if (!grid_method) counts.unique_candidates = counts.candidates;
             stage.start();
-            const std::size_t colliding = narrow_phase(counts.candidates);
+            const std::size_t colliding = narrow_phase(counts.unique_candidates);
             result.times.narrow_phase = stage.stop_ms();
             stage.start();
             exec_.sort(out_keys_.data(), colliding); // the deterministic output order
