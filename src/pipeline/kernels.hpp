@@ -263,10 +263,11 @@ struct LargerNeighbourFilter {
     KDET_HD void operator()(std::uint32_t u) const {
         // A cell holds only tets of its own layer, so the tie-break needs no load of u's data.
         if (same_layer && u <= t) return;
-        if (!pair_is_active(*scene, object, scene->tet_object[u])) return;
+        // Most entries fail the box test, so it comes before anything that loads more of u's data.
         const Aabb& other = scene->info[u].box;
         if (!boxes_overlap(box, other)) return;
         if (!reports_from_this_cell(other)) return;
+        if (!pair_is_active(*scene, object, scene->tet_object[u])) return;
         (*visit)(u);
     }
 };
