@@ -9,6 +9,7 @@
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
+#include <kdet/prepare.hpp>
 #include <kdet/scenes.hpp>
 
 #include <cmath>

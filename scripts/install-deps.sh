@@ -2,6 +2,9 @@
 # Installs what kdet needs to build and test on Debian (run as root). Skips apt when all is there.
 set -euo pipefail
 packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3 clang libclang-rt-14-dev tetgen)
+# `kdet view`: GLFW, Dear ImGui (with its GLFW and OpenGL 3 backends), libepoxy, libpng; its tests draw
+# under Xvfb with Mesa's software renderer (llvmpipe).
+packages+=(pkg-config libglfw3-dev libimgui-dev libepoxy-dev libpng-dev xvfb xauth libgl1-mesa-dri)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

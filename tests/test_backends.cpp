@@ -53,7 +53,7 @@ TEST_F(CudaBackend, EveryMethodTestAndHashMatchesTheCpuOnSoups) {
             expect_backends_agree({a, b}, true, o);
         }
     for (HashFunction hash : {HashFunction::djb2, HashFunction::fnv1a, HashFunction::simple, HashFunction::morton})
-        for (int block : {16, 32, 64, 128, 256}) {
+        for (int block : {16, 32, 64, 128, 256, 512, 1024}) {
             DetectorOptions o;
             o.hash = hash;
             o.block_size = block;

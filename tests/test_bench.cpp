@@ -66,7 +66,7 @@ TEST(BenchArgs, EveryAcceptedValue) {
                                                       {"gpu_no_loop", Method::brute_force_pairs}};
     for (const auto& [name, method] : methods) {
         EXPECT_EQ(parse_words({"-c", name}).options.method, method) << name;
-        EXPECT_STREQ(bench_method_name(method), name);
+        EXPECT_EQ(bench_method_name(method), name);
     }
     const std::pair<const char*, NarrowPhase> tests[] = {{"sat", NarrowPhase::sat},
                                                          {"sat_no_edges", NarrowPhase::sat_no_edges},
@@ -90,6 +90,23 @@ TEST(BenchArgs, EveryAcceptedValue) {
     EXPECT_EQ(one_frame.last_frame, 0);
 }
 
+TEST(BenchArgs, TheThesissExampleCommandRunsUnchanged) {
+    // Appendix A.1.3: benchmark_tet buddha_and_armadillo -r 2 -n 5 -c gpu_no_loop -o sat-mtv -d DIR
+    const BenchConfig c = parse_words({"buddha_and_armadillo", "-r", "2", "-n", "5", "-c", "gpu_no_loop", "-o", "sat-mtv",
+                                       "-d", "./../../exports/benchmark_data"});
+    EXPECT_EQ(settings(c), "buddha_and_armadillo r2 gpu_no_loop sat_mtv g128 n5 self 0 djb2 ./../../exports/benchmark_data "
+                           "cpu threads 0 frames 0:-1 quiet 0 help 0 procedural flag ''");
+    EXPECT_EQ(parse_words({"-c", "Brute-Force-Pairs", "-h", "FNV_1A", "--backend", "CPU"}).options.method,
+              Method::brute_force_pairs);
+}
+
+TEST(BenchArgs, HelpListsTheLibrarysNames) {
+    const std::string help = bench_help();
+    for (const std::string& name : option_names<NarrowPhase>()) EXPECT_NE(help.find(name), std::string::npos) << name;
+    for (const std::string& name : option_names<Method>()) EXPECT_NE(help.find(name), std::string::npos) << name;
+    EXPECT_NE(help.find("gpu_no_loop = brute_force_pairs"), std::string::npos) << help;
+}
+
 TEST(BenchArgs, ProceduralSceneSizeAndLength) {
     const BenchConfig c = parse_words({"--tets", "5000", "--scene-frames", "7"});
     EXPECT_EQ(c.request.procedural.total_tets, 5000u);
@@ -107,13 +124,13 @@ TEST(BenchArgs, EveryMistakeIsOneLineNamingTheFlagAndWhatItAccepts) {
         {{"-r", "0"}, "invalid value '0' for -r: expected an integer in [1, 4]"},
         {{"-r", "5"}, "invalid value '5' for -r: expected an integer in [1, 4]"},
         {{"-r", "two"}, "invalid value 'two' for -r"},
-        {{"-c", "bvh"}, "invalid value 'bvh' for -c: expected kdet, kdet_no_pairs, gpu or gpu_no_loop"},
-        {{"-o", "sat-mtv"}, "invalid value 'sat-mtv' for -o: expected sat, sat_no_edges, sat_mtv, gjk or fast"},
+        {{"-c", "bvh"}, "invalid value 'bvh' for -c: expected kdet, kdet_no_pairs, brute_force_loop or brute_force_pairs"},
+        {{"-o", "sat.mtv"}, "invalid value 'sat.mtv' for -o: expected sat, sat_no_edges, sat_mtv, gjk or fast"},
         {{"-g", "100"}, "invalid value '100' for -g: expected 16, 32, 64, 128 or 256"},
         {{"-n", "0"}, "invalid value '0' for -n: expected an integer in [1, 20]"},
         {{"-n", "21"}, "invalid value '21' for -n: expected an integer in [1, 20]"},
         {{"-s", "maybe"}, "invalid value 'maybe' for -s: expected yes, y, no or n"},
-        {{"-h", "md5"}, "invalid value 'md5' for -h: expected djb2, fnv-1a, morton or simple"},
+        {{"-h", "md5"}, "invalid value 'md5' for -h: expected djb2, fnv-1a, simple or morton"},
         {{"-d", ""}, "invalid value '' for -d: expected a folder"},
         {{"--backend", "gpu"}, "invalid value 'gpu' for --backend: expected cpu or cuda"},
         {{"--threads", "0"}, "invalid value '0' for --threads: expected an integer in [1, 1024]"},
@@ -279,8 +296,15 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     config.last_frame = 3;
     config.self = true;
     const auto scene = open_scene("procedural", config.request);
-    ProgressBar progress(false, config.runs, 3);
+    std::vector<std::pair<int, int>> reported;
+    const BenchProgress progress = [&](int run, int frame_index) {
+        reported.emplace_back(run, frame_index);
+        return true;
+    };
     const BenchOutcome outcome = run_benchmark(config, *scene, progress);
+    const std::vector<std::pair<int, int>> every_frame = {{0, 0}, {0, 1}, {0, 2}, {1, 0}, {1, 1}, {1, 2}};
+    EXPECT_EQ(reported, every_frame);
+    EXPECT_FALSE(outcome.stopped);
 
     const std::vector<std::string> thesis_keys = {"scene name",        "resolution", "algorithm", "block size",
                                                   "overlap test",      "self collisions", "hashing algorithm",
@@ -326,13 +350,25 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     EXPECT_NE(brute.stem.find("_gpu_sat_none_g128_"), std::string::npos) << brute.stem;
 }
 
+TEST(BenchRunner, ProgressCanStopIt) {
+    BenchConfig config;
+    config.request.procedural = ProceduralSceneOptions{400, 4};
+    config.runs = 3;
+    const auto scene = open_scene("procedural", config.request);
+    int frames_allowed = 6;
+    const BenchOutcome outcome = run_benchmark(config, *scene, [&](int, int) { return frames_allowed-- > 0; });
+    EXPECT_TRUE(outcome.stopped);
+    ASSERT_EQ(outcome.runs.size(), 2u);
+    EXPECT_EQ(outcome.runs[0].size(), 4u);
+    EXPECT_EQ(outcome.runs[1].size(), 2u);
+}
+
 TEST(BenchRunner, FilesHoldAveragesAndRuns) {
     BenchConfig config;
     config.request.procedural = ProceduralSceneOptions{600, 5};
     config.runs = 3;
     const auto scene = open_scene("procedural", config.request);
-    ProgressBar progress(false, config.runs, 5);
-    const BenchOutcome outcome = run_benchmark(config, *scene, progress);
+    const BenchOutcome outcome = run_benchmark(config, *scene, [](int, int) { return true; });
     const auto dir = temp_dir("files") / "nested";
     const BenchFiles files = write_bench_files(dir.string(), outcome.stem, outcome.header, outcome.runs);
     EXPECT_EQ(files.averages, (dir / (outcome.stem + ".csv")).string());

@@ -158,13 +158,13 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
         {"collide /nonexistent/x.mesh --self", 1, "/nonexistent/x.mesh: cannot open file"},
         {"collide BAD --self", 1, "bad.mesh:6: "},
         {"collide BUNNY BUNNY --hash md5", 2, "invalid value 'md5' for --hash"},
-        {"bench -c nope", 2, "invalid value 'nope' for -c: expected kdet, kdet_no_pairs, gpu or gpu_no_loop"},
+        {"bench -c nope", 2, "invalid value 'nope' for -c: expected kdet, kdet_no_pairs, brute_force_loop or brute_force_pairs"},
         {"bench -s maybe", 2, "invalid value 'maybe' for -s: expected yes, y, no or n"},
         {"bench -r 5", 2, "invalid value '5' for -r"},
-        {"bench -o sat-mtv", 2, "invalid value 'sat-mtv' for -o"},
+        {"bench -o sat+mtv", 2, "invalid value 'sat+mtv' for -o"},
         {"bench -g 100", 2, "invalid value '100' for -g"},
         {"bench -n 21", 2, "invalid value '21' for -n"},
-        {"bench -h md5", 2, "invalid value 'md5' for -h: expected djb2, fnv-1a, morton or simple"},
+        {"bench -h md5", 2, "invalid value 'md5' for -h: expected djb2, fnv-1a, simple or morton"},
         {"bench -h", 2, "option '-h' needs a value"},
         {"bench --backend gpu", 2, "invalid value 'gpu' for --backend"},
         {"bench --threads 0", 2, "invalid value '0' for --threads"},
@@ -204,7 +204,26 @@ TEST(Cli, HelpAndVersion) {
     EXPECT_EQ(help.exit_code, 0);
     EXPECT_NE(help.out.find("--pairs FILE"), std::string::npos);
     EXPECT_EQ(kdet_cli("bench --help").exit_code, 0);
+    EXPECT_NE(kdet_cli("--help").out.find("view [SCENE | A [B]]"), std::string::npos);
 }
+
+#ifdef KDET_VIEWER_LEFT_OUT
+TEST(Cli, ViewSaysItWasNotBuilt) {
+    for (const char* arguments : {"view", "view --tets 1000 --screenshot x.png", "view --help"}) {
+        const Outcome r = kdet_cli(arguments);
+        EXPECT_EQ(r.exit_code, 1) << arguments;
+        EXPECT_NE(r.out.find("built without the viewer"), std::string::npos) << r.out;
+        EXPECT_EQ(line_count(r.out), 1u) << r.out;
+    }
+}
+#else
+TEST(Cli, ViewHelpNamesItsOptions) {
+    const Outcome help = kdet_cli("view --help");
+    EXPECT_EQ(help.exit_code, 0) << help.out;
+    for (const char* option : {"--screenshot FILE", "--size WxH", "--method M", "--clip AXIS", "--profile"})
+        EXPECT_NE(help.out.find(option), std::string::npos) << option;
+}
+#endif
 
 #endif
 

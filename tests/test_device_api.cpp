@@ -70,14 +70,19 @@ TEST(DeviceApi, PositionsGivenInBackendMemoryDriveTheDetection) {
     EXPECT_EQ(got, expected);
 }
 
-TEST(DeviceApi, NonFinitePositionsInBackendMemoryAreRejected) {
-    const TetMesh a = test::random_soup(10, 1.0, 0.0, 96);
+TEST(DeviceApi, NonFinitePositionsInBackendMemoryAreRejectedAndNeverUsed) {
+    const TetMesh a = test::random_soup(300, 2.0, 1.0, 96);
     Detector detector;
     const ObjectId id = detector.add_object(a);
+    detector.set_self_collision(id, true);
+    const std::vector<TetPair> before = detector.detect().pairs;
+    ASSERT_FALSE(before.empty());
     std::vector<float> xyz = as_float(a);
     xyz[7] = std::numeric_limits<float>::infinity();
     EXPECT_THROW(detector.set_positions_on_device(id, xyz.data(), a.num_vertices()), Error);
     EXPECT_THROW(detector.set_positions_on_device(id, xyz.data(), a.num_vertices() - 1), Error);
+    // The rejected positions never became current: the detector still sees the last good ones.
+    EXPECT_EQ(detector.detect().pairs, before);
 }
 
 } // namespace

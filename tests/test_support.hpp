@@ -4,6 +4,7 @@
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 #include <kdet/mesh.hpp>
+#include <kdet/prepare.hpp>
 
 #include <gtest/gtest.h>
 

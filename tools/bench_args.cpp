@@ -7,18 +7,15 @@ namespace kdet::cli {
 
 namespace {
 
-struct MethodName {
-    const char* flag;
-    Method method;
-};
-
-// The thesis named the brute-force methods after the GPU; they run on any backend here.
-constexpr MethodName method_names[] = {{"kdet", Method::kdet},
-                                       {"kdet_no_pairs", Method::kdet_no_pairs},
-                                       {"gpu", Method::brute_force_loop},
-                                       {"gpu_no_loop", Method::brute_force_pairs}};
-
-const char* help_text = R"(usage: kdet bench [scene] [options]
+std::string help_text() {
+    const DetectorOptions defaults;
+    std::string thesis_names;
+    for (const std::string& name : option_names<Method>()) {
+        Method method{};
+        parse(name, method);
+        for (const std::string& alias : aliases(method)) thesis_names += (thesis_names.empty() ? "" : ", ") + alias + " = " + name;
+    }
+    return R"(usage: kdet bench [scene] [options]
 
 Runs a scene frame by frame and writes per-frame times and pair counts as CSV (thesis appendix A.1.4):
   DIR/STEM.csv        per-frame averages over the runs
@@ -31,17 +28,17 @@ scene: procedural (default; two deforming tori, no data files needed) or another
 
 thesis options (any order):
   -r N                 model resolution 1-4 (default 1)
-  -c M                 method: kdet (default), kdet_no_pairs, gpu (brute force, loop),
-                       gpu_no_loop (brute force, one work item per pair)
-  -o T                 overlap test: sat (default), sat_no_edges, sat_mtv, gjk, fast
+  -c M                 method: )" + option_help(defaults.method) + R"(
+                       (the thesis's names: )" + thesis_names + R"()
+  -o T                 overlap test: )" + option_help(defaults.narrow_phase) + R"(
   -g N                 CUDA block size: 16, 32, 64, 128 (default) or 256
   -n N                 runs 1-20 (default 10)
   -s yes|y|no|n        self-collisions of every object (default no)
-  -h H                 grid hash: djb2 (default), fnv-1a, morton, simple  (-h is not help)
+  -h H                 grid hash: )" + option_help(defaults.hash) + R"(  (-h is not help)
   -d DIR               output folder (default exports/benchmark_data)
 
 more options:
-  --backend cpu|cuda   where detection runs (default cpu); cuda needs a GPU
+  --backend B          where detection runs: )" + option_help(defaults.backend) + R"(; cuda needs a GPU
   --threads N          CPU threads (default: all)
   --frames A:B         run frames A to B only (0-based, inclusive)
   --quiet              no per-frame table and no progress bar; only the summary
@@ -51,17 +48,23 @@ procedural scene only:
   --tets N             total tetrahedra (default 100000, 100 to 20000000)
   --scene-frames N     length of the motion in frames (default 120)
   --frames N           the same as --scene-frames N (kept from earlier versions)
+Names of methods, tests, hashes and backends ignore case, and '-' and '_' are interchangeable.
 )";
+}
 
 } // namespace
 
-const char* bench_method_name(Method method) {
-    for (const MethodName& m : method_names)
-        if (m.method == method) return m.flag;
-    return "?";
+std::string bench_method_name(Method method) {
+    const std::vector<std::string> thesis_names = aliases(method);
+    return thesis_names.empty() ? to_string(method) : thesis_names.front();
 }
 
-const char* bench_help() { return help_text; }
+std::string bench_help() { return help_text(); }
+
+const std::vector<std::string>& bench_block_sizes() {
+    static const std::vector<std::string> sizes = {"16", "32", "64", "128", "256"};
+    return sizes;
+}
 
 BenchConfig parse_bench_args(int argc, char** argv, int first) {
     BenchConfig config;
@@ -73,33 +76,21 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     parser.option("-r", "resolution", [&](const std::string& v) {
         config.request.resolution = static_cast<int>(parse_integer("-r", v, 1, 4));
     });
-    parser.option("-c", "method", [&](const std::string& v) {
-        std::vector<std::string> accepted;
-        for (const MethodName& m : method_names) accepted.emplace_back(m.flag);
-        const std::string name = parse_choice("-c", v, accepted);
-        for (const MethodName& m : method_names)
-            if (name == m.flag) config.options.method = m.method;
-    });
-    parser.option("-o", "test", [&](const std::string& v) {
-        parse(parse_choice("-o", v, {"sat", "sat_no_edges", "sat_mtv", "gjk", "fast"}), config.options.narrow_phase);
-    });
+    parser.option("-c", "method", [&](const std::string& v) { config.options.method = parse_option<Method>("-c", v); });
+    parser.option("-o", "test", [&](const std::string& v) { config.options.narrow_phase = parse_option<NarrowPhase>("-o", v); });
     parser.option("-g", "block size", [&](const std::string& v) {
-        config.options.block_size = std::stoi(parse_choice("-g", v, {"16", "32", "64", "128", "256"}));
+        config.options.block_size = std::stoi(parse_choice("-g", v, bench_block_sizes()));
     });
     parser.option("-n", "runs", [&](const std::string& v) { config.runs = static_cast<int>(parse_integer("-n", v, 1, 20)); });
     parser.option("-s", "yes|no", [&](const std::string& v) {
         config.self = parse_choice("-s", v, {"yes", "y", "no", "n"})[0] == 'y';
     });
-    parser.option("-h", "hash", [&](const std::string& v) {
-        parse(parse_choice("-h", v, {"djb2", "fnv-1a", "morton", "simple"}), config.options.hash);
-    });
+    parser.option("-h", "hash", [&](const std::string& v) { config.options.hash = parse_option<HashFunction>("-h", v); });
     parser.option("-d", "folder", [&](const std::string& v) {
         if (v.empty()) throw UsageError("invalid value '' for -d: expected a folder");
         config.output_dir = v;
     });
-    parser.option("--backend", "cpu|cuda", [&](const std::string& v) {
-        parse(parse_choice("--backend", v, {"cpu", "cuda"}), config.options.backend);
-    });
+    parser.option("--backend", "backend", [&](const std::string& v) { config.options.backend = parse_option<Backend>("--backend", v); });
     parser.option("--threads", "N", [&](const std::string& v) {
         config.options.threads = static_cast<int>(parse_integer("--threads", v, 1, 1024));
     });

@@ -8,6 +8,7 @@
 #include <kdet/scenes.hpp>
 
 #include <string>
+#include <vector>
 
 namespace kdet::cli {
 
@@ -31,9 +32,12 @@ struct BenchConfig {
 BenchConfig parse_bench_args(int argc, char** argv, int first);
 
 /// @brief The thesis's name for a method (`-c`): kdet, kdet_no_pairs, gpu, gpu_no_loop.
-const char* bench_method_name(Method method);
+std::string bench_method_name(Method method);
+
+/// @brief The CUDA block sizes `-g` accepts, as in the thesis.
+const std::vector<std::string>& bench_block_sizes();
 
 /// @brief The text of `kdet bench --help`.
-const char* bench_help();
+std::string bench_help();
 
 } // namespace kdet::cli

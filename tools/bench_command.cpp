@@ -50,7 +50,7 @@ void print_report(const BenchConfig& config, const Scene& scene, const BenchOutc
     std::printf("scene %s (resolution %d): %s+%s tets, frames %d-%d, %d run(s); method %s, test %s, hash %s, self %s, "
                 "backend %s on %s\n",
                 scene.name().c_str(), config.request.resolution, value("#tetsA").c_str(), value("#tetsB").c_str(),
-                config.first_frame, last_frame_of(config, scene), config.runs, bench_method_name(config.options.method),
+                config.first_frame, last_frame_of(config, scene), config.runs, bench_method_name(config.options.method).c_str(),
                 to_string(config.options.narrow_phase), value("hashing algorithm").c_str(), config.self ? "yes" : "no",
                 to_string(config.options.backend), value("device").c_str());
     const std::size_t device = column("device time"), pairs = column("collision pairs");
@@ -89,7 +89,11 @@ int run_bench(int argc, char** argv) {
         throw Error("bench: --backend cuda is not available here: " + reason);
     const std::unique_ptr<Scene> scene = open_bench_scene(config);
     ProgressBar progress(!config.quiet, config.runs, last_frame_of(config, *scene) - config.first_frame + 1);
-    const BenchOutcome outcome = run_benchmark(config, *scene, progress);
+    const BenchOutcome outcome = run_benchmark(config, *scene, [&](int run, int frame_index) {
+        progress.update(run, frame_index);
+        return true;
+    });
+    progress.finish();
     const BenchFiles files = write_bench_files(config.output_dir, outcome.stem, outcome.header, outcome.runs);
     print_report(config, *scene, outcome, files);
     return exit_ok;

@@ -86,23 +86,30 @@ int last_frame_of(const BenchConfig& config, const Scene& scene) {
     return config.last_frame < 0 ? scene.num_frames() - 1 : config.last_frame;
 }
 
-BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, ProgressBar& progress) {
-    Detector detector(config.options);
+void add_scene_objects(Detector& detector, const Scene& scene, bool self) {
     for (std::size_t o = 0; o < scene.num_objects(); ++o)
-        detector.set_self_collision(detector.add_object(scene.rest_mesh(o)), config.self);
+        detector.set_self_collision(detector.add_object(scene.rest_mesh(o)), self);
     // Self-collisions follow -s, as in the thesis; which object pairs collide is the scene's choice.
     for (std::size_t a = 0; a < scene.num_objects(); ++a)
         for (std::size_t b = a + 1; b < scene.num_objects(); ++b)
             if (!scene.checks_pair(a, b))
                 detector.set_pair_collision(static_cast<ObjectId>(a), static_cast<ObjectId>(b), false);
+}
+
+BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, const BenchProgress& progress) {
+    Detector detector(config.options);
+    add_scene_objects(detector, scene, config.self);
 
     const int last = last_frame_of(config, scene);
     BenchOutcome outcome;
     std::vector<std::vector<float>> xyz(scene.num_objects());
-    for (int run = 0; run < config.runs; ++run) {
+    for (int run = 0; run < config.runs && !outcome.stopped; ++run) {
         std::vector<FrameRow>& rows = outcome.runs.emplace_back();
         for (int frame = config.first_frame; frame <= last; ++frame) {
-            progress.update(run, frame - config.first_frame);
+            if (!progress(run, frame - config.first_frame)) {
+                outcome.stopped = true;
+                break;
+            }
             for (std::size_t o = 0; o < scene.num_objects(); ++o) {
                 scene.positions(o, frame, xyz[o]);
                 detector.set_positions(static_cast<ObjectId>(o), xyz[o].data(), xyz[o].size() / 3);
@@ -116,7 +123,6 @@ BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, Progre
             outcome.peak_memory = std::max(outcome.peak_memory, result.memory_bytes);
         }
     }
-    progress.finish();
     outcome.header = header_of(config, scene, detector, last, outcome.peak_memory);
     outcome.stem = stem_of(config, scene, last);
     return outcome;

@@ -4,11 +4,12 @@
 
 #include "bench_args.hpp"
 #include "bench_csv.hpp"
-#include "bench_progress.hpp"
 
+#include <kdet/detector.hpp>
 #include <kdet/scenes.hpp>
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,16 @@ struct BenchOutcome {
     std::vector<HeaderField> header;         ///< thesis fields first, then backend, machine and build
     std::string stem;                        ///< file name without extension, from the parameters
     std::size_t peak_memory = 0;             ///< largest FrameResult::memory_bytes of any frame
+    bool stopped = false;                    ///< the progress callback asked to stop; runs are incomplete
 };
+
+/// @brief Told before each frame which run (0-based) and frame (0-based within the range) comes
+/// next; returning false stops the benchmark there.
+using BenchProgress = std::function<bool(int run, int frame_index)>;
+
+/// @brief Adds every object of @p scene to @p detector (ids in scene order), with self-collision of
+/// each object as @p self says and the object pairs the scene checks.
+void add_scene_objects(Detector& detector, const Scene& scene, bool self);
 
 /// @brief The last frame `config` selects in `scene` (its --frames B, else the scene's last frame).
 int last_frame_of(const BenchConfig& config, const Scene& scene);
@@ -28,6 +38,6 @@ int last_frame_of(const BenchConfig& config, const Scene& scene);
 /// @brief Runs frames first_frame..last_frame_of() of `scene` config.runs times with one Detector
 /// (its buffers persist between runs, as in an application). Only detect() is timed; the scene's
 /// positions are computed and uploaded outside the measured time.
-BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, ProgressBar& progress);
+BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, const BenchProgress& progress);
 
 } // namespace kdet::cli

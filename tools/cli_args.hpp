@@ -2,6 +2,8 @@
 /// @file cli_args.hpp
 /// @brief A small command-line parser that turns every mistake into a one-line UsageError.
 
+#include <kdet/options.hpp>
+
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -53,5 +55,27 @@ std::string parse_choice(const std::string& flag, const std::string& text, const
 
 /// @brief Joins names for error messages: "a, b or c".
 std::string join_choices(const std::vector<std::string>& names);
+
+/// @brief Reads the value of an option flag (a Backend, Method, NarrowPhase or HashFunction) with the
+/// library's names (kdet::parse: any case, '-' or '_'), or throws a UsageError that lists them.
+template <class Option>
+Option parse_option(const std::string& flag, const std::string& text) {
+    Option value{};
+    if (!kdet::parse(text, value))
+        throw UsageError("invalid value '" + text + "' for " + flag + ": expected " + join_choices(option_names<Option>()));
+    return value;
+}
+
+/// @brief "a (default), b, c": the names of an option type for help texts, the default marked.
+template <class Option>
+std::string option_help(Option default_value) {
+    std::string out;
+    for (const std::string& name : option_names<Option>()) {
+        if (!out.empty()) out += ", ";
+        out += name;
+        if (name == to_string(default_value)) out += " (default)";
+    }
+    return out;
+}
 
 } // namespace kdet::cli

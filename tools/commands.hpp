@@ -6,6 +6,8 @@
 
 #include <kdet/options.hpp>
 
+#include <string>
+
 namespace kdet::cli {
 
 /// @brief Exit codes: 0 success, 1 bad input or failure, 2 command-line mistake.
@@ -18,6 +20,6 @@ int run_bench(int argc, char** argv);
 void add_detector_options(ArgParser& parser, DetectorOptions& options);
 
 /// @brief Help lines for the options of add_detector_options.
-const char* detector_options_help();
+std::string detector_options_help();
 
 } // namespace kdet::cli

@@ -1,6 +1,7 @@
 #include "bench_plot.hpp"
 #include "commands.hpp"
 #include "prepare_command.hpp"
+#include "view_command.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
@@ -19,6 +20,8 @@ commands:
   collide A [B] [options]   colliding pairs between two meshes, or inside one with --self
   bench [scene] [options]   runs a scene frame by frame (default: the built-in procedural scene)
                             and writes the thesis's CSV files
+  view [SCENE | A [B]]      shows a scene or meshes in a window, detecting collisions every frame;
+                            --screenshot FILE draws one frame into a PNG without a window
   plot FOLDER               turns the CSV files of kdet bench into PNG figures (matplotlib)
   prepare [MODEL...] [-r N] builds the tet meshes of the thesis scenes (CGAL + TetGen) into the cache
 
@@ -40,6 +43,7 @@ int main(int argc, char** argv) {
         if (command == "bench") return run_bench(argc, argv);
         if (command == "prepare") return run_prepare(argc, argv);
         if (command == "plot") return run_plot(argc, argv);
+        if (command == "view") return run_view(argc, argv);
         if (command == "--help" || command == "-h" || command == "help") {
             std::cout << usage;
             return exit_ok;
@@ -48,7 +52,7 @@ int main(int argc, char** argv) {
             std::cout << "kdet " << kdet::version() << "\n";
             return exit_ok;
         }
-        std::cerr << "kdet: unknown command '" << command << "' (commands: collide, bench, plot, prepare; see 'kdet --help')\n";
+        std::cerr << "kdet: unknown command '" << command << "' (commands: collide, bench, view, plot, prepare; see 'kdet --help')\n";
         return exit_usage;
     } catch (const UsageError& e) {
         std::cerr << "kdet " << e.what() << "\n";

@@ -104,12 +104,4 @@ void write_vtk(const TetMesh& mesh, const std::string& path, const VtkFormat& fo
 /// @throws Error with a message such as "source: tet 17: ..." or "source: vertex 3: ...".
 void validate_tet_mesh(const TetMesh& mesh, const std::string& source, const ReadOptions& options = {});
 
-/// @brief The folder holding the source models: $KDET_DATA_DIR when set and non-empty, else
-/// "../shared/models" (relative to the working directory).
-std::string data_dir();
-
-/// @brief The path of model @p file inside data_dir().
-/// @throws Error "model 'x' not found in DIR (...)" when there is no such file.
-std::string data_path(const std::string& file);
-
 } // namespace kdet

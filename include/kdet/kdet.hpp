@@ -9,4 +9,3 @@
 #include <kdet/mesh.hpp>
 #include <kdet/options.hpp>
 #include <kdet/results.hpp>
-#include <kdet/scenes.hpp>

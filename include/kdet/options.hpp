@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace kdet {
 
@@ -31,17 +32,38 @@ enum class NarrowPhase {
 /// @brief Hash function of the hierarchical grid.
 enum class HashFunction { djb2, fnv1a, simple, morton };
 
-/// @brief Name of an enumerator as used on the command line.
+/// @brief The canonical name of a value: what the command line, the viewer and the Python package
+/// show and what benchmark files record.
 const char* to_string(Backend value);
 const char* to_string(Method value);
 const char* to_string(NarrowPhase value);
 const char* to_string(HashFunction value);
 
-/// @brief Parses a command-line name; returns false when the name is unknown.
+/// @brief Reads a name into @p out; returns false (leaving @p out unchanged) when it is unknown.
+/// Accepted: the canonical names, and the thesis's own spellings of the brute-force methods ("gpu"
+/// for brute_force_loop, "gpu_no_loop" for brute_force_pairs). Case is ignored, and '-' and '_' are
+/// interchangeable ("SAT-MTV" is sat_mtv, "fnv_1a" is fnv-1a).
 bool parse(const std::string& name, Backend& out);
 bool parse(const std::string& name, Method& out);
 bool parse(const std::string& name, NarrowPhase& out);
 bool parse(const std::string& name, HashFunction& out);
+
+/// @brief Canonical names of every value of an option type (Backend, Method, NarrowPhase or
+/// HashFunction) in declaration order, for help texts, error messages, menus and bindings.
+template <class Option>
+const std::vector<std::string>& option_names();
+template <>
+const std::vector<std::string>& option_names<Backend>();
+template <>
+const std::vector<std::string>& option_names<Method>();
+template <>
+const std::vector<std::string>& option_names<NarrowPhase>();
+template <>
+const std::vector<std::string>& option_names<HashFunction>();
+
+/// @brief The other names parse() accepts for @p value besides its canonical one (the thesis's
+/// "gpu" and "gpu_no_loop"); empty for most values.
+std::vector<std::string> aliases(Method value);
 
 /// @brief Settings of a Detector; all have working defaults.
 struct DetectorOptions {
@@ -51,7 +73,7 @@ struct DetectorOptions {
     HashFunction hash = HashFunction::djb2;
     /// CPU threads; 0 leaves OpenMP's default.
     int threads = 0;
-    /// CUDA block size (threads per block).
+    /// CUDA block size (threads per block), 1-1024; capped per kernel at what the kernel can launch with.
     int block_size = 128;
     /// Tet ids per grid bucket before an overflow bucket is chained.
     std::uint32_t bucket_capacity = 32;

@@ -16,8 +16,11 @@ template <class T>
 class HostBuffer {
 public:
     /// @brief Makes room for n elements; discards the old contents when it has to reallocate.
+    /// A failed allocation (std::bad_alloc) leaves the buffer empty, never a size without memory.
     void resize_discard(std::size_t n) {
         if (n > capacity_) {
+            data_.reset();
+            size_ = capacity_ = 0;
             data_.reset(new T[n]);
             capacity_ = n;
         }

@@ -28,11 +28,16 @@ public:
     DeviceBuffer& operator=(const DeviceBuffer&) = delete;
     ~DeviceBuffer() { cudaFree(data_); }
 
+    /// @brief Makes room for n elements; discards the old contents when it has to reallocate.
+    /// A failed allocation throws and leaves the buffer empty, never a size without memory.
     void resize_discard(std::size_t n) {
         if (n > capacity_) {
-            cuda_check(cudaFree(data_), "cudaFree");
+            T* old = data_;
             data_ = nullptr;
-            capacity_ = 0;
+            size_ = capacity_ = 0;
+            cuda_check(cudaFree(old), "cudaFree");
+            if (n > static_cast<std::size_t>(-1) / sizeof(T))
+                throw Error("cannot allocate " + std::to_string(n) + " elements of device memory: size overflows");
             cuda_check(cudaMalloc(reinterpret_cast<void**>(&data_), n * sizeof(T)), "cudaMalloc");
             capacity_ = n;
         }
@@ -96,10 +101,24 @@ public:
     template <class F>
     void for_each(std::uint64_t n, const F& f) const {
         if (n == 0) return;
-        const std::uint64_t wanted = (n + block_size_ - 1) / block_size_;
+        const int block = launchable_block_size<F>();
+        const std::uint64_t wanted = (n + block - 1) / block;
         const auto blocks = static_cast<unsigned>(wanted < (1u << 30) ? wanted : (1u << 30));
-        for_each_kernel<<<blocks, block_size_>>>(n, f);
+        for_each_kernel<<<blocks, block>>>(n, f);
         cuda_check(cudaGetLastError(), "kernel launch");
+    }
+
+    /// @brief The requested block size, capped at what the kernel for F can launch with: heavy
+    /// kernels need so many registers per thread that 1024 (or 512) threads do not fit a block.
+    template <class F>
+    int launchable_block_size() const {
+        static const int kernel_limit = [] {
+            cudaFuncAttributes attributes{};
+            cuda_check(cudaFuncGetAttributes(&attributes, for_each_kernel<F>), "cudaFuncGetAttributes");
+            return attributes.maxThreadsPerBlock;
+        }();
+        if (block_size_ <= kernel_limit) return block_size_;
+        return kernel_limit >= 32 ? kernel_limit / 32 * 32 : kernel_limit; // whole warps
     }
 
     void sort(std::uint64_t* keys, std::size_t n) const {

@@ -69,10 +69,11 @@ public:
     }
 
     void set_positions_on_device(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
-        exec_.copy(positions_.data() + first, positions, count);
+        // Checked where they are, before they replace anything: rejected positions never become current.
         reset_counters();
-        exec_.for_each(count, FiniteCheckKernel{positions_.data() + first, &counters_.data()->non_finite});
+        exec_.for_each(count, FiniteCheckKernel{positions, &counters_.data()->non_finite});
         if (read_counters().non_finite) throw Error("positions given on the device hold a non-finite coordinate");
+        exec_.copy(positions_.data() + first, positions, count);
     }
 
     void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count) override {
@@ -137,6 +138,8 @@ private:
     void ensure_candidate_capacity(std::size_t relevant_tets);
 
     Exec exec_;
+    // Kept between frames: on the GPU each holds two CUDA events, created once.
+    typename Exec::stage_timer total_timer_, stage_timer_;
     DetectorOptions options_;
     SceneTopology topology_;
     GridParams params_{};
@@ -484,7 +487,8 @@ void Pipeline<Exec>::count_and_copy_flags(bool any, FrameResult& result) {
 
 template <class Exec>
 void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, FrameResult& result) {
-    typename Exec::stage_timer total, stage;
+    auto& total = total_timer_;
+    auto& stage = stage_timer_;
     total.start();
     result.pairs.clear();
     result.contacts.clear();

@@ -1,4 +1,4 @@
-# Compiles the scene files of scenes/ into the kdet library (scenes::builtin_scene_files), so that the
+# Compiles the scene files of scenes/ into the kdet_scenes library (scenes::builtin_scene_files), so that the
 # thesis scenes need only the data folder at run time. CMake reruns when a scene file changes.
 file(GLOB _kdet_scene_files CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/scenes/*.scene)
 set(_kdet_scene_entries "")
@@ -24,4 +24,4 @@ ${_kdet_scene_entries}    };
 ")
 # Copying only on change keeps the library from recompiling on every configure.
 configure_file(${CMAKE_CURRENT_BINARY_DIR}/builtin_scenes.cpp.new ${CMAKE_CURRENT_BINARY_DIR}/builtin_scenes.cpp COPYONLY)
-target_sources(kdet PRIVATE ${CMAKE_CURRENT_BINARY_DIR}/builtin_scenes.cpp)
+target_sources(kdet_scenes PRIVATE ${CMAKE_CURRENT_BINARY_DIR}/builtin_scenes.cpp)

@@ -1,6 +1,8 @@
 #pragma once
 /// @file scenes.hpp
-/// @brief Meshes and moving scenes that the code builds itself, so that kdet runs without data files.
+/// @brief Part of the benchmark harness (the kdet_scenes target), not of the kdet library: meshes and
+/// moving scenes that the code builds itself (so that kdet runs without data files), the thesis
+/// scenes, scene files and recordings.
 
 #include <kdet/mesh.hpp>
 

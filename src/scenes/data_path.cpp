@@ -2,7 +2,7 @@
 /// @brief Where the source models are found.
 
 #include <kdet/error.hpp>
-#include <kdet/io.hpp>
+#include <kdet/prepare.hpp>
 
 #include <cstdlib>
 #include <filesystem>

@@ -1,8 +1,9 @@
 #pragma once
 /// @file prepare.hpp
-/// @brief The thesis models as tetrahedral meshes: their sizes (thesis Table 5.2) and the cache that
-/// `kdet prepare` fills. The library only reads the cache; making the meshes needs CGAL and TetGen
-/// and is the job of the `kdet prepare` command.
+/// @brief Part of the benchmark harness (the kdet_scenes target), not of the kdet library: where the
+/// source models are found, the thesis models as tetrahedral meshes with their sizes (thesis Table
+/// 5.2), and the cache that `kdet prepare` fills. This target only reads the cache; making the meshes
+/// needs CGAL and TetGen and is the job of the `kdet prepare` command.
 
 #include <kdet/mesh.hpp>
 
@@ -30,6 +31,14 @@ const ModelInfo& thesis_model(const std::string& name);
 /// @brief The tet count Table 5.2 gives for @p model at @p resolution (1-4); prepared meshes land
 /// within 10 % of it. Throws kdet::Error for an unknown model or a resolution outside 1-4.
 std::size_t target_tets(const std::string& model, int resolution);
+
+/// @brief The folder holding the source models: $KDET_DATA_DIR when set and non-empty, else
+/// "../shared/models" (relative to the working directory).
+std::string data_dir();
+
+/// @brief The path of model @p file inside data_dir().
+/// @throws Error "model 'x' not found in DIR (...)" when there is no such file.
+std::string data_path(const std::string& file);
 
 /// @brief Where prepared meshes are kept: $KDET_CACHE_DIR when set and non-empty, else
 /// $XDG_CACHE_HOME/kdet, else $HOME/.cache/kdet.

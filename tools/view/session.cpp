@@ -1,0 +1,145 @@
+#include "session.hpp"
+
+#include "bench_runner.hpp"
+
+#include <kdet/error.hpp>
+
+#include <time.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+namespace kdet::view {
+
+namespace {
+
+/// @brief One or two meshes read from files, standing still: a scene of one frame.
+class MeshScene final : public Scene {
+public:
+    MeshScene(const std::vector<std::string>& paths, const ReadOptions& options) {
+        for (const std::string& path : paths) {
+            meshes_.push_back(read_tet_mesh(path, options));
+            if (!name_.empty()) name_ += "+";
+            name_ += std::filesystem::path(path).stem().string();
+        }
+    }
+    std::string name() const override { return name_; }
+    std::size_t num_objects() const override { return meshes_.size(); }
+    int num_frames() const override { return 1; }
+    const TetMesh& rest_mesh(std::size_t object) const override { return meshes_.at(object); }
+    void positions(std::size_t object, int, std::vector<float>& out) const override {
+        const std::vector<double>& p = meshes_.at(object).positions;
+        out.assign(p.begin(), p.end());
+    }
+    void positions(std::size_t object, int, std::vector<double>& out) const override {
+        out = meshes_.at(object).positions;
+    }
+
+private:
+    std::vector<TetMesh> meshes_;
+    std::string name_;
+};
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+} // namespace
+
+std::unique_ptr<Scene> open_view_source(const ViewSource& source) {
+    if (!source.meshes.empty()) return std::make_unique<MeshScene>(source.meshes, source.read_options);
+    return open_scene(source.scene, source.request);
+}
+
+std::size_t resident_bytes() {
+    std::ifstream statm("/proc/self/statm");
+    std::size_t total_pages = 0, resident_pages = 0;
+    if (!(statm >> total_pages >> resident_pages)) return 0;
+    return resident_pages * static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+}
+
+double process_cpu_ms() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+ViewSession::ViewSession(const ViewSource& source, const DetectorOptions& options, bool self)
+    : options_(options), self_(self) {
+    open(source);
+}
+
+void ViewSession::open(const ViewSource& source) {
+    std::unique_ptr<Scene> scene = open_view_source(source);
+    std::vector<MeshFaces> faces;
+    for (std::size_t o = 0; o < scene->num_objects(); ++o) faces.push_back(analyse_faces(scene->rest_mesh(o)));
+    // Release the old detector before the new scene's buffers are made.
+    detector_.reset();
+    scene_ = std::move(scene);
+    faces_ = std::move(faces);
+    source_ = source;
+    positions_.assign(scene_->num_objects(), {});
+    if (frame_ >= scene_->num_frames()) frame_ = 0;
+    positions_frame_ = -1;
+    results_stale_ = true;
+    has_result_ = false;
+    result_ = FrameResult{};
+    ++scene_version_;
+}
+
+void ViewSession::set_options(const DetectorOptions& options) {
+    options_ = options;
+    detector_.reset();
+    results_stale_ = true;
+}
+
+void ViewSession::set_self(bool self) {
+    if (self == self_) return;
+    self_ = self;
+    detector_.reset();
+    results_stale_ = true;
+}
+
+void ViewSession::set_frame(int frame) { frame_ = std::clamp(frame, 0, scene_->num_frames() - 1); }
+
+void ViewSession::build_detector() {
+    auto detector = std::make_unique<Detector>(options_);
+    cli::add_scene_objects(*detector, *scene_, self_);
+    detector_ = std::move(detector);
+}
+
+bool ViewSession::update() {
+    bool changed = false;
+    if (positions_frame_ != frame_) {
+        const auto start = std::chrono::steady_clock::now();
+        for (std::size_t o = 0; o < scene_->num_objects(); ++o) scene_->positions(o, frame_, positions_[o]);
+        positions_ms_ = milliseconds_since(start);
+        positions_frame_ = frame_;
+        ++positions_version_;
+        results_stale_ = true;
+        changed = true;
+    }
+    if (results_stale_) {
+        if (!detector_) build_detector();
+        for (std::size_t o = 0; o < scene_->num_objects(); ++o)
+            detector_->set_positions(static_cast<ObjectId>(o), positions_[o].data(), positions_[o].size() / 3);
+        const auto start = std::chrono::steady_clock::now();
+        const double cpu_start = process_cpu_ms();
+        result_ = detector_->detect();
+        detect_cpu_ms_ = process_cpu_ms() - cpu_start;
+        detect_ms_ = milliseconds_since(start);
+        has_result_ = true;
+        results_stale_ = false;
+        ++result_version_;
+        changed = true;
+    }
+    return changed;
+}
+
+std::size_t ViewSession::detector_memory() const { return detector_ ? detector_->memory_bytes() : 0; }
+
+std::string ViewSession::device_name() const { return detector_ ? detector_->device_name() : std::string(); }
+
+} // namespace kdet::view

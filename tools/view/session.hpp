@@ -1,0 +1,110 @@
+#pragma once
+/// @file session.hpp
+/// @brief What the viewer shows and computes, without any drawing: the open scene, the Detector
+/// with the chosen options, the current frame's positions and the detection's results.
+
+#include "surface.hpp"
+
+#include <kdet/detector.hpp>
+#include <kdet/io.hpp>
+#include <kdet/scenes.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace kdet::view {
+
+/// @brief Where the viewer's objects come from: a scene (anything `kdet bench` opens) or, when
+/// `meshes` is not empty, one or two mesh files as in `kdet collide` (one frame).
+struct ViewSource {
+    std::string scene = "procedural";
+    std::vector<std::string> meshes;
+    SceneRequest request;
+    ReadOptions read_options;
+};
+
+/// @brief Opens @p source. Throws kdet::Error with a one-line message when it cannot.
+std::unique_ptr<Scene> open_view_source(const ViewSource& source);
+
+/// @brief The process's resident set in bytes (0 when the system does not tell).
+std::size_t resident_bytes();
+
+/// @brief Processor time used by all threads of the process so far, in milliseconds. Unlike wall
+/// time it hardly changes when other programs share the processors.
+double process_cpu_ms();
+
+/// @brief The scene, detector and current results of one viewer. Every setting may change at any
+/// time, before or after the first detection: the detector is rebuilt with the new settings the next
+/// time results are needed, and the old one is released.
+class ViewSession {
+public:
+    /// @brief Opens @p source (throws kdet::Error when it cannot).
+    ViewSession(const ViewSource& source, const DetectorOptions& options, bool self);
+
+    /// @brief Switches to another source. Throws kdet::Error when it cannot be opened, and then keeps
+    /// the current one. The frame is kept when the new scene has it, else it becomes 0.
+    void open(const ViewSource& source);
+    void set_options(const DetectorOptions& options);
+    /// @brief Self-collision of every object (as `kdet bench -s`).
+    void set_self(bool self);
+    /// @brief Selects a frame; clamped to the scene's frames.
+    void set_frame(int frame);
+
+    /// @brief Brings the current frame up to date: reads its positions if the frame changed and
+    /// runs detection if positions or settings changed. Returns true when it computed anything.
+    bool update();
+
+    const ViewSource& source() const { return source_; }
+    const Scene& scene() const { return *scene_; }
+    const DetectorOptions& options() const { return options_; }
+    bool self() const { return self_; }
+    int frame() const { return frame_; }
+    int num_frames() const { return scene_->num_frames(); }
+
+    /// @brief Each object's boundary and face neighbours, computed once when the scene opens.
+    const std::vector<MeshFaces>& faces() const { return faces_; }
+    /// @brief Positions (x y z per vertex) of each object at frame() as of the last update().
+    const std::vector<std::vector<float>>& positions() const { return positions_; }
+    /// @brief The last detection; empty before the first update().
+    const FrameResult& result() const { return result_; }
+    bool has_result() const { return has_result_; }
+    /// @brief Bytes held by the current detector (0 before the first detection).
+    std::size_t detector_memory() const;
+    /// @brief Name of the device the detector runs on (empty before the first detection).
+    std::string device_name() const;
+
+    /// @brief Milliseconds the last update() spent computing positions and in detect() (wall
+    /// clock), and the processor time of every thread of the process during detect().
+    double positions_ms() const { return positions_ms_; }
+    double detect_ms() const { return detect_ms_; }
+    double detect_cpu_ms() const { return detect_cpu_ms_; }
+    /// @brief Counters that step whenever positions or results change; a renderer compares them to
+    /// know what to upload.
+    std::uint64_t positions_version() const { return positions_version_; }
+    std::uint64_t result_version() const { return result_version_; }
+    /// @brief Steps whenever another scene is opened (its meshes and surfaces changed).
+    std::uint64_t scene_version() const { return scene_version_; }
+
+private:
+    void build_detector();
+
+    ViewSource source_;
+    std::unique_ptr<Scene> scene_;
+    std::vector<MeshFaces> faces_;
+    DetectorOptions options_;
+    bool self_ = false;
+    int frame_ = 0;
+    int positions_frame_ = -1; ///< frame whose positions are in positions_, -1 for none
+    bool results_stale_ = true;
+    std::unique_ptr<Detector> detector_; ///< null until needed, and after a setting changed
+    std::vector<std::vector<float>> positions_;
+    FrameResult result_;
+    bool has_result_ = false;
+    double positions_ms_ = 0, detect_ms_ = 0, detect_cpu_ms_ = 0;
+    std::uint64_t positions_version_ = 0, result_version_ = 0, scene_version_ = 0;
+};
+
+} // namespace kdet::view

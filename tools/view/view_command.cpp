@@ -1,0 +1,49 @@
+#include "view_command.hpp"
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "session.hpp"
+#include "view_args.hpp"
+#include "viewer.hpp"
+
+#include <kdet/detector.hpp>
+#include <kdet/error.hpp>
+
+#include <cstdio>
+#include <iostream>
+
+namespace kdet::cli {
+
+int run_view(int argc, char** argv) {
+    view::ViewConfig config = view::parse_view_args(argc, argv, 2);
+    if (config.help) {
+        std::cout << view::view_help();
+        return exit_ok;
+    }
+    std::string reason;
+    if (config.options.backend == Backend::cuda && !cuda_available(&reason))
+        throw Error("view: --backend cuda is not available here: " + reason);
+    config.options.contacts = config.options.narrow_phase == NarrowPhase::sat_mtv;
+    view::ViewSession session(config.source, config.options, config.self);
+    if (config.frame >= session.num_frames())
+        throw UsageError("invalid value '" + std::to_string(config.frame) + "' for --frame: scene '" +
+                         session.scene().name() + "' has frames 0 to " + std::to_string(session.num_frames() - 1));
+    const bool headless = !config.screenshot.empty() || config.profile;
+    view::Viewer viewer(session, config, !headless);
+    if (!config.screenshot.empty()) {
+        viewer.screenshot(config.screenshot, config.width, config.height, config.panel);
+        const FrameResult& r = session.result();
+        std::printf("wrote %s: frame %d of %s, %llu colliding pairs, %llu colliding tets\n", config.screenshot.c_str(),
+                    session.frame(), session.scene().name().c_str(), static_cast<unsigned long long>(r.counts.colliding_pairs),
+                    static_cast<unsigned long long>(r.counts.colliding_tets));
+        return exit_ok;
+    }
+    if (config.profile) {
+        viewer.profile(config.width, config.height);
+        return exit_ok;
+    }
+    viewer.run();
+    return exit_ok;
+}
+
+} // namespace kdet::cli
