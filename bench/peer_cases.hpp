@@ -7,6 +7,7 @@
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 #include <kdet/mesh.hpp>
+#include <kdet/prepare.hpp>
 #include <kdet/scenes.hpp>
 
 #include <algorithm>
