@@ -14,7 +14,7 @@
 ///   --cases REGEX  only the cases whose names match (e.g. 'hand|soup 10k'); only those are built
 ///   --table FILE  also write the markdown table of medians and ratios to FILE
 /// The table (stdout, after the benchmark output) uses the median of the repetitions when
-/// --benchmark_repetitions is given, else the mean.
+/// --benchmark_repetitions is given, else the mean; a second table splits a one-off query by stage.
 
 #include "peer.hpp"
 #include "peer_cases.hpp"
@@ -44,6 +44,7 @@ using bench::PeerCase;
 DetectorOptions kdet_options(int threads) {
     DetectorOptions options;
     options.threads = threads;
+    options.narrow_phase = NarrowPhase::sat; // the peer's test, whatever the library's default
     return options;
 }
 
@@ -125,6 +126,29 @@ void register_case(const PeerCase& c, int threads) {
         }
         set_counters(state, c, pairs);
     });
+}
+
+/// Where a one-off query's time goes: the first frame of a fresh Detector (what kdet::collide runs),
+/// the run with the median total of five, with its stage times, candidates and buffer regrowths.
+std::string stage_table(const std::vector<PeerCase>& cases, int threads) {
+    std::string out = "| case | total ms | boxes | populate | candidates | narrow | sort | candidates found | "
+                      "left by the pre-test | colliding | regrows |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    char line[512];
+    for (const PeerCase& c : cases) {
+        std::vector<FrameResult> runs;
+        for (int r = 0; r < 5; ++r) runs.push_back(detect_frame(*make_detector(c, threads), c, 0));
+        std::sort(runs.begin(), runs.end(),
+                  [](const FrameResult& a, const FrameResult& b) { return a.times.total < b.times.total; });
+        const StageTimes& t = runs[2].times;
+        const FrameCounts& n = runs[2].counts;
+        std::snprintf(line, sizeof line, "| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %llu | %llu | %llu | %u |\n",
+                      c.name.c_str(), t.total, t.bounding_boxes, t.populate_grid, t.find_candidates, t.narrow_phase,
+                      t.sort_unique, static_cast<unsigned long long>(n.candidates),
+                      static_cast<unsigned long long>(n.unique_candidates),
+                      static_cast<unsigned long long>(n.colliding_pairs), n.buffer_regrows);
+        out += line;
+    }
+    return out;
 }
 
 /// Collects each benchmark's time (median of the repetitions, or the mean) for the ratio table.
@@ -221,7 +245,7 @@ int main(int argc, char** argv) {
     }
     TableReporter reporter;
     benchmark::RunSpecifiedBenchmarks(&reporter);
-    const std::string table = reporter.table(cases);
+    const std::string table = reporter.table(cases) + "\n" + stage_table(cases, threads);
     std::printf("\n%s", table.c_str());
     if (!table_file.empty()) std::ofstream(table_file) << table;
     benchmark::Shutdown();

@@ -1,6 +1,7 @@
 // Every method must return exactly the pair set of brute force; the flags of kdet_no_pairs must equal
 // the tets that appear in brute force's pairs.
 
+#include "near_touching.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -124,6 +125,26 @@ TEST(Pipeline, FoldedBarSelfCollidesLikeBruteForce) {
     TetMesh gently = bar;
     fold_bar(bar, 3.14159265358979, gently.positions);
     EXPECT_TRUE(run({gently}, true, with_method(Method::kdet)).pairs.empty());
+}
+
+TEST(Pipeline, NearTouchingPairsGetEachTestsOwnAnswer) {
+    // The grid methods run the face-plane pre-test before the test, brute force runs the test alone:
+    // on pairs around the pre-test's margin and the tests' tolerance, the pair sets must not differ.
+    const test::NearTouchingPairs pairs = test::near_touching_pairs(216, 5);
+    const std::size_t count = pairs.first.tets.size() / 4;
+    for (NarrowPhase narrow : test::every_narrow_phase_test()) {
+        DetectorOptions brute = with_method(Method::brute_force_loop), grid = with_method(Method::kdet);
+        brute.narrow_phase = grid.narrow_phase = narrow;
+        const Outcome oracle = run({pairs.first, pairs.second}, false, brute);
+        const Outcome found = run({pairs.first, pairs.second}, false, grid);
+        EXPECT_EQ(found.pairs, oracle.pairs) << to_string(narrow);
+        EXPECT_GT(oracle.pairs.size(), count / 4) << to_string(narrow);
+        // Not vacuous: the pre-test proved a good part of the pairs separated.
+        EXPECT_GT(found.counts.candidates - found.counts.unique_candidates, count / 10) << to_string(narrow);
+        grid.method = Method::kdet_no_pairs;
+        EXPECT_EQ(run({pairs.first, pairs.second}, false, grid).colliding, flags_of(oracle.pairs, oracle.colliding))
+            << to_string(narrow);
+    }
 }
 
 TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {

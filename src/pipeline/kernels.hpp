@@ -67,9 +67,17 @@ KDET_HD inline std::uint64_t pair_key(std::uint32_t t, std::uint32_t u) {
 KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
 KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
 
-/// @brief The decision for a pair whose boxes overlap and that is not adjacent: the face-plane
-/// pre-test where it is sure (the same answer as every test, see face_planes.hpp), else the test.
-/// The lower stored id goes first, so every method sees the same floating-point computation.
+/// @brief The narrow-phase test alone on stored tets first < second: the lower stored id goes first, so
+/// every method sees the same floating-point computation.
+KDET_HD inline bool test_pair(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second) {
+    vec3 a[4], b[4];
+    load_tet(s, first, a);
+    load_tet(s, second, b);
+    return tets_intersect(test, a, b);
+}
+
+/// @brief The decision for a pair whose boxes overlap and that is not adjacent (first < second): the
+/// face-plane pre-test where it is sure (the answer the test gives, see face_planes.hpp), else the test.
 KDET_HD inline bool candidate_collides(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second) {
     vec3 a[4], b[4];
     load_tet(s, first, a);
@@ -79,13 +87,18 @@ KDET_HD inline bool candidate_collides(const SceneView& s, NarrowPhase test, std
     return tets_intersect(test, a, b);
 }
 
-/// @brief The predicate every method applies to a pair that may collide: adjacency, boxes, then
-/// candidate_collides.
-KDET_HD inline bool tets_collide(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u) {
-    const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
+/// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, and
+/// their boxes overlap.
+KDET_HD inline bool may_collide(const SceneView& s, std::uint32_t first, std::uint32_t second) {
     if (s.tet_object[first] == s.tet_object[second] && share_vertex(s.tets[first], s.tets[second])) return false;
-    if (!boxes_overlap(s.info[first].box, s.info[second].box)) return false;
-    return candidate_collides(s, test, first, second);
+    return boxes_overlap(s.info[first].box, s.info[second].box);
+}
+
+/// @brief The brute-force methods' predicate: adjacency, boxes, then the test itself, without the
+/// pre-test, so that they stay the oracle the grid methods (which use it) are compared with.
+KDET_HD inline bool tets_collide_tested(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u) {
+    const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
+    return may_collide(s, first, second) && test_pair(s, test, first, second);
 }
 
 /// @brief Stage 1: box of each tet; no size and no layer yet.
@@ -162,16 +175,6 @@ struct TetSizeKernel {
         const std::uint32_t size = float_to_ordered(info.diameter);
         if (size < atomic_load_acquire(min_size)) atomic_min(min_size, size);
         if (size > atomic_load_acquire(max_size)) atomic_max(max_size, size);
-    }
-};
-
-/// @brief Stage 1, brute-force methods only: the face planes of every tet (they test every pair).
-struct TetPlanesKernel {
-    SceneView scene;
-    KDET_HD void operator()(std::uint64_t t) const {
-        vec3 v[4];
-        load_tet(scene, static_cast<std::uint32_t>(t), v);
-        scene.planes[t] = tet_planes(v);
     }
 };
 
@@ -391,7 +394,8 @@ struct NoPairsKernel {
             std::uint32_t* flags = kernel->colliding;
             if (atomic_load_acquire(&flags[t]) && atomic_load_acquire(&flags[u])) return;
             ++tests;
-            if (tets_collide(kernel->scene, kernel->test, t, u)) {
+            const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
+            if (may_collide(kernel->scene, first, second) && candidate_collides(kernel->scene, kernel->test, first, second)) {
                 atomic_store_relaxed(&flags[t], 1u);
                 atomic_store_relaxed(&flags[u], 1u);
             }
@@ -420,7 +424,7 @@ struct BruteForceLoopKernel {
             if (!pair_is_active(scene, object, other)) continue;
             const std::uint32_t begin = other == object ? t + 1 : object_tet_begin[other];
             for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u)
-                if (tets_collide(scene, test, t, u)) batch.push(pair_key(t, u));
+                if (tets_collide_tested(scene, test, t, u)) batch.push(pair_key(t, u));
         }
         batch.flush();
     }
@@ -460,21 +464,24 @@ struct BruteForcePairsKernel {
         }
         const auto t = static_cast<std::uint32_t>(object_tet_begin[oa] + i);
         const auto u = static_cast<std::uint32_t>(object_tet_begin[ob] + j);
-        if (tets_collide(scene, test, t, u)) out.push(pair_key(t, u));
+        if (tets_collide_tested(scene, test, t, u)) out.push(pair_key(t, u));
     }
 };
 
-/// @brief Stage 5: decides each candidate once (candidate_collides) and flags colliding tets.
+/// @brief Stage 5: decides each candidate once and flags colliding tets. The grid methods decide with
+/// candidate_collides (their tets have face planes); brute force, whose pairs come tested, with the
+/// test alone.
 struct NarrowPhaseKernel {
     SceneView scene;
     NarrowPhase test;
+    bool pretest;
     const std::uint64_t* keys;
     std::uint32_t* hit;
     std::uint32_t* colliding;
 
     KDET_HD void operator()(std::uint64_t k) const {
         const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
-        const bool collides = candidate_collides(scene, test, t, u);
+        const bool collides = pretest ? candidate_collides(scene, test, t, u) : test_pair(scene, test, t, u);
         hit[k] = collides ? 1u : 0u;
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);

@@ -396,7 +396,6 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
         exec_.upload(block_objects_.data(), block_objects.data(), block_objects.size());
     }
     if (candidates_.size() == 0) candidates_.resize_discard(4096);
-    exec_.for_each(tets_.size(), TetPlanesKernel{scene_view()});
     append_candidates_growing(
         [&](const KeyAppender& out) {
             if (options_.method == Method::brute_force_pairs)
@@ -418,8 +417,9 @@ template <class Exec>
 std::size_t Pipeline<Exec>::narrow_phase(std::size_t candidates) {
     hit_.resize_discard(candidates);
     position_.resize_discard(candidates);
-    exec_.for_each(candidates, NarrowPhaseKernel{scene_view(), options_.narrow_phase, candidates_.data(), hit_.data(),
-                                                 colliding_.data()});
+    const bool grid_method = options_.method == Method::kdet || options_.method == Method::kdet_no_pairs;
+    exec_.for_each(candidates, NarrowPhaseKernel{scene_view(), options_.narrow_phase, grid_method, candidates_.data(),
+                                                 hit_.data(), colliding_.data()});
     const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), candidates);
     out_keys_.resize_discard(colliding);
     exec_.for_each(candidates, CompactKernel{candidates_.data(), hit_.data(), position_.data(), out_keys_.data()});
