@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #if defined(KDET_HAS_CUDA)
 #include <cuda_runtime.h>
 #endif
@@ -128,6 +130,48 @@ TEST_F(CudaBackend, DevicePositionsAndDeviceResultsNeverPassThroughTheHost) {
         EXPECT_EQ(keys[k], (std::uint64_t{detector.first_tet(p.object_a) + p.tet_a} << 32) |
                                (detector.first_tet(p.object_b) + p.tet_b));
     }
+}
+#endif
+
+#if defined(KDET_HAS_CUDA)
+TEST_F(CudaBackend, AFrameOnTheCallersStreamReadsPositionsWrittenBeforeItOnThatStream) {
+    const TetMesh a = test::random_soup(4000, 5.0, 2.0, 31), b = test::random_soup(4000, 5.0, 2.0, 32);
+    const TetMesh b_moved = test::moved(b, 0.5, -0.3, 0.2, 0.0);
+    cudaStream_t stream = nullptr;
+    ASSERT_EQ(cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking), cudaSuccess);
+    DetectorOptions o;
+    o.backend = Backend::cuda;
+    o.cuda_stream = stream;
+    o.contacts = true;
+    Detector detector(o);
+    const ObjectId ia = detector.add_object(a), ib = detector.add_object(b);
+    detector.set_self_collision(ia, true);
+    detector.detect();
+
+    // The caller's simulation writes the new positions on its stream and hands them over at once.
+    const std::vector<float> xyz(b_moved.positions.begin(), b_moved.positions.end());
+    float* pinned = nullptr;
+    float* device_xyz = nullptr;
+    ASSERT_EQ(cudaMallocHost(reinterpret_cast<void**>(&pinned), xyz.size() * sizeof(float)), cudaSuccess);
+    ASSERT_EQ(cudaMalloc(reinterpret_cast<void**>(&device_xyz), xyz.size() * sizeof(float)), cudaSuccess);
+    std::copy(xyz.begin(), xyz.end(), pinned);
+    ASSERT_EQ(cudaMemsetAsync(device_xyz, 0xff, xyz.size() * sizeof(float), stream), cudaSuccess); // NaN first
+    ASSERT_EQ(cudaMemcpyAsync(device_xyz, pinned, xyz.size() * sizeof(float), cudaMemcpyHostToDevice, stream),
+              cudaSuccess);
+    detector.set_positions_on_device(ib, device_xyz, b.num_vertices());
+    const FrameResult& got = detector.detect();
+
+    Detector cpu;
+    cpu.set_self_collision(cpu.add_object(a), true);
+    cpu.add_object(b_moved);
+    const FrameResult& expected = cpu.detect();
+    ASSERT_GT(expected.pairs.size(), 10u);
+    EXPECT_EQ(got.pairs, expected.pairs);
+    EXPECT_EQ(got.colliding, expected.colliding);
+    ASSERT_EQ(got.contacts.size(), expected.contacts.size());
+    cudaFree(device_xyz);
+    cudaFreeHost(pinned);
+    cudaStreamDestroy(stream);
 }
 #endif
 

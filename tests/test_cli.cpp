@@ -77,7 +77,7 @@ TEST(Cli, SelfCollisionJsonHasCountsTimesAndMemory) {
     EXPECT_EQ(line_count(r.out), 1u) << r.out;
     for (const char* key : {"\"candidates\": ", "\"unique_candidates\": ", "\"colliding_pairs\": 0",
                             "\"times_ms\": {\"bounding_boxes\": ", "\"narrow_phase\": ", "\"total_ms\": ",
-                            "\"memory_bytes\": "})
+                            "\"memory_bytes\": ", "\"host_waits\": "})
         EXPECT_NE(r.out.find(key), std::string::npos) << key << " missing in " << r.out;
 }
 

@@ -15,6 +15,30 @@ namespace {
 
 std::vector<float> as_float(const TetMesh& m) { return std::vector<float>(m.positions.begin(), m.positions.end()); }
 
+void expect_rejected(const DetectorOptions& options, const std::string& naming) {
+    try {
+        Detector detector(options);
+        FAIL() << "expected kdet::Error naming " << naming;
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(naming), std::string::npos) << e.what();
+    }
+}
+
+TEST(DetectorOptions, InvalidSettingsAreRejectedByName) {
+    DetectorOptions o;
+    o.block_size = 0;
+    expect_rejected(o, "block size");
+    o.block_size = 2048;
+    expect_rejected(o, "block size");
+    o = DetectorOptions{};
+    o.bucket_capacity = 0;
+    expect_rejected(o, "bucket capacity");
+    o = DetectorOptions{};
+    int not_a_stream = 0;
+    o.cuda_stream = &not_a_stream; // never used as a stream: the CPU backend rejects any
+    expect_rejected(o, "cuda_stream");
+}
+
 TEST(DeviceApi, ResultsLeftInBackendMemoryEqualTheHostResults) {
     const TetMesh a = test::random_soup(1500, 4.0, 2.0, 91), b = test::random_soup(1500, 4.0, 2.0, 92);
     DetectorOptions host_options, device_options;

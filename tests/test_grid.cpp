@@ -141,7 +141,9 @@ struct TestTable {
 
 TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
     TestTable table(64, 4, 4096, 32, HashFunction::fnv1a);
-    const CpuExec exec(2, 128);
+    DetectorOptions two_threads;
+    two_threads.threads = 2;
+    const CpuExec exec(two_threads);
     const std::uint32_t ids = 5000, cells = 7;
     exec.for_each(ids, [&](std::uint64_t i) {
         grid_insert(table.view, CellCoord{static_cast<std::uint32_t>(i % cells), 1, 2, 0}, static_cast<std::uint32_t>(i));

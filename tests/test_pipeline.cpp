@@ -239,6 +239,33 @@ TEST(Detector, SeparatedObjectsSkipEverythingAfterTheBoxCheck) {
     EXPECT_EQ(r.times.populate_grid, 0.0);
 }
 
+TEST(Detector, CountsTheTimesTheHostWaitsForTheBackend) {
+    const TetMesh a = random_soup(2000, 3.0, 1.0, 57);
+    for (bool to_host : {true, false}) {
+        DetectorOptions o;
+        o.results_to_host = to_host;
+        Detector detector(o);
+        detector.set_self_collision(detector.add_object(a), true);
+        const ObjectId b = detector.add_object(moved(a, 0.3, 0.2, 0.0, 0.0));
+        const FrameResult& first = detector.detect();
+        ASSERT_GT(first.counts.colliding_pairs, 0u);
+        const std::uint32_t first_frame = first.counts.host_waits, regrows = first.counts.buffer_regrows;
+        const std::uint32_t colliding_frame = detector.detect().counts.host_waits;
+        // Bounds on today's count, so that a change adding a wait to the frame fails here.
+        EXPECT_LE(colliding_frame, to_host ? 10u : 8u);
+        // Each regrow reruns a stage and reads its counters again; once grown, every frame waits as often.
+        EXPECT_EQ(first_frame, colliding_frame + regrows);
+        const std::size_t grown_bytes = detector.memory_bytes();
+        EXPECT_EQ(detector.detect().counts.host_waits, colliding_frame);
+        EXPECT_EQ(detector.memory_bytes(), grown_bytes); // nothing allocated once grown
+        // Objects apart, self-collision off: only the object boxes are read.
+        const TetMesh far = moved(a, 0.0, 50.0, 0.0, 0.0);
+        detector.set_self_collision(0, false);
+        detector.set_positions(b, far.positions.data(), far.num_vertices());
+        EXPECT_EQ(detector.detect().counts.host_waits, 1u);
+    }
+}
+
 TEST(Detector, FlagsClearWhenObjectsSeparateAfterColliding) {
     const TetMesh a = random_soup(500, 1.0, 1.0, 53);
     const TetMesh near = moved(a, 0.3, 0.05, 0.0, 0.0), far = moved(a, 0.3, 5.0, 0.0, 0.0);

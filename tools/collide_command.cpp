@@ -143,7 +143,8 @@ int run_collide(int argc, char** argv) {
                   << to_string(options.hash) << "\", \"backend\": \"" << to_string(options.backend)
                   << "\", \"candidates\": " << c.candidates << ", \"unique_candidates\": " << c.unique_candidates
                   << ", \"colliding_pairs\": " << c.colliding_pairs << ", \"colliding_tets\": " << c.colliding_tets
-                  << ", \"buffer_regrows\": " << c.buffer_regrows << ", \"times_ms\": {\"bounding_boxes\": "
+                  << ", \"buffer_regrows\": " << c.buffer_regrows << ", \"host_waits\": " << c.host_waits
+                  << ", \"times_ms\": {\"bounding_boxes\": "
                   << json_number(t.bounding_boxes) << ", \"populate_grid\": " << json_number(t.populate_grid)
                   << ", \"find_candidates\": " << json_number(t.find_candidates)
                   << ", \"sort_unique\": " << json_number(t.sort_unique)

@@ -82,6 +82,10 @@ struct DetectorOptions {
     std::size_t initial_candidate_capacity = 0;
     /// Return depth and direction per colliding pair (computed with the 44-axis SAT).
     bool contacts = false;
+    /// CUDA backend: the stream (a cudaStream_t) every kernel, copy and sort of the detector runs on,
+    /// so positions that the caller's kernels write on that stream are read after them. Null: the
+    /// default stream. Must stay null on the CPU backend.
+    void* cuda_stream = nullptr;
     /// Copy pairs, flags and contacts into FrameResult. Off: they stay in the backend's memory
     /// (Detector::device_results()) and FrameResult carries counts, times and memory only.
     bool results_to_host = true;

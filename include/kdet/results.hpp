@@ -47,7 +47,7 @@ struct StageTimes {
     double find_candidates = 0; ///< for kdet_no_pairs this includes its inline narrow phase
     double sort_unique = 0;     ///< sorting the colliding pairs into the output order (candidates are unique as found)
     double narrow_phase = 0;    ///< includes compacting the colliding pairs, contacts and copying them out
-    double total = 0;           ///< the whole detect() call, results copied out included
+    double total = 0;           ///< the whole detect() call, positions copied in and results copied out included
 };
 
 /// @brief Sizes of one detection.
@@ -60,6 +60,9 @@ struct FrameCounts {
     std::uint64_t grid_cells = 0;        ///< occupied grid cells (main buckets claimed)
     std::uint64_t grid_slots = 0;        ///< main buckets of the hash table
     std::uint64_t grid_overflow_buckets = 0; ///< overflow buckets chained this frame
+    /// Times the host waited for the backend (reads of counters and results); on the GPU each is a
+    /// stream synchronisation. Counted identically on the CPU backend.
+    std::uint32_t host_waits = 0;
 };
 
 /// @brief Result of one detection. For Method::kdet_no_pairs, `pairs` stays empty and only the

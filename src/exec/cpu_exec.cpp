@@ -9,7 +9,8 @@
 
 namespace kdet {
 
-CpuExec::CpuExec(int threads, int /*block_size*/) : threads_(threads > 0 ? threads : omp_get_max_threads()) {}
+CpuExec::CpuExec(const DetectorOptions& options)
+    : threads_(options.threads > 0 ? options.threads : omp_get_max_threads()) {}
 
 void CpuExec::sort(std::uint64_t* keys, std::size_t n) const {
     if (n > 1 << 14 && threads_ > 1)
@@ -19,6 +20,8 @@ void CpuExec::sort(std::uint64_t* keys, std::size_t n) const {
 }
 
 std::uint64_t CpuExec::exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
+    if (n == 0) return 0;
+    ++host_waits_;
     // Two passes over per-thread blocks: block sums, then each block scans from its offset.
     const int blocks = std::max(1, std::min<int>(threads_, static_cast<int>(n / 4096)));
     std::vector<std::uint64_t> block_sum(static_cast<std::size_t>(blocks) + 1, 0);

@@ -2,6 +2,8 @@
 /// @file cpu_exec.hpp
 /// @brief The CPU execution layer: OpenMP loops over the same per-element functors the CUDA layer launches.
 
+#include <kdet/options.hpp>
+
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -37,26 +39,39 @@ private:
     std::size_t capacity_ = 0;
 };
 
-/// @brief Times one stage in milliseconds of wall-clock time.
-class CpuStageTimer {
+/// @brief Stage times in milliseconds of wall-clock time, from marks set as the frame runs
+/// (the CPU twin of CudaStageClock).
+class CpuStageClock {
 public:
-    void start() { begin_ = std::chrono::steady_clock::now(); }
-    double stop_ms() {
-        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin_).count();
+    static constexpr int mark_count = 8;
+
+    void begin_frame() { recorded_ = 0; }
+    void mark(int k) {
+        marks_[k] = std::chrono::steady_clock::now();
+        recorded_ |= 1u << k;
+    }
+    void wait(int) const {}
+    /// @brief Milliseconds from mark `from` to mark `to`, 0 when either was not recorded this frame.
+    double between_ms(int from, int to) const {
+        if (!(recorded_ >> from & 1u) || !(recorded_ >> to & 1u)) return 0;
+        return std::chrono::duration<double, std::milli>(marks_[to] - marks_[from]).count();
     }
 
 private:
-    std::chrono::steady_clock::time_point begin_{};
+    std::chrono::steady_clock::time_point marks_[mark_count]{};
+    unsigned recorded_ = 0;
 };
 
 class CpuExec {
 public:
     template <class T>
     using buffer = HostBuffer<T>;
-    using stage_timer = CpuStageTimer;
+    using stage_clock = CpuStageClock;
 
-    /// @brief threads = 0 keeps OpenMP's default; block_size only matters on the GPU.
-    CpuExec(int threads, int block_size);
+    /// @brief options.threads = 0 keeps OpenMP's default; the block size and stream only matter on the GPU.
+    explicit CpuExec(const DetectorOptions& options);
+
+    stage_clock make_stage_clock() const { return stage_clock(); }
 
     /// @brief Runs f(i) for every i in [0, n) on all threads.
     template <class F>
@@ -76,16 +91,22 @@ public:
     void upload(T* device, const T* host, std::size_t n) const {
         if (n) std::memcpy(device, host, n * sizeof(T));
     }
+    /// @brief Copies out of the backend's memory. Like exclusive_scan, whose result
+    /// the host reads, it is a point where the GPU backend waits for the device: counted here too, so
+    /// both backends report the same number of host waits.
     template <class T>
     void download(T* host, const T* device, std::size_t n) const {
-        if (n) std::memcpy(host, device, n * sizeof(T));
+        if (!n) return;
+        ++host_waits_;
+        std::memcpy(host, device, n * sizeof(T));
     }
     /// @brief Copies within the backend's memory.
     template <class T>
     void copy(T* destination, const T* source, std::size_t n) const {
         if (n) std::memmove(destination, source, n * sizeof(T));
     }
-    void synchronize() const {}
+    /// @brief Times the host has waited for the backend so far: once per download, scan and sort.
+    std::uint64_t host_waits() const { return host_waits_; }
 
     /// @brief Bytes of scratch memory the layer keeps (none on the CPU).
     std::size_t scratch_bytes() const { return 0; }
@@ -95,6 +116,7 @@ public:
 
 private:
     int threads_;
+    mutable std::uint64_t host_waits_ = 0;
 };
 
 } // namespace kdet

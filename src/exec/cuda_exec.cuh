@@ -2,8 +2,11 @@
 /// @file cuda_exec.cuh
 /// @brief The CUDA execution layer: launches the same per-element functors as CpuExec, with CUB for
 /// sorting, unique and scans, and CUDA events for stage times. Plain device allocations, kept and grown.
+/// Every launch, copy and CUB call goes to the stream of DetectorOptions::cuda_stream (the default
+/// stream when none is given), so a frame runs in order after the caller's own work on that stream.
 
 #include <kdet/error.hpp>
+#include <kdet/options.hpp>
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
@@ -11,6 +14,7 @@
 #include <cuda_runtime.h>
 
 #include <cstdint>
+#include <cstring>
 #include <string>
 
 namespace kdet {
@@ -54,30 +58,68 @@ private:
     std::size_t capacity_ = 0;
 };
 
-/// @brief Times one stage on the GPU with a pair of events.
-class CudaStageTimer {
+/// @brief Page-locked host memory, kept and grown: copies from the device land here without the
+/// driver's extra staging copy, and a buffer that has grown allocates nothing in later frames.
+class PinnedBuffer {
 public:
-    CudaStageTimer() {
-        cuda_check(cudaEventCreate(&begin_), "cudaEventCreate");
-        cuda_check(cudaEventCreate(&end_), "cudaEventCreate");
+    PinnedBuffer() = default;
+    PinnedBuffer(const PinnedBuffer&) = delete;
+    PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+    ~PinnedBuffer() { cudaFreeHost(data_); }
+
+    /// @brief At least `bytes` of pinned memory; the old contents are not kept.
+    unsigned char* reserve(std::size_t bytes) {
+        if (bytes > capacity_) {
+            unsigned char* old = data_;
+            data_ = nullptr;
+            capacity_ = 0;
+            cuda_check(cudaFreeHost(old), "cudaFreeHost");
+            cuda_check(cudaMallocHost(reinterpret_cast<void**>(&data_), bytes), "cudaMallocHost");
+            capacity_ = bytes;
+        }
+        return data_;
     }
-    ~CudaStageTimer() {
-        cudaEventDestroy(begin_);
-        cudaEventDestroy(end_);
+    std::size_t capacity_bytes() const { return capacity_; }
+
+private:
+    unsigned char* data_ = nullptr;
+    std::size_t capacity_ = 0;
+};
+
+/// @brief Stage times from events recorded on the stream as the frame is enqueued. Recording costs
+/// no synchronisation; the times are read once, when the frame's last mark has completed.
+class CudaStageClock {
+public:
+    static constexpr int mark_count = 8;
+
+    explicit CudaStageClock(cudaStream_t stream) : stream_(stream) {
+        for (cudaEvent_t& e : events_) cuda_check(cudaEventCreate(&e), "cudaEventCreate");
     }
-    CudaStageTimer(const CudaStageTimer&) = delete;
-    CudaStageTimer& operator=(const CudaStageTimer&) = delete;
-    void start() { cuda_check(cudaEventRecord(begin_), "cudaEventRecord"); }
-    double stop_ms() {
-        cuda_check(cudaEventRecord(end_), "cudaEventRecord");
-        cuda_check(cudaEventSynchronize(end_), "cudaEventSynchronize");
+    ~CudaStageClock() {
+        for (cudaEvent_t e : events_) cudaEventDestroy(e);
+    }
+    CudaStageClock(const CudaStageClock&) = delete;
+    CudaStageClock& operator=(const CudaStageClock&) = delete;
+
+    void begin_frame() { recorded_ = 0; }
+    void mark(int k) {
+        cuda_check(cudaEventRecord(events_[k], stream_), "cudaEventRecord");
+        recorded_ |= 1u << k;
+    }
+    /// @brief Waits for mark k (a host synchronisation when the stream is still busy).
+    void wait(int k) { cuda_check(cudaEventSynchronize(events_[k]), "cudaEventSynchronize"); }
+    /// @brief Milliseconds from mark `from` to mark `to`, 0 when either was not recorded this frame.
+    double between_ms(int from, int to) const {
+        if (!(recorded_ >> from & 1u) || !(recorded_ >> to & 1u)) return 0;
         float ms = 0;
-        cuda_check(cudaEventElapsedTime(&ms, begin_, end_), "cudaEventElapsedTime");
+        cuda_check(cudaEventElapsedTime(&ms, events_[from], events_[to]), "cudaEventElapsedTime");
         return ms;
     }
 
 private:
-    cudaEvent_t begin_{}, end_{};
+    cudaStream_t stream_;
+    cudaEvent_t events_[mark_count]{};
+    unsigned recorded_ = 0;
 };
 
 template <class F>
@@ -90,13 +132,16 @@ class CudaExec {
 public:
     template <class T>
     using buffer = DeviceBuffer<T>;
-    using stage_timer = CudaStageTimer;
+    using stage_clock = CudaStageClock;
 
-    CudaExec(int /*threads*/, int block_size) : block_size_(block_size) {
+    explicit CudaExec(const DetectorOptions& options)
+        : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
         int devices = 0;
         if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0)
             throw Error("backend 'cuda' needs a CUDA device, and none is available");
     }
+
+    stage_clock make_stage_clock() const { return stage_clock(stream_); }
 
     template <class F>
     void for_each(std::uint64_t n, const F& f) const {
@@ -104,7 +149,7 @@ public:
         const int block = launchable_block_size<F>();
         const std::uint64_t wanted = (n + block - 1) / block;
         const auto blocks = static_cast<unsigned>(wanted < (1u << 30) ? wanted : (1u << 30));
-        for_each_kernel<<<blocks, block>>>(n, f);
+        for_each_kernel<<<blocks, block, 0, stream_>>>(n, f);
         cuda_check(cudaGetLastError(), "kernel launch");
     }
 
@@ -125,38 +170,52 @@ public:
         if (n < 2) return;
         sorted_.resize_discard(n);
         std::size_t bytes = 0;
-        cub::DeviceRadixSort::SortKeys(nullptr, bytes, keys, sorted_.data(), n);
+        cub::DeviceRadixSort::SortKeys(nullptr, bytes, keys, sorted_.data(), n, 0, 64, stream_);
         temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, keys, sorted_.data(), n), "radix sort");
+        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, keys, sorted_.data(), n, 0, 64, stream_),
+                   "radix sort");
         copy(keys, sorted_.data(), n);
     }
 
     std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
         if (n == 0) return 0;
-        std::uint32_t last = 0, last_offset = 0;
-        download(&last, in + n - 1, 1);
         std::size_t bytes = 0;
-        cub::DeviceScan::ExclusiveSum(nullptr, bytes, in, out, n);
+        cub::DeviceScan::ExclusiveSum(nullptr, bytes, in, out, n, stream_);
         temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, in, out, n), "exclusive scan");
-        download(&last_offset, out + n - 1, 1);
-        return std::uint64_t{last_offset} + last;
+        cuda_check(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, in, out, n, stream_), "exclusive scan");
+        // The total is the last offset plus the last input: both read back with one wait.
+        auto* last = reinterpret_cast<std::uint32_t*>(staging_.reserve(2 * sizeof(std::uint32_t)));
+        cuda_check(cudaMemcpyAsync(last, in + n - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost, stream_), "download");
+        cuda_check(cudaMemcpyAsync(last + 1, out + n - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost, stream_),
+                   "download");
+        wait_for_stream();
+        return std::uint64_t{last[0]} + last[1];
     }
 
+    /// @brief Enqueues a copy from the library's own pageable host memory, which the driver stages
+    /// before returning: the source may be reused at once.
     template <class T>
     void upload(T* device, const T* host, std::size_t n) const {
-        if (n) cuda_check(cudaMemcpy(device, host, n * sizeof(T), cudaMemcpyHostToDevice), "upload");
+        if (n) cuda_check(cudaMemcpyAsync(device, host, n * sizeof(T), cudaMemcpyHostToDevice, stream_), "upload");
     }
+    /// @brief Copies to the host through pinned memory; waits for the stream (a host synchronisation).
     template <class T>
     void download(T* host, const T* device, std::size_t n) const {
-        if (n) cuda_check(cudaMemcpy(host, device, n * sizeof(T), cudaMemcpyDeviceToHost), "download");
+        if (!n) return;
+        unsigned char* staging = staging_.reserve(n * sizeof(T));
+        cuda_check(cudaMemcpyAsync(staging, device, n * sizeof(T), cudaMemcpyDeviceToHost, stream_), "download");
+        wait_for_stream();
+        std::memcpy(static_cast<void*>(host), staging, n * sizeof(T));
     }
     /// @brief Copies within device memory.
     template <class T>
     void copy(T* destination, const T* source, std::size_t n) const {
-        if (n) cuda_check(cudaMemcpy(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice), "device copy");
+        if (n)
+            cuda_check(cudaMemcpyAsync(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice, stream_),
+                       "device copy");
     }
-    void synchronize() const { cuda_check(cudaDeviceSynchronize(), "synchronize"); }
+    /// @brief Times the host has waited for the device so far: once per download, scan and sort.
+    std::uint64_t host_waits() const { return host_waits_; }
 
     std::string device_name() const {
         int device = 0;
@@ -166,13 +225,21 @@ public:
         return properties.name;
     }
 
-    /// @brief Bytes of the scratch buffers CUB needs, for memory reports.
+    /// @brief Bytes of the scratch buffers CUB needs, for memory reports (device memory only).
     std::size_t scratch_bytes() const {
         return temp_.capacity_bytes() + sorted_.capacity_bytes();
     }
 
 private:
+    void wait_for_stream() const {
+        ++host_waits_;
+        cuda_check(cudaStreamSynchronize(stream_), "synchronize");
+    }
+
     int block_size_;
+    cudaStream_t stream_;
+    mutable PinnedBuffer staging_;
+    mutable std::uint64_t host_waits_ = 0;
     mutable DeviceBuffer<unsigned char> temp_;
     mutable DeviceBuffer<std::uint64_t> sorted_;
 };

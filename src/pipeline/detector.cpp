@@ -123,6 +123,9 @@ Detector::Detector(const DetectorOptions& options) : impl_(std::make_unique<Impl
     if (options.block_size < 1 || options.block_size > 1024)
         throw Error("block size " + std::to_string(options.block_size) + " out of range [1, 1024]");
     if (options.bucket_capacity < 1) throw Error("bucket capacity must be at least 1");
+    if (options.cuda_stream && options.backend != Backend::cuda)
+        throw Error("option cuda_stream is set, but the backend is '" + std::string(to_string(options.backend)) +
+                    "': a CUDA stream needs backend 'cuda'");
     impl_->pipeline = options.backend == Backend::cuda ? make_cuda_pipeline(options) : make_cpu_pipeline(options);
 }
 
@@ -181,17 +184,18 @@ void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
 const FrameResult& Detector::detect() {
     Impl& d = *impl_;
     if (d.topology_changed) d.rebuild_pipeline();
-    for (std::size_t o = 0; o < d.objects(); ++o) {
-        if (!d.positions_dirty[o]) continue;
-        const std::uint32_t first = d.object_vertex_begin[o];
-        d.pipeline->set_positions(first, d.positions.data() + first, d.object_vertex_begin[o + 1] - first);
-        d.positions_dirty[o] = 0;
-    }
     if (d.objects() == 0) {
         d.result = FrameResult{};
         return d.result;
     }
-    d.pipeline->detect(d.pair_enabled, d.result);
+    std::vector<PositionUpload> uploads;
+    for (std::size_t o = 0; o < d.objects(); ++o)
+        if (d.positions_dirty[o]) {
+            const std::uint32_t first = d.object_vertex_begin[o];
+            uploads.push_back({first, d.positions.data() + first, d.object_vertex_begin[o + 1] - first});
+        }
+    d.pipeline->detect(uploads, d.pair_enabled, d.result);
+    std::fill(d.positions_dirty.begin(), d.positions_dirty.end(), 0);
     return d.result;
 }
 

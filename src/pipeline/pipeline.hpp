@@ -35,7 +35,7 @@ class Pipeline final : public PipelineBase {
 
 public:
     explicit Pipeline(const DetectorOptions& options)
-        : exec_(options.threads, options.block_size), options_(options) {}
+        : exec_(options), clock_(exec_.make_stage_clock()), options_(options) {}
 
     void set_topology(const SceneTopology& topology) override {
         topology_ = topology;
@@ -62,10 +62,6 @@ public:
         bounds_.resize_discard(objects);
         object_boxes_.resize_discard(objects);
         pair_active_.resize_discard(objects * objects);
-    }
-
-    void set_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
-        exec_.upload(positions_.data() + first, positions, count);
     }
 
     void set_positions_on_device(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
@@ -98,7 +94,8 @@ public:
 
     std::string device_name() const override { return exec_.device_name(); }
 
-    void detect(const std::vector<std::uint8_t>& pair_enabled, FrameResult& result) override;
+    void detect(const std::vector<PositionUpload>& uploads, const std::vector<std::uint8_t>& pair_enabled,
+                FrameResult& result) override;
 
 private:
     SceneView scene_view() {
@@ -137,9 +134,11 @@ private:
     }
     void ensure_candidate_capacity(std::size_t relevant_tets);
 
+    /// Marks between the stages of a frame, for StageTimes.
+    enum StageMark { frame_start, boxes_done, grid_done, candidates_done, narrow_phase_done, sorted, results_done, frame_end };
+
     Exec exec_;
-    // Kept between frames: on the GPU each holds two CUDA events, created once.
-    typename Exec::stage_timer total_timer_, stage_timer_;
+    typename Exec::stage_clock clock_; // kept between frames: on the GPU it holds CUDA events, created once
     DetectorOptions options_;
     SceneTopology topology_;
     GridParams params_{};
@@ -486,10 +485,12 @@ void Pipeline<Exec>::count_and_copy_flags(bool any, FrameResult& result) {
 }
 
 template <class Exec>
-void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, FrameResult& result) {
-    auto& total = total_timer_;
-    auto& stage = stage_timer_;
-    total.start();
+void Pipeline<Exec>::detect(const std::vector<PositionUpload>& uploads, const std::vector<std::uint8_t>& pair_enabled,
+                            FrameResult& result) {
+    const std::uint64_t waits_before = exec_.host_waits();
+    clock_.begin_frame();
+    clock_.mark(frame_start);
+    for (const PositionUpload& u : uploads) exec_.upload(positions_.data() + u.first, u.positions, u.count);
     result.pairs.clear();
     result.contacts.clear();
     result.counts = FrameCounts{};
@@ -497,20 +498,17 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
     FrameCounts& counts = result.counts;
     colliding_count_ = 0;
 
-    stage.start();
     const Method method = options_.method;
     const bool grid_method = method == Method::kdet || method == Method::kdet_no_pairs;
     const bool any =
         tets_.size() > 0 && compute_bounds_and_culling(pair_enabled) && (!grid_method || size_relevant_tets());
     if (any) fill(colliding_, 0u);
-    result.times.bounding_boxes = stage.stop_ms();
+    clock_.mark(boxes_done);
 
     if (any) {
         if (grid_method) {
-            stage.start();
             const GridView grid = populate(counts);
-            result.times.populate_grid = stage.stop_ms();
-            stage.start();
+            clock_.mark(grid_done);
             if (method == Method::kdet) {
                 find_candidates(grid, counts);
             } else {
@@ -520,23 +518,18 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
                                                            &counters_.data()->tests_run});
                 counts.candidates = counts.unique_candidates = read_counters().tests_run;
             }
-            result.times.find_candidates = stage.stop_ms();
         } else {
-            stage.start();
             brute_force(counts);
-            result.times.find_candidates = stage.stop_ms();
         }
+        clock_.mark(candidates_done);
         if (method != Method::kdet_no_pairs) {
             if (!grid_method) counts.unique_candidates = counts.candidates;
-            stage.start();
             const std::size_t colliding = narrow_phase(counts.unique_candidates);
-            result.times.narrow_phase = stage.stop_ms();
-            stage.start();
+            clock_.mark(narrow_phase_done);
             exec_.sort(out_keys_.data(), colliding); // the deterministic output order
-            result.times.sort_unique = stage.stop_ms();
-            stage.start();
+            clock_.mark(sorted);
             contacts_and_pairs(colliding, result);
-            result.times.narrow_phase += stage.stop_ms();
+            clock_.mark(results_done);
         }
     }
 
@@ -544,7 +537,16 @@ void Pipeline<Exec>::detect(const std::vector<std::uint8_t>& pair_enabled, Frame
     result.memory_bytes = memory_bytes();
     result.grid_bytes = headers_.capacity_bytes() + ids_.capacity_bytes();
     result.candidate_bytes = candidates_.capacity_bytes();
-    result.times.total = total.stop_ms();
+    clock_.mark(frame_end);
+    clock_.wait(frame_end);
+    StageTimes& t = result.times;
+    t.bounding_boxes = clock_.between_ms(frame_start, boxes_done);
+    t.populate_grid = clock_.between_ms(boxes_done, grid_done);
+    t.find_candidates = clock_.between_ms(grid_method ? grid_done : boxes_done, candidates_done);
+    t.sort_unique = clock_.between_ms(narrow_phase_done, sorted);
+    t.narrow_phase = clock_.between_ms(candidates_done, narrow_phase_done) + clock_.between_ms(sorted, results_done);
+    t.total = clock_.between_ms(frame_start, frame_end);
+    counts.host_waits = static_cast<std::uint32_t>(exec_.host_waits() - waits_before);
 }
 
 } // namespace kdet

@@ -23,19 +23,26 @@ struct SceneTopology {
     std::uint32_t vertex_count = 0;
 };
 
+/// @brief Positions of `count` vertices from global vertex `first` on, copied in at the start of a frame.
+struct PositionUpload {
+    std::uint32_t first;
+    const vec3* positions;
+    std::uint32_t count;
+};
+
 class PipelineBase {
 public:
     virtual ~PipelineBase() = default;
     /// @brief Replaces all geometry; positions must be set again afterwards.
     virtual void set_topology(const SceneTopology& topology) = 0;
-    /// @brief Copies `count` positions starting at global vertex `first`.
-    virtual void set_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
     /// @brief Copies `count` positions already in the backend's memory; throws Error on a non-finite value.
     virtual void set_positions_on_device(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
     /// @brief Copies `count` positions starting at global vertex `first` back to the host.
     virtual void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count) = 0;
-    /// @brief One detection; pair_enabled is [objects * objects], symmetric, diagonal = self-collision.
-    virtual void detect(const std::vector<std::uint8_t>& pair_enabled, FrameResult& result) = 0;
+    /// @brief One detection, after copying in the positions that changed on the host (counted in
+    /// its total time); pair_enabled is [objects * objects], symmetric, diagonal = self-collision.
+    virtual void detect(const std::vector<PositionUpload>& uploads, const std::vector<std::uint8_t>& pair_enabled,
+                        FrameResult& result) = 0;
     virtual DeviceResults device_results() = 0;
     virtual std::size_t memory_bytes() const = 0;
     virtual std::string device_name() const = 0;

@@ -266,6 +266,7 @@ void Viewer::panel_results() {
                                                                                    : std::to_string(c.colliding_pairs));
         row("colliding tets", c.colliding_tets);
         row("buffer regrows", c.buffer_regrows);
+        row("host waits", c.host_waits);
         row_ms("boxes", t.bounding_boxes);
         row_ms("populate grid", t.populate_grid);
         row_ms("candidates", t.find_candidates);
