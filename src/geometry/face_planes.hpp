@@ -22,7 +22,8 @@
 ///   (1.3e-4 L / l + 3.1e-5), which moves a gap by 5.8e-4 L^2 / l + 1.4e-4 L at most.
 /// - The float tests' tolerance: a separation needs a gap above 32 eps L (3.8e-6 L).
 /// A face's margin is k_plane_margin L^2 / l, k_plane_margin = 2^-9 (1.95e-3), more than 2.5 times
-/// the sum of the last three, so a pair the pre-test separates shows a gap above 1.2e-3 L^2 / l
+/// what the first, third and fourth add up to (7.3e-4 L^2 / l at most, as l <= L), so a pair the
+/// pre-test separates shows a gap above 1.2e-3 L^2 / l
 /// along a face axis that sat, sat_no_edges and sat_mtv compute and report as separating. A vertex
 /// found inside all four planes of a tet whose opposite vertices lie below their faces by the margin
 /// (`solid`) lies inside the true tet by more than 1.7e-3 L^2 / l, so the tets overlap by that much
