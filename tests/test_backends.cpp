@@ -34,6 +34,9 @@ void expect_backends_agree(const std::vector<TetMesh>& meshes, bool self, const 
     if (options.method == Method::kdet) {
         EXPECT_EQ(cuda.counts.unique_candidates, cpu.counts.unique_candidates);
     }
+    if (options.method != Method::kdet_no_pairs) { // kdet_no_pairs skips pairs in a racy order
+        EXPECT_EQ(cuda.counts.exact_stage_pairs, cpu.counts.exact_stage_pairs);
+    }
 }
 
 class CudaBackend : public ::testing::Test {
@@ -48,7 +51,7 @@ TEST_F(CudaBackend, EveryMethodTestAndHashMatchesTheCpuOnSoups) {
     const TetMesh a = test::random_soup(2000, 6.0, 3.0, 81), b = test::random_soup(2000, 6.0, 3.0, 82);
     for (Method method : {Method::kdet, Method::kdet_no_pairs, Method::brute_force_loop, Method::brute_force_pairs})
         for (NarrowPhase test : {NarrowPhase::sat, NarrowPhase::sat_no_edges, NarrowPhase::sat_mtv, NarrowPhase::gjk,
-                                 NarrowPhase::fast}) {
+                                 NarrowPhase::fast, NarrowPhase::exact}) {
             DetectorOptions o;
             o.method = method;
             o.narrow_phase = test;
@@ -73,6 +76,18 @@ TEST_F(CudaBackend, RealMeshesAndTinyBuffersMatchTheCpu) {
         o.bucket_capacity = 2;
         o.contacts = true;
         expect_backends_agree({mesh, test::moved(mesh, 0.3, 0.1 * e, 0.05 * e, 0.0)}, true, o);
+    }
+}
+
+/// A mesh against an exact copy of itself touches everywhere: most pairs take the exact test's exact
+/// stage, which then runs on the GPU.
+TEST_F(CudaBackend, ExactStageMatchesTheCpuOnTouchingCopies) {
+    const TetMesh mesh = test::load_model("octopus-low.mesh");
+    for (Method method : {Method::kdet, Method::kdet_no_pairs, Method::brute_force_loop, Method::brute_force_pairs}) {
+        DetectorOptions o;
+        o.method = method;
+        o.narrow_phase = NarrowPhase::exact;
+        expect_backends_agree({mesh, mesh}, true, o);
     }
 }
 

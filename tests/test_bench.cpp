@@ -72,7 +72,8 @@ TEST(BenchArgs, EveryAcceptedValue) {
                                                          {"sat_no_edges", NarrowPhase::sat_no_edges},
                                                          {"sat_mtv", NarrowPhase::sat_mtv},
                                                          {"gjk", NarrowPhase::gjk},
-                                                         {"fast", NarrowPhase::fast}};
+                                                         {"fast", NarrowPhase::fast},
+                                                         {"exact", NarrowPhase::exact}};
     for (const auto& [name, test] : tests) EXPECT_EQ(parse_words({"-o", name}).options.narrow_phase, test) << name;
     for (int g : {16, 32, 64, 128, 256}) EXPECT_EQ(parse_words({"-g", std::to_string(g)}).options.block_size, g);
     for (int n : {1, 7, 20}) EXPECT_EQ(parse_words({"-n", std::to_string(n)}).runs, n);
@@ -105,6 +106,7 @@ TEST(BenchArgs, HelpListsTheLibrarysNames) {
     for (const std::string& name : option_names<NarrowPhase>()) EXPECT_NE(help.find(name), std::string::npos) << name;
     for (const std::string& name : option_names<Method>()) EXPECT_NE(help.find(name), std::string::npos) << name;
     EXPECT_NE(help.find("gpu_no_loop = brute_force_pairs"), std::string::npos) << help;
+    EXPECT_NE(help.find("sat (default)"), std::string::npos) << help; // the thesis's test, not the library's
 }
 
 TEST(BenchArgs, ProceduralSceneSizeAndLength) {
@@ -125,7 +127,7 @@ TEST(BenchArgs, EveryMistakeIsOneLineNamingTheFlagAndWhatItAccepts) {
         {{"-r", "5"}, "invalid value '5' for -r: expected an integer in [1, 4]"},
         {{"-r", "two"}, "invalid value 'two' for -r"},
         {{"-c", "bvh"}, "invalid value 'bvh' for -c: expected kdet, kdet_no_pairs, brute_force_loop or brute_force_pairs"},
-        {{"-o", "sat.mtv"}, "invalid value 'sat.mtv' for -o: expected sat, sat_no_edges, sat_mtv, gjk or fast"},
+        {{"-o", "sat.mtv"}, "invalid value 'sat.mtv' for -o: expected sat, sat_no_edges, sat_mtv, gjk, fast or exact"},
         {{"-g", "100"}, "invalid value '100' for -g: expected 16, 32, 64, 128 or 256"},
         {{"-n", "0"}, "invalid value '0' for -n: expected an integer in [1, 20]"},
         {{"-n", "21"}, "invalid value '21' for -n: expected an integer in [1, 20]"},
@@ -165,6 +167,7 @@ FrameResult sample_result() {
     r.counts.colliding_pairs = 5;
     r.counts.colliding_tets = 4;
     r.counts.buffer_regrows = 1;
+    r.counts.exact_stage_pairs = 2;
     r.times = StageTimes{0.5, 1.0, 2.0, 3.0, 4.0, 11.0};
     r.memory_bytes = 1234;
     return r;
@@ -181,14 +184,15 @@ TEST(BenchCsv, ColumnsStartWithTheThesissEightThenStagesAndCounts) {
     const std::vector<std::string> expected = {
         "frame", "host time", "device time", "bbox time", "collision time", "col tets A to B", "col tets B to A",
         "collision pairs", "populate time", "find candidates time", "sort unique time", "narrow phase time",
-        "candidates", "unique candidates", "colliding tets", "buffer regrows", "memory bytes", "bbox overlap x"};
+        "candidates", "unique candidates", "colliding tets", "buffer regrows", "memory bytes", "bbox overlap x",
+        "exact stage pairs"};
     EXPECT_EQ(frame_columns(), expected);
 }
 
 TEST(BenchCsv, FrameRowTakesTimesCountsAndFlagsFromTheResult) {
     const FrameRow row = make_frame_row(7, 12.5, sample_result(), -0.25);
     // In frame_columns() order; collision time = populate + candidates + sort + narrow phase.
-    EXPECT_EQ(row, (FrameRow{7, 12.5, 11.0, 0.5, 10.0, 3, 1, 5, 1.0, 2.0, 3.0, 4.0, 40, 30, 4, 1, 1234, -0.25}));
+    EXPECT_EQ(row, (FrameRow{7, 12.5, 11.0, 0.5, 10.0, 3, 1, 5, 1.0, 2.0, 3.0, 4.0, 40, 30, 4, 1, 1234, -0.25, 2}));
 }
 
 TEST(BenchCsv, BoxOverlapAlongXIsNegativeForAGap) {

@@ -76,9 +76,23 @@ TEST(Cli, SelfCollisionJsonHasCountsTimesAndMemory) {
     ASSERT_EQ(r.exit_code, 0) << r.out;
     EXPECT_EQ(line_count(r.out), 1u) << r.out;
     for (const char* key : {"\"candidates\": ", "\"unique_candidates\": ", "\"colliding_pairs\": 0",
+                            "\"exact_stage_pairs\": 0",
                             "\"times_ms\": {\"bounding_boxes\": ", "\"narrow_phase\": ", "\"total_ms\": ",
                             "\"memory_bytes\": ", "\"host_waits\": "})
         EXPECT_NE(r.out.find(key), std::string::npos) << key << " missing in " << r.out;
+}
+
+TEST(Cli, ExactTestReportsThePairsThatReachedItsExactStage) {
+    test::use_default_data_dir();
+    const std::string mesh = data_path("octopus-low.mesh");
+    const Outcome json = kdet_cli("collide " + mesh + " " + mesh + " --test exact --json");
+    ASSERT_EQ(json.exit_code, 0) << json.out;
+    const std::string key = "\"exact_stage_pairs\": ";
+    const auto at = json.out.find(key);
+    ASSERT_NE(at, std::string::npos) << json.out;
+    EXPECT_GT(std::stoull(json.out.substr(at + key.size())), 0u) << json.out; // an exact copy touches everywhere
+    const Outcome text = kdet_cli("collide " + mesh + " " + mesh + " --test exact");
+    EXPECT_NE(text.out.find("exact stage       "), std::string::npos) << text.out;
 }
 
 TEST(Cli, ContactsFileHasDepthAndUnitDirectionPerPair) {

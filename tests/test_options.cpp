@@ -35,7 +35,7 @@ void expect_names_round_trip(std::size_t value_count) {
 TEST(Options, EveryNameReadsBackInAnyCaseAndWithEitherSeparator) {
     expect_names_round_trip<Backend>(2);
     expect_names_round_trip<Method>(4);
-    expect_names_round_trip<NarrowPhase>(5);
+    expect_names_round_trip<NarrowPhase>(6);
     expect_names_round_trip<HashFunction>(4);
 }
 

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <set>
+#include <string>
 
 namespace kdet {
 namespace {
@@ -115,7 +116,14 @@ TEST_P(RealMesh, UndeformedMeshHasNoSelfCollision) {
     EXPECT_LT(counts.unique_candidates, counts.candidates / 2);
 }
 
-INSTANTIATE_TEST_SUITE_P(Models, RealMesh, ::testing::Values("bunny.mesh", "hand.mesh", "octopus-low.mesh"));
+// Named after the model (Models/RealMesh.Test/bunny), so test filters can pick models by name.
+INSTANTIATE_TEST_SUITE_P(Models, RealMesh, ::testing::Values("bunny.mesh", "hand.mesh", "octopus-low.mesh"),
+                         [](const ::testing::TestParamInfo<const char*>& model) {
+                             std::string name = model.param;
+                             name = name.substr(0, name.find('.'));
+                             std::replace(name.begin(), name.end(), '-', '_');
+                             return name;
+                         });
 
 TEST(Pipeline, FoldedBarSelfCollidesLikeBruteForce) {
     const TetMesh bar = make_box_mesh(60, 4, 4, 0.1);

@@ -88,7 +88,7 @@ TEST(SpatialOrder, PairsFlagsAndContactsUseTheCallersNumbering) {
     for (std::uint32_t i = 0; i < ta.size(); ++i)
         for (std::uint32_t j = 0; j < tb.size(); ++j) {
             if (!boxes_overlap(tet_box(ta[i].data()), tet_box(tb[j].data())) ||
-                !tets_intersect(NarrowPhase::sat, ta[i].data(), tb[j].data()))
+                !tets_intersect(DetectorOptions{}.narrow_phase, ta[i].data(), tb[j].data()))
                 continue;
             expected.push_back(TetPair{0, i, 1, j});
             float depth = 0;

@@ -8,7 +8,7 @@ namespace kdet::cli {
 namespace {
 
 std::string help_text() {
-    const DetectorOptions defaults;
+    const DetectorOptions defaults = bench_default_options();
     std::string thesis_names;
     for (const std::string& name : option_names<Method>()) {
         Method method{};
@@ -53,6 +53,12 @@ Names of methods, tests, hashes and backends ignore case, and '-' and '_' are in
 }
 
 } // namespace
+
+DetectorOptions bench_default_options() {
+    DetectorOptions options;
+    options.narrow_phase = NarrowPhase::sat;
+    return options;
+}
 
 std::string bench_method_name(Method method) {
     const std::vector<std::string> thesis_names = aliases(method);

@@ -12,11 +12,15 @@
 
 namespace kdet::cli {
 
+/// @brief The detector options `kdet bench` starts from: the library's, except the test, which is the
+/// thesis's default (sat) so that its files compare with the thesis's.
+DetectorOptions bench_default_options();
+
 /// @brief Everything `kdet bench` was asked to do.
 struct BenchConfig {
     std::string scene = "procedural";
     SceneRequest request;                       ///< -r, and --tets / --scene-frames for "procedural"
-    DetectorOptions options;                    ///< -c, -o, -h, -g, --backend, --threads
+    DetectorOptions options = bench_default_options(); ///< -c, -o, -h, -g, --backend, --threads
     int runs = 10;                              ///< -n
     bool self = false;                          ///< -s
     std::string output_dir = "exports/benchmark_data"; ///< -d

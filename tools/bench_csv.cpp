@@ -45,7 +45,8 @@ const std::vector<std::string>& frame_columns() {
     static const std::vector<std::string> columns = {
         "frame", "host time", "device time", "bbox time", "collision time", "col tets A to B", "col tets B to A",
         "collision pairs", "populate time", "find candidates time", "sort unique time", "narrow phase time",
-        "candidates", "unique candidates", "colliding tets", "buffer regrows", "memory bytes", "bbox overlap x"};
+        "candidates", "unique candidates", "colliding tets", "buffer regrows", "memory bytes", "bbox overlap x",
+        "exact stage pairs"};
     return columns;
 }
 
@@ -69,7 +70,8 @@ FrameRow make_frame_row(int frame, double host_ms, const FrameResult& result, do
             static_cast<double>(c.colliding_tets),
             static_cast<double>(c.buffer_regrows),
             static_cast<double>(result.memory_bytes),
-            overlap_x};
+            overlap_x,
+            static_cast<double>(c.exact_stage_pairs)};
 }
 
 double box_overlap_x(const std::vector<float>& a, const std::vector<float>& b) {

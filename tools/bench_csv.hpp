@@ -20,7 +20,8 @@ using FrameRow = std::vector<double>;
 
 /// @brief The per-frame columns: the thesis's eight (frame, host time, device time, bbox time,
 /// collision time, col tets A to B, col tets B to A, collision pairs), then per-stage times,
-/// candidate counts, memory and the box overlap along x.
+/// candidate counts, memory, the box overlap along x and the pairs that reached the exact stage of
+/// the `exact` test.
 const std::vector<std::string>& frame_columns();
 
 /// @brief One frame's row. `host_ms` is the wall-clock time around detect(), `overlap_x` the

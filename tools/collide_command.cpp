@@ -144,6 +144,7 @@ int run_collide(int argc, char** argv) {
                   << "\", \"candidates\": " << c.candidates << ", \"unique_candidates\": " << c.unique_candidates
                   << ", \"colliding_pairs\": " << c.colliding_pairs << ", \"colliding_tets\": " << c.colliding_tets
                   << ", \"buffer_regrows\": " << c.buffer_regrows << ", \"host_waits\": " << c.host_waits
+                  << ", \"exact_stage_pairs\": " << c.exact_stage_pairs
                   << ", \"times_ms\": {\"bounding_boxes\": "
                   << json_number(t.bounding_boxes) << ", \"populate_grid\": " << json_number(t.populate_grid)
                   << ", \"find_candidates\": " << json_number(t.find_candidates)
@@ -169,6 +170,8 @@ int run_collide(int argc, char** argv) {
     if (options.method != Method::kdet_no_pairs)
         std::printf("colliding pairs   %llu\n", static_cast<unsigned long long>(c.colliding_pairs));
     std::printf("colliding tets    %llu\n", static_cast<unsigned long long>(c.colliding_tets));
+    if (options.narrow_phase == NarrowPhase::exact)
+        std::printf("exact stage       %llu pairs\n", static_cast<unsigned long long>(c.exact_stage_pairs));
     std::printf("times (ms)        boxes %.3f, populate %.3f, candidates %.3f, sort+unique %.3f, narrow %.3f\n",
                 t.bounding_boxes, t.populate_grid, t.find_candidates, t.sort_unique, t.narrow_phase);
     std::printf("total             %.3f ms\n", t.total);

@@ -22,11 +22,12 @@ enum class Method {
 
 /// @brief The tetrahedron-tetrahedron test run on each unique candidate pair.
 enum class NarrowPhase {
-    sat,          ///< separating axis test over the 44 axes (default)
+    sat,          ///< separating axis test over the 44 axes, float with a relative tolerance
     sat_no_edges, ///< face normals only: conservative, may report extra pairs
     sat_mtv,      ///< 44-axis SAT that also returns depth and direction
     gjk,          ///< GJK with a signed-volumes distance sub-algorithm
     fast,         ///< Ganovelli-Ponchio-Rocchini face-plane test
+    exact,        ///< exact for the float coordinates (filtered: float, then double, then exact sums); default
 };
 
 /// @brief Hash function of the hierarchical grid.
@@ -69,7 +70,7 @@ std::vector<std::string> aliases(Method value);
 struct DetectorOptions {
     Backend backend = Backend::cpu;
     Method method = Method::kdet;
-    NarrowPhase narrow_phase = NarrowPhase::sat;
+    NarrowPhase narrow_phase = NarrowPhase::exact;
     HashFunction hash = HashFunction::djb2;
     /// CPU threads; 0 leaves OpenMP's default.
     int threads = 0;

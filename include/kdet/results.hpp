@@ -56,6 +56,7 @@ struct FrameCounts {
     std::uint64_t unique_candidates = 0; ///< of which the face-plane pre-test could not reject: the narrow phase runs on these
     std::uint64_t colliding_pairs = 0;
     std::uint64_t colliding_tets = 0;    ///< tets flagged as colliding, all objects together
+    std::uint64_t exact_stage_pairs = 0; ///< NarrowPhase::exact: pairs its float filter left to the exact stage
     std::uint32_t buffer_regrows = 0;    ///< times a buffer grew and its stage reran this frame
     std::uint64_t grid_cells = 0;        ///< occupied grid cells (main buckets claimed)
     std::uint64_t grid_slots = 0;        ///< main buckets of the hash table

@@ -8,11 +8,13 @@
 /// - all tolerances are relative to the longest edge of the pair, never absolute: each test moves the
 ///   pair to a frame with origin at a[0] and longest edge 1;
 /// - a separation is reported only when proven by a gap above 32 float epsilons (relative), so an
-///   intersecting pair is never missed; pairs closer than that count as intersecting;
+///   intersecting pair is never missed; pairs closer than that count as intersecting. The `exact` test
+///   has no tolerance: it answers exactly for the float points it is given;
 /// - no exceptions, no allocation, no static state.
 
 #include <kdet/options.hpp>
 
+#include "geometry/exact_test.hpp"
 #include "geometry/gjk.hpp"
 #include "geometry/gpr.hpp"
 #include "geometry/sat.hpp"
@@ -20,7 +22,7 @@
 namespace kdet {
 
 /// @brief Separating axis test over the 44 axes (4 + 4 face normals, 36 edge cross products).
-/// Edge pairs within sqrt(eps) of parallel are skipped (they add no usable axis); the default test.
+/// Edge pairs within sqrt(eps) of parallel are skipped (they add no usable axis).
 KDET_HD inline bool tets_intersect_sat(const vec3 a[4], const vec3 b[4]) {
     return narrow::sat_intersect(a, b, true);
 }
@@ -56,9 +58,24 @@ KDET_HD inline bool tets_intersect_gjk(const vec3 a[4], const vec3 b[4]) { retur
 /// rounding) is decided by that edge's 6 SAT axes; a tet too flat to orient sends the pair to the SAT.
 KDET_HD inline bool tets_intersect_fast(const vec3 a[4], const vec3 b[4]) { return narrow::gpr_intersect(a, b); }
 
-/// @brief Runs the test selected by `test`.
-KDET_HD inline bool tets_intersect(NarrowPhase test, const vec3 a[4], const vec3 b[4]) {
+/// @brief Exact: true iff the closed tets share a point, for the float coordinates given (CGAL's
+/// do_intersect with exact predicates gives the same answer), zero-volume tets included. A float
+/// separating-axis test with proven error bounds decides almost every pair; the rest go to an exact
+/// stage (exact_test.hpp), and then `exact_stage` is set to true (it is never cleared). The default test.
+KDET_HD inline bool tets_intersect_exact(const vec3 a[4], const vec3 b[4], bool& exact_stage) {
+    return narrow::exact_intersect(a, b, exact_stage);
+}
+KDET_HD inline bool tets_intersect_exact(const vec3 a[4], const vec3 b[4]) {
+    bool exact_stage = false;
+    return narrow::exact_intersect(a, b, exact_stage);
+}
+
+/// @brief Runs the test selected by `test`; `exact_stage` as for tets_intersect_exact (only that test
+/// has an exact stage).
+KDET_HD inline bool tets_intersect(NarrowPhase test, const vec3 a[4], const vec3 b[4], bool& exact_stage) {
     switch (test) {
+    case NarrowPhase::exact:
+        return tets_intersect_exact(a, b, exact_stage);
     case NarrowPhase::sat_no_edges:
         return tets_intersect_sat_no_edges(a, b);
     case NarrowPhase::sat_mtv: {
@@ -74,6 +91,11 @@ KDET_HD inline bool tets_intersect(NarrowPhase test, const vec3 a[4], const vec3
         break;
     }
     return tets_intersect_sat(a, b);
+}
+
+KDET_HD inline bool tets_intersect(NarrowPhase test, const vec3 a[4], const vec3 b[4]) {
+    bool exact_stage = false;
+    return tets_intersect(test, a, b, exact_stage);
 }
 
 } // namespace kdet

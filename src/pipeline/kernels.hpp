@@ -68,23 +68,26 @@ KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<s
 KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
 
 /// @brief The narrow-phase test alone on stored tets first < second: the lower stored id goes first, so
-/// every method sees the same floating-point computation.
-KDET_HD inline bool test_pair(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second) {
+/// every method sees the same floating-point computation. `exact_stage` is set when the pair reached
+/// the exact stage of NarrowPhase::exact.
+KDET_HD inline bool test_pair(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second,
+                              bool& exact_stage) {
     vec3 a[4], b[4];
     load_tet(s, first, a);
     load_tet(s, second, b);
-    return tets_intersect(test, a, b);
+    return tets_intersect(test, a, b, exact_stage);
 }
 
 /// @brief The decision for a pair whose boxes overlap and that is not adjacent (first < second): the
 /// face-plane pre-test where it is sure (the answer the test gives, see face_planes.hpp), else the test.
-KDET_HD inline bool candidate_collides(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second) {
+KDET_HD inline bool candidate_collides(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second,
+                                       bool& exact_stage) {
     vec3 a[4], b[4];
     load_tet(s, first, a);
     load_tet(s, second, b);
     const PlaneVerdict verdict = face_plane_pretest(s.planes[first], a, s.planes[second], b, false);
     if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
-    return tets_intersect(test, a, b);
+    return tets_intersect(test, a, b, exact_stage);
 }
 
 /// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, and
@@ -96,9 +99,10 @@ KDET_HD inline bool may_collide(const SceneView& s, std::uint32_t first, std::ui
 
 /// @brief The brute-force methods' predicate: adjacency, boxes, then the test itself, without the
 /// pre-test, so that they stay the oracle the grid methods (which use it) are compared with.
-KDET_HD inline bool tets_collide_tested(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u) {
+KDET_HD inline bool tets_collide_tested(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u,
+                                       bool& exact_stage) {
     const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
-    return may_collide(s, first, second) && test_pair(s, test, first, second);
+    return may_collide(s, first, second) && test_pair(s, test, first, second, exact_stage);
 }
 
 /// @brief Stage 1: box of each tet; no size and no layer yet.
@@ -385,27 +389,33 @@ struct NoPairsKernel {
     NarrowPhase test;
     std::uint32_t* colliding;
     unsigned long long* tests_run;
+    unsigned long long* exact_stage_pairs;
 
     struct TestAndFlag {
         const NoPairsKernel* kernel;
         std::uint32_t t;
         unsigned long long tests;
+        unsigned long long exact_stage;
         KDET_HD void operator()(std::uint32_t u) {
             std::uint32_t* flags = kernel->colliding;
             if (atomic_load_acquire(&flags[t]) && atomic_load_acquire(&flags[u])) return;
             ++tests;
             const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
-            if (may_collide(kernel->scene, first, second) && candidate_collides(kernel->scene, kernel->test, first, second)) {
+            bool reached_exact = false;
+            if (may_collide(kernel->scene, first, second) &&
+                candidate_collides(kernel->scene, kernel->test, first, second, reached_exact)) {
                 atomic_store_relaxed(&flags[t], 1u);
                 atomic_store_relaxed(&flags[u], 1u);
             }
+            exact_stage += reached_exact;
         }
     };
 
     KDET_HD void operator()(std::uint64_t i) const {
-        TestAndFlag visit{this, static_cast<std::uint32_t>(i), 0};
+        TestAndFlag visit{this, static_cast<std::uint32_t>(i), 0, 0};
         for_each_larger_neighbour(scene, grid, params, layer_mask, visit.t, visit);
         if (visit.tests) atomic_fetch_add(tests_run, visit.tests);
+        if (visit.exact_stage) atomic_fetch_add(exact_stage_pairs, visit.exact_stage);
     }
 };
 
@@ -415,18 +425,24 @@ struct BruteForceLoopKernel {
     NarrowPhase test;
     const std::uint32_t* object_tet_begin; ///< [object_count + 1]
     KeyAppender out;
+    unsigned long long* exact_stage_pairs;
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto t = static_cast<std::uint32_t>(i);
         const std::uint32_t object = scene.tet_object[t];
         KeyBatch batch(&out);
+        unsigned long long exact_stage = 0;
         for (std::uint32_t other = object; other < scene.object_count; ++other) {
             if (!pair_is_active(scene, object, other)) continue;
             const std::uint32_t begin = other == object ? t + 1 : object_tet_begin[other];
-            for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u)
-                if (tets_collide_tested(scene, test, t, u)) batch.push(pair_key(t, u));
+            for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u) {
+                bool reached_exact = false;
+                if (tets_collide_tested(scene, test, t, u, reached_exact)) batch.push(pair_key(t, u));
+                exact_stage += reached_exact;
+            }
         }
         batch.flush();
+        if (exact_stage) atomic_fetch_add(exact_stage_pairs, exact_stage);
     }
 };
 
@@ -440,6 +456,7 @@ struct BruteForcePairsKernel {
     const std::uint32_t* block_objects;    ///< [2 * block_count]
     std::uint32_t block_count;
     KeyAppender out;
+    unsigned long long* exact_stage_pairs;
 
     KDET_HD void operator()(std::uint64_t work) const {
         std::uint32_t b = 0;
@@ -464,7 +481,9 @@ struct BruteForcePairsKernel {
         }
         const auto t = static_cast<std::uint32_t>(object_tet_begin[oa] + i);
         const auto u = static_cast<std::uint32_t>(object_tet_begin[ob] + j);
-        if (tets_collide_tested(scene, test, t, u)) out.push(pair_key(t, u));
+        bool reached_exact = false;
+        if (tets_collide_tested(scene, test, t, u, reached_exact)) out.push(pair_key(t, u));
+        if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull);
     }
 };
 
@@ -478,10 +497,14 @@ struct NarrowPhaseKernel {
     const std::uint64_t* keys;
     std::uint32_t* hit;
     std::uint32_t* colliding;
+    unsigned long long* exact_stage_pairs;
 
     KDET_HD void operator()(std::uint64_t k) const {
         const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
-        const bool collides = pretest ? candidate_collides(scene, test, t, u) : test_pair(scene, test, t, u);
+        bool reached_exact = false;
+        const bool collides = pretest ? candidate_collides(scene, test, t, u, reached_exact)
+                                      : test_pair(scene, test, t, u, reached_exact);
+        if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
         hit[k] = collides ? 1u : 0u;
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);

@@ -25,7 +25,8 @@ constexpr Name<NarrowPhase> narrow_phase_table[] = {{NarrowPhase::sat, "sat"},
                                                     {NarrowPhase::sat_no_edges, "sat_no_edges"},
                                                     {NarrowPhase::sat_mtv, "sat_mtv"},
                                                     {NarrowPhase::gjk, "gjk"},
-                                                    {NarrowPhase::fast, "fast"}};
+                                                    {NarrowPhase::fast, "fast"},
+                                                    {NarrowPhase::exact, "exact"}};
 constexpr Name<HashFunction> hash_table[] = {{HashFunction::djb2, "djb2"},
                                              {HashFunction::fnv1a, "fnv-1a"},
                                              {HashFunction::simple, "simple"},

@@ -18,6 +18,7 @@ struct FrameCounters {
     unsigned long long candidates;
     unsigned long long tests_run;
     unsigned long long rejected; ///< candidate pairs the face-plane pre-test proved separated
+    unsigned long long exact_stage_pairs; ///< pairs that reached the exact stage of NarrowPhase::exact
     std::uint32_t grid_failure;
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
@@ -126,7 +127,7 @@ private:
     FrameCounters append_candidates_growing(const Launch& launch, FrameCounts& counts);
     void find_candidates(const GridView& grid, FrameCounts& counts);
     void brute_force(FrameCounts& counts);
-    std::size_t narrow_phase(std::size_t candidates);
+    std::size_t narrow_phase(std::size_t candidates, FrameCounts& counts);
     void contacts_and_pairs(std::size_t colliding, FrameResult& result);
     void count_and_copy_flags(bool any, FrameResult& result);
     KeyAppender candidate_appender() {
@@ -351,6 +352,7 @@ FrameCounters Pipeline<Exec>::append_candidates_growing(const Launch& launch, Fr
         launch(candidate_appender());
         const FrameCounters after = read_counters();
         counts.candidates = after.candidates;
+        counts.exact_stage_pairs = after.exact_stage_pairs; // brute force tests while it appends
         if (after.candidates <= candidates_.size()) return after;
         candidates_.resize_discard(after.candidates + after.candidates / 4);
         ++counts.buffer_regrows;
@@ -401,10 +403,12 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
                 exec_.for_each(block_begin.back(),
                                BruteForcePairsKernel{scene_view(), options_.narrow_phase, object_tet_begin_.data(),
                                                      blocks_begin_.data(), block_objects_.data(),
-                                                     static_cast<std::uint32_t>(block_objects.size() / 2), out});
+                                                     static_cast<std::uint32_t>(block_objects.size() / 2), out,
+                                                     &counters_.data()->exact_stage_pairs});
             else
                 exec_.for_each(tets_.size(), BruteForceLoopKernel{scene_view(), options_.narrow_phase,
-                                                                  object_tet_begin_.data(), out});
+                                                                  object_tet_begin_.data(), out,
+                                                                  &counters_.data()->exact_stage_pairs});
         },
         counts);
 }
@@ -413,12 +417,15 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
 /// they need no sorting); the colliding pairs are compacted and renamed to the caller's tet ids.
 /// Returns their number.
 template <class Exec>
-std::size_t Pipeline<Exec>::narrow_phase(std::size_t candidates) {
+std::size_t Pipeline<Exec>::narrow_phase(std::size_t candidates, FrameCounts& counts) {
     hit_.resize_discard(candidates);
     position_.resize_discard(candidates);
     const bool grid_method = options_.method == Method::kdet || options_.method == Method::kdet_no_pairs;
+    const bool exact = options_.narrow_phase == NarrowPhase::exact;
+    if (exact) reset_counters();
     exec_.for_each(candidates, NarrowPhaseKernel{scene_view(), options_.narrow_phase, grid_method, candidates_.data(),
-                                                 hit_.data(), colliding_.data()});
+                                                 hit_.data(), colliding_.data(), &counters_.data()->exact_stage_pairs});
+    if (exact) counts.exact_stage_pairs = read_counters().exact_stage_pairs;
     const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), candidates);
     out_keys_.resize_discard(colliding);
     exec_.for_each(candidates, CompactKernel{candidates_.data(), hit_.data(), position_.data(), out_keys_.data()});
@@ -515,8 +522,11 @@ void Pipeline<Exec>::detect(const std::vector<PositionUpload>& uploads, const st
                 reset_counters();
                 exec_.for_each(tets_.size(), NoPairsKernel{scene_view(), grid, params_, layer_mask_,
                                                            options_.narrow_phase, colliding_.data(),
-                                                           &counters_.data()->tests_run});
-                counts.candidates = counts.unique_candidates = read_counters().tests_run;
+                                                           &counters_.data()->tests_run,
+                                                           &counters_.data()->exact_stage_pairs});
+                const FrameCounters after = read_counters();
+                counts.candidates = counts.unique_candidates = after.tests_run;
+                counts.exact_stage_pairs = after.exact_stage_pairs;
             }
         } else {
             brute_force(counts);
@@ -524,7 +534,7 @@ void Pipeline<Exec>::detect(const std::vector<PositionUpload>& uploads, const st
         clock_.mark(candidates_done);
         if (method != Method::kdet_no_pairs) {
             if (!grid_method) counts.unique_candidates = counts.candidates;
-            const std::size_t colliding = narrow_phase(counts.unique_candidates);
+            const std::size_t colliding = narrow_phase(counts.unique_candidates, counts);
             clock_.mark(narrow_phase_done);
             exec_.sort(out_keys_.data(), colliding); // the deterministic output order
             clock_.mark(sorted);

@@ -7,6 +7,10 @@
 /// dependency of the kdet library.
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Gmpzf.h>
+#include <CGAL/Homogeneous.h>
+#include <CGAL/Polytope_distance_d.h>
+#include <CGAL/Polytope_distance_d_traits_3.h>
 #include <CGAL/intersections.h>
 
 #include <algorithm>
@@ -14,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "geometry/vec3.hpp"
@@ -34,11 +39,32 @@ enum class CaseKind {
     edge_on_edge,    ///< an edge of the second tet crossing (or near) an edge of the first, body outside
     translated_copy, ///< the second tet is the first moved: all edges parallel, often near touching
     sliver,          ///< one or both tets nearly flat
+    face_on_face,    ///< a face of the second tet in (or near) the plane of a face of the first, body outside
+    needle,          ///< the first tet long and thin (width 1e-2 to 1e-4 of its length)
+    // Exactly representable coordinates (integers times a power of two) with exact contacts, then
+    // possibly moved by one lattice unit: the cases that only exact arithmetic decides.
+    lattice_vertex_on_face, ///< a vertex exactly inside a face of the first tet, body outside
+    lattice_edge_on_edge,   ///< an edge exactly crossing an edge of the first tet, bodies on either side
+    lattice_face_on_face,   ///< a face exactly in the plane of a face of the first tet, body outside
+    lattice_translated_copy, ///< the first tet moved by one of its edge vectors: touching at a vertex
+    lattice_random,          ///< two random lattice tets near each other
 };
-constexpr CaseKind k_case_kinds[] = {CaseKind::random,         CaseKind::shared_vertex, CaseKind::shared_edge,
-                                     CaseKind::shared_face,    CaseKind::vertex_on_face, CaseKind::edge_on_edge,
-                                     CaseKind::translated_copy, CaseKind::sliver};
-constexpr int k_case_kind_count = 8;
+constexpr CaseKind k_case_kinds[] = {CaseKind::random,
+                                     CaseKind::shared_vertex,
+                                     CaseKind::shared_edge,
+                                     CaseKind::shared_face,
+                                     CaseKind::vertex_on_face,
+                                     CaseKind::edge_on_edge,
+                                     CaseKind::translated_copy,
+                                     CaseKind::sliver,
+                                     CaseKind::face_on_face,
+                                     CaseKind::needle,
+                                     CaseKind::lattice_vertex_on_face,
+                                     CaseKind::lattice_edge_on_edge,
+                                     CaseKind::lattice_face_on_face,
+                                     CaseKind::lattice_translated_copy,
+                                     CaseKind::lattice_random};
+constexpr int k_case_kind_count = 15;
 
 inline const char* case_kind_name(CaseKind kind) {
     switch (kind) {
@@ -50,12 +76,22 @@ inline const char* case_kind_name(CaseKind kind) {
     case CaseKind::edge_on_edge: return "edge_on_edge";
     case CaseKind::translated_copy: return "translated_copy";
     case CaseKind::sliver: return "sliver";
+    case CaseKind::face_on_face: return "face_on_face";
+    case CaseKind::needle: return "needle";
+    case CaseKind::lattice_vertex_on_face: return "lattice_vertex_on_face";
+    case CaseKind::lattice_edge_on_edge: return "lattice_edge_on_edge";
+    case CaseKind::lattice_face_on_face: return "lattice_face_on_face";
+    case CaseKind::lattice_translated_copy: return "lattice_translated_copy";
+    case CaseKind::lattice_random: return "lattice_random";
     }
     return "?";
 }
 
+inline bool is_lattice(CaseKind kind) { return kind >= CaseKind::lattice_vertex_on_face; }
+
 /// @brief Tet sizes and offsets from the origin (relative to the size, capped at 1e6 absolute).
-constexpr double k_sizes[] = {1.0, 1e-3, 1e-6};
+constexpr double k_sizes[] = {1e-6, 1e-3, 1.0, 1e3, 1e6};
+constexpr int k_size_count = 5;
 constexpr double k_relative_offsets[] = {0.0, 1e2, 1e4, 1e6};
 constexpr double k_max_offset = 1e6;
 
@@ -115,6 +151,25 @@ inline Tetrahedron to_tetrahedron(const d3 v[4]) {
 /// @brief Exact oracle on double coordinates (closed sets).
 [[gnu::noinline]] inline bool cgal_intersect(const d3 a[4], const d3 b[4]) {
     return CGAL::do_intersect(to_tetrahedron(a), to_tetrahedron(b));
+}
+
+/// @brief Exact oracle for any two sets of 4 points, degenerate ones included: the squared distance
+/// between their convex hulls, computed exactly (CGAL's polytope distance with Gmpzf arithmetic
+/// throughout: with double as its inner number type it returned an invalid non-zero distance for
+/// flat tets sharing a vertex, one coordinate 2^-65), is zero iff the hulls meet. The solution is
+/// checked (is_valid) every time.
+[[gnu::noinline]] inline bool cgal_hulls_meet(const d3 a[4], const d3 b[4]) {
+    using HomogeneousKernel = CGAL::Homogeneous<double>;
+    using Distance =
+        CGAL::Polytope_distance_d<CGAL::Polytope_distance_d_traits_3<HomogeneousKernel, CGAL::Gmpzf, CGAL::Gmpzf>>;
+    HomogeneousKernel::Point_3 p[4], q[4];
+    for (int i = 0; i < 4; ++i) {
+        p[i] = HomogeneousKernel::Point_3(a[i].x, a[i].y, a[i].z, 1.0);
+        q[i] = HomogeneousKernel::Point_3(b[i].x, b[i].y, b[i].z, 1.0);
+    }
+    const Distance distance(p, p + 4, q, q + 4);
+    if (!distance.is_valid()) throw std::runtime_error("CGAL's polytope distance found no valid solution");
+    return distance.is_zero();
 }
 
 inline void widen(const vec3 v[4], d3 out[4]) {
@@ -192,6 +247,9 @@ public:
     explicit Random(std::uint64_t seed) : engine_(seed) {}
     double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(engine_); }
     int index(int n) { return std::uniform_int_distribution<int>(0, n - 1)(engine_); }
+    std::int64_t integer(std::int64_t lo, std::int64_t hi) {
+        return std::uniform_int_distribution<std::int64_t>(lo, hi)(engine_);
+    }
     d3 in_cube(double half) { return {uniform(-half, half), uniform(-half, half), uniform(-half, half)}; }
     d3 direction() {
         for (;;) {
@@ -349,6 +407,34 @@ inline void build_pair(Random& rng, CaseKind kind, double s, d3 a[4], d3 b[4]) {
         }
         return;
     }
+    case CaseKind::face_on_face: {
+        // Three vertices of b in the plane of a face of a (moved along its normal), covering part of
+        // the face and often reaching past it; the fourth outside.
+        const int k = rng.index(4);
+        const d3 n = outward_normal(a, k);
+        const d3 p = a[(k + 1) & 3], q = a[(k + 2) & 3], r = a[(k + 3) & 3];
+        const d3 lift = n * (rng.perturbation() * s);
+        for (int i = 0; i < 3; ++i) b[i] = p + (q - p) * rng.uniform(-0.3, 1.0) + (r - p) * rng.uniform(-0.3, 1.0) + lift;
+        b[3] = (b[0] + b[1] + b[2]) * (1.0 / 3.0) + n * (s * rng.uniform(0.3, 1.0));
+        break;
+    }
+    case CaseKind::needle: {
+        // a: length s along a random axis, width w; b: a random tet or a second needle crossing near a's.
+        const double w = s * (rng.index(2) ? 1e-2 : (rng.index(2) ? 1e-3 : 1e-4));
+        const Rotation rotate(rng);
+        const d3 corners[4] = {{-0.5 * s, 0, 0}, {0.5 * s, 0, 0}, {0, w, 0.3 * w}, {0.1 * s, -0.4 * w, w}};
+        for (int q = 0; q < 4; ++q) a[q] = rotate(corners[q]);
+        if (rng.index(2)) {
+            random_tet(rng, rng.in_cube(0.6 * s), s, b);
+        } else {
+            const Rotation rotate_b(rng);
+            const d3 shift = a[0] + (a[1] - a[0]) * rng.uniform(0.1, 0.9) + rng.in_cube(2 * w);
+            for (int q = 0; q < 4; ++q) b[q] = rotate_b(corners[q]) + shift;
+        }
+        return;
+    }
+    default: // the lattice kinds are built by build_lattice_pair
+        return;
     }
     // Shuffle b's vertices: the tests must not depend on vertex order or orientation.
     std::array<int, 4> order{0, 1, 2, 3};
@@ -356,6 +442,164 @@ inline void build_pair(Random& rng, CaseKind kind, double s, d3 a[4], d3 b[4]) {
     d3 shuffled[4];
     for (int q = 0; q < 4; ++q) shuffled[q] = b[order[q]];
     std::copy(shuffled, shuffled + 4, b);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Lattice pairs: integer coordinates with exact contacts, realised as integer * 2^k, which floats hold
+// exactly while the integers stay below 2^24.
+
+struct i3 {
+    std::int64_t x, y, z;
+};
+__extension__ typedef __int128 i128; // dot products of lattice vectors reach 2^64
+inline i3 operator+(i3 a, i3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline i3 operator-(i3 a, i3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline i3 operator*(i3 a, std::int64_t k) { return {a.x * k, a.y * k, a.z * k}; }
+inline i3 operator/(i3 a, std::int64_t k) { return {a.x / k, a.y / k, a.z / k}; } // exact where used
+inline i128 dot(i3 a, i3 b) { return i128{a.x} * b.x + i128{a.y} * b.y + i128{a.z} * b.z; }
+inline i3 cross(i3 a, i3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline bool is_zero(i3 a) { return a.x == 0 && a.y == 0 && a.z == 0; }
+
+inline i3 lattice_point(Random& rng, std::int64_t r) {
+    return {rng.integer(-r, r), rng.integer(-r, r), rng.integer(-r, r)};
+}
+
+/// @brief A tet with vertices that are multiples of 8 in [-r, r]^3 (so that eighths of its edges are
+/// lattice vectors), not too flat. With r <= 2^20, cross products stay below 2^45 and dot products
+/// (128 bits) exact.
+inline void lattice_tet(Random& rng, std::int64_t r, i3 out[4]) {
+    for (;;) {
+        for (int i = 0; i < 4; ++i) out[i] = lattice_point(rng, r / 8) * 8;
+        const i128 volume = dot(out[1] - out[0], cross(out[2] - out[0], out[3] - out[0]));
+        if (volume > i128{r} * r * r / 64 || volume < -(i128{r} * r * r / 64)) return;
+    }
+}
+
+/// @brief Outward normal (not normalised) of face k of a lattice tet.
+inline i3 outward_normal(const i3 t[4], int k) {
+    const i3 p = t[(k + 1) & 3], n = cross(t[(k + 2) & 3] - p, t[(k + 3) & 3] - p);
+    return dot(n, t[k] - p) > 0 ? n * -1 : n;
+}
+
+/// @brief A lattice vector in [-r, r]^3 strictly on the positive side of n.
+inline i3 outward_vector(Random& rng, i3 n, std::int64_t r) {
+    for (;;) {
+        const i3 w = lattice_point(rng, r);
+        if (dot(n, w) > 0) return w;
+    }
+}
+
+/// @brief One lattice unit along the coordinate where n is largest, toward +n; scaled by -1, 0 or 1 at
+/// random (half the time 0): keeps the contact, or moves the second tet out of or into the first.
+inline i3 unit_step(Random& rng, i3 n) {
+    const std::int64_t ax = n.x < 0 ? -n.x : n.x, ay = n.y < 0 ? -n.y : n.y, az = n.z < 0 ? -n.z : n.z;
+    i3 step{0, 0, 0};
+    if (ax >= ay && ax >= az) step.x = n.x > 0 ? 1 : -1;
+    else if (ay >= az) step.y = n.y > 0 ? 1 : -1;
+    else step.z = n.z > 0 ? 1 : -1;
+    const int choice = rng.index(4);
+    return choice < 2 ? i3{0, 0, 0} : step * (choice == 2 ? 1 : -1);
+}
+
+/// @brief Builds one lattice pair of the given kind in [-2r, 2r]^3 (r a multiple of 64).
+inline void build_lattice_pair(Random& rng, CaseKind kind, std::int64_t r, i3 a[4], i3 b[4]) {
+    lattice_tet(rng, r, a);
+    i3 shift{0, 0, 0};
+    switch (kind) {
+    case CaseKind::lattice_vertex_on_face: {
+        const int k = rng.index(4);
+        const i3 n = outward_normal(a, k), p = a[(k + 1) & 3], q = a[(k + 2) & 3], s = a[(k + 3) & 3];
+        const std::int64_t i = 1 + rng.index(6), j = 1 + rng.index(7 - static_cast<int>(i));
+        b[0] = p + ((q - p) * i + (s - p) * j) / 8; // strictly inside the face
+        for (int m = 1; m < 4; ++m) b[m] = b[0] + outward_vector(rng, n, r);
+        shift = unit_step(rng, n);
+        break;
+    }
+    case CaseKind::lattice_edge_on_edge: {
+        // The plane through a's edge (i, j) and a direction d supports a when a's other two vertices
+        // lie strictly on one side; b's edge crosses a's edge inside it, b's body on the other side.
+        const int i = rng.index(4), j = (i + 1 + rng.index(3)) & 3;
+        int others[2], o = 0;
+        for (int v = 0; v < 4; ++v)
+            if (v != i && v != j) others[o++] = v;
+        const i3 e = a[j] - a[i];
+        i3 d, n;
+        for (;;) {
+            d = lattice_point(rng, 32);
+            n = cross(e, d);
+            const i128 s0 = dot(n, a[others[0]] - a[i]), s1 = dot(n, a[others[1]] - a[i]);
+            if (s0 == 0 || s1 == 0 || (s0 > 0) != (s1 > 0)) continue;
+            if (s0 > 0) n = n * -1;
+            break;
+        }
+        const i3 m = a[i] + e * (1 + rng.index(7)) / 8;
+        b[0] = m - d * rng.integer(r / 64, r / 16);
+        b[1] = m + d * rng.integer(r / 64, r / 16);
+        b[2] = m + outward_vector(rng, n, r);
+        b[3] = m + outward_vector(rng, n, r);
+        shift = unit_step(rng, n);
+        break;
+    }
+    case CaseKind::lattice_face_on_face: {
+        const int k = rng.index(4);
+        const i3 n = outward_normal(a, k), p = a[(k + 1) & 3], q = a[(k + 2) & 3], s = a[(k + 3) & 3];
+        do {
+            for (int m = 0; m < 3; ++m) b[m] = p + ((q - p) * rng.integer(-4, 10) + (s - p) * rng.integer(-4, 10)) / 8;
+        } while (is_zero(cross(b[1] - b[0], b[2] - b[0])));
+        b[3] = b[0] + outward_vector(rng, n, r);
+        shift = unit_step(rng, n);
+        break;
+    }
+    case CaseKind::lattice_translated_copy: {
+        // Moved by a - a' for two vertices: the difference body's vertex, so the copies touch at one point.
+        const int i = rng.index(4), j = (i + 1 + rng.index(3)) & 3;
+        for (int m = 0; m < 4; ++m) b[m] = a[m] + (a[j] - a[i]);
+        shift = unit_step(rng, lattice_point(rng, 1));
+        break;
+    }
+    default: { // lattice_random
+        lattice_tet(rng, r, b);
+        const i3 center = lattice_point(rng, r);
+        for (int m = 0; m < 4; ++m) b[m] = b[m] / 2 + center;
+        break;
+    }
+    }
+    std::array<int, 4> order{0, 1, 2, 3};
+    for (int q = 3; q > 0; --q) std::swap(order[q], order[rng.index(q + 1)]);
+    i3 shuffled[4];
+    for (int q = 0; q < 4; ++q) shuffled[q] = b[order[q]] + shift;
+    std::copy(shuffled, shuffled + 4, b);
+}
+
+/// @brief Where a lattice pair goes: coordinates (lattice point + offset) * 2^exponent, with the
+/// lattice as fine as the offset allows while every coordinate stays below 2^24 units.
+struct LatticeFrame {
+    std::int64_t r;  ///< half extent of the first tet in units
+    int exponent;    ///< one unit is 2^exponent
+    i3 offset;       ///< in units
+};
+
+/// @brief A frame for tets of size about s at distance `offset` from the origin along `direction`:
+/// 2^20 units per size (so that products of three coordinates exceed double's 53 bits), coarser when
+/// the offset needs it (down to 2^6 units per size).
+inline LatticeFrame lattice_frame(double s, double offset, d3 direction) {
+    int bits = 20, exponent = static_cast<int>(std::ceil(std::log2(s))) - bits;
+    const double limit = 0x1p24 - 0x1p22; // room for the pair itself (|lattice| < 4r <= 2^22)
+    while (bits > 6 && std::ldexp(offset, -exponent) > limit) {
+        --bits;
+        ++exponent;
+    }
+    const double units = std::min(std::ldexp(offset, -exponent), limit);
+    const d3 o = direction * units;
+    return LatticeFrame{std::int64_t{1} << bits, exponent,
+                        i3{std::llround(o.x), std::llround(o.y), std::llround(o.z)}};
+}
+
+inline vec3 realise(i3 p, const LatticeFrame& frame) {
+    const i3 q = p + frame.offset;
+    return vec3{static_cast<float>(std::ldexp(static_cast<double>(q.x), frame.exponent)),
+                static_cast<float>(std::ldexp(static_cast<double>(q.y), frame.exponent)),
+                static_cast<float>(std::ldexp(static_cast<double>(q.z), frame.exponent))};
 }
 
 /// @brief Generates `per_combination` pairs for every kind, size and offset, with ground truth and
@@ -369,13 +613,23 @@ inline std::vector<Case> generate_cases(std::uint64_t seed, int per_combination)
                 const double offset = std::min(relative_offset * s, k_max_offset);
                 for (int n = 0; n < per_combination; ++n) {
                     for (int attempt = 0; attempt < 100; ++attempt) {
-                        d3 a[4], b[4];
-                        build_pair(rng, kind, s, a, b);
-                        const d3 shift = rng.direction() * offset;
                         Case c{};
-                        for (int i = 0; i < 4; ++i) {
-                            c.a[i] = to_vec3(a[i] + shift);
-                            c.b[i] = to_vec3(b[i] + shift);
+                        const d3 direction = rng.direction();
+                        if (is_lattice(kind)) {
+                            const LatticeFrame frame = lattice_frame(s, offset, direction);
+                            i3 a[4], b[4];
+                            build_lattice_pair(rng, kind, frame.r, a, b);
+                            for (int i = 0; i < 4; ++i) {
+                                c.a[i] = realise(a[i], frame);
+                                c.b[i] = realise(b[i], frame);
+                            }
+                        } else {
+                            d3 a[4], b[4];
+                            build_pair(rng, kind, s, a, b);
+                            for (int i = 0; i < 4; ++i) {
+                                c.a[i] = to_vec3(a[i] + direction * offset);
+                                c.b[i] = to_vec3(b[i] + direction * offset);
+                            }
                         }
                         d3 ad[4], bd[4];
                         widen(c.a, ad);
@@ -390,6 +644,116 @@ inline std::vector<Case> generate_cases(std::uint64_t seed, int per_combination)
                     }
                 }
             }
+    return cases;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Zero-volume pairs (what --allow-degenerate lets in): points, segments and flat tets, mostly in one
+// plane of a lattice, judged by cgal_hulls_meet.
+
+/// @brief A pair in which at least one tet has zero volume.
+struct DegenerateCase {
+    vec3 a[4];
+    vec3 b[4];
+    int dim_a, dim_b; ///< dimension of each tet's hull: 0 point, 1 segment, 2 flat, 3 solid
+    bool lattice;     ///< exactly representable lattice coordinates (else random floats on a plane z = c)
+    bool truth;
+};
+
+/// @brief Dimension of the hull of 4 float points (exact, from CGAL's predicates).
+inline int hull_dimension(const vec3 t[4]) {
+    d3 d[4];
+    widen(t, d);
+    const Point p[4] = {to_point(d[0]), to_point(d[1]), to_point(d[2]), to_point(d[3])};
+    if (!degenerate(d)) return 3;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+            for (int k = j + 1; k < 4; ++k)
+                if (!CGAL::collinear(p[i], p[j], p[k])) return 2;
+    for (int i = 1; i < 4; ++i)
+        if (p[i] != p[0]) return 1;
+    return 0;
+}
+
+/// @brief Four points of a plane lattice o + i u + j v (small i, j) spanning `dim` dimensions; for
+/// dim 3 the fourth leaves the plane along w. `line` is the direction (in (i, j)) used for dim 1.
+inline void lattice_flat(Random& rng, int dim, i3 u, i3 v, i3 w, const std::int64_t line[2], i3 out[4]) {
+    const auto at = [&](std::int64_t i, std::int64_t j) { return u * i + v * j; };
+    const std::int64_t i0 = rng.integer(-3, 3), j0 = rng.integer(-3, 3);
+    for (int m = 0; m < 4; ++m) {
+        if (dim == 0) {
+            out[m] = at(i0, j0);
+        } else if (dim == 1) {
+            const std::int64_t t = rng.integer(-2, 2);
+            out[m] = at(i0 + t * line[0], j0 + t * line[1]);
+        } else {
+            out[m] = at(rng.integer(-3, 3), rng.integer(-3, 3));
+        }
+    }
+    if (dim == 3) out[3] = out[3] + w * (rng.index(2) ? 1 : -1);
+}
+
+/// @brief `count` degenerate pairs: half on plane lattices (exactly coplanar or collinear, shared
+/// planes and lines, parallel ones, mixed dimensions, exact contacts), half random floats on a plane
+/// z = c (flat against flat or against a solid tet), at sizes 1e-6 to 1e6.
+inline std::vector<DegenerateCase> generate_degenerate_cases(std::uint64_t seed, int count) {
+    Random rng(seed);
+    std::vector<DegenerateCase> cases;
+    while (static_cast<int>(cases.size()) < count) {
+        DegenerateCase c{};
+        const double s = k_sizes[rng.index(k_size_count)];
+        c.lattice = cases.size() % 2 == 0;
+        if (c.lattice) {
+            // Plane vectors of 2..19 bits: small ones give many exact contacts, large ones products
+            // that double arithmetic rounds.
+            const std::int64_t r = std::int64_t{1} << (2 + rng.index(18));
+            i3 u, v, w;
+            do {
+                u = lattice_point(rng, r);
+                v = lattice_point(rng, r);
+                w = lattice_point(rng, r);
+            } while (dot(cross(u, v), w) == 0);
+            std::int64_t line_a[2] = {rng.integer(-2, 2), rng.integer(-2, 2)}, line_b[2] = {line_a[0], line_a[1]};
+            if (line_a[0] == 0 && line_a[1] == 0) line_a[0] = line_b[0] = 1;
+            if (rng.index(2)) line_b[0] = rng.integer(-2, 2), line_b[1] = 1;
+            const int dim_a = rng.index(3), dim_b = rng.index(4); // a always degenerate
+            i3 a[4], b[4];
+            lattice_flat(rng, dim_a, u, v, w, line_a, a);
+            lattice_flat(rng, dim_b, u, v, w, line_b, b);
+            const int move = rng.index(4); // keep, into a parallel plane, or by one unit
+            for (int m = 0; m < 4; ++m) b[m] = b[m] + (move == 1 ? w : (move == 2 ? unit_step(rng, w) : i3{0, 0, 0}));
+            const int exponent = static_cast<int>(std::ceil(std::log2(s))) - (4 + static_cast<int>(std::log2(static_cast<double>(r))));
+            const LatticeFrame frame{r, exponent, i3{0, 0, 0}};
+            for (int m = 0; m < 4; ++m) {
+                c.a[m] = realise(a[m], frame);
+                c.b[m] = realise(b[m], frame);
+            }
+            // Half the time, a flat tet's first vertex (the exact test's origin) is put 2^-30 to 2^-60 times
+            // closer to the lattice's origin, still in the plane: differences to it need more bits than a
+            // double has, which exercises the error bounds of the plane test.
+            const auto near_origin = [&](vec3& vertex) {
+                const LatticeFrame tiny{r, exponent - 30 - rng.index(31), i3{0, 0, 0}};
+                vertex = realise(u * rng.integer(-3, 3) + v * rng.integer(-3, 3), tiny);
+            };
+            if (dim_a == 2 && rng.index(2)) near_origin(c.a[0]);
+            if (dim_b == 2 && move != 1 && rng.index(2)) near_origin(c.b[0]);
+        } else {
+            const float z = static_cast<float>(rng.uniform(-1.0, 1.0) * s);
+            for (int m = 0; m < 4; ++m) {
+                c.a[m] = vec3{static_cast<float>(rng.uniform(-0.5, 0.5) * s), static_cast<float>(rng.uniform(-0.5, 0.5) * s), z};
+                c.b[m] = vec3{static_cast<float>(rng.uniform(0.0, 1.0) * s), static_cast<float>(rng.uniform(-0.5, 0.5) * s),
+                              rng.index(2) ? z : static_cast<float>(z + rng.uniform(-0.5, 0.5) * s)};
+            }
+        }
+        c.dim_a = hull_dimension(c.a);
+        c.dim_b = hull_dimension(c.b);
+        if (c.dim_a == 3 && c.dim_b == 3) continue;
+        d3 ad[4], bd[4];
+        widen(c.a, ad);
+        widen(c.b, bd);
+        c.truth = cgal_hulls_meet(ad, bd);
+        cases.push_back(c);
+    }
     return cases;
 }
 

@@ -1,8 +1,11 @@
 /// @file narrow_phase_report.cpp
 /// @brief Prints, for every narrow-phase test, its CPU time per pair and its false positives and false
-/// negatives against CGAL per margin bucket. The numbers in docs/narrow-phase.md come from here.
+/// negatives against CGAL per margin bucket; for `exact`, also both argument orders, the pairs that
+/// reached its exact stage per kind, and zero-volume pairs. The numbers in docs/narrow-phase.md come
+/// from here.
 ///
 /// Usage: narrow_phase_report [pairs per kind/size/offset combination, default 3000]
+///                            [zero-volume pairs, default 20000]
 
 #include <ctime>
 #include <cstdio>
@@ -18,7 +21,7 @@ using kdet::NarrowPhase;
 using namespace kdet::cgal_check;
 
 constexpr NarrowPhase k_all_tests[] = {NarrowPhase::sat, NarrowPhase::sat_no_edges, NarrowPhase::sat_mtv,
-                                       NarrowPhase::gjk, NarrowPhase::fast};
+                                       NarrowPhase::gjk, NarrowPhase::fast, NarrowPhase::exact};
 constexpr long long k_timed_calls = 1000000;
 
 /// @brief CPU time of this thread in nanoseconds: unlike wall time, not inflated when other processes
@@ -67,22 +70,70 @@ double time_per_pair(NarrowPhase test, const std::vector<const Case*>& pairs) {
             pairs);
     case NarrowPhase::gjk: return time_per_pair(kdet::tets_intersect_gjk, pairs);
     case NarrowPhase::fast: return time_per_pair(kdet::tets_intersect_fast, pairs);
+    case NarrowPhase::exact:
+        return time_per_pair([](const vec3 a[4], const vec3 b[4]) { return kdet::tets_intersect_exact(a, b); }, pairs);
     case NarrowPhase::sat: break;
     }
     return time_per_pair(kdet::tets_intersect_sat, pairs);
+}
+
+/// @brief exact in both argument orders against CGAL, per kind, with the pairs that reached its exact
+/// stage; then zero-volume pairs against CGAL's polytope distance.
+void exact_report(const std::vector<Case>& cases, int degenerate_count) {
+    std::printf("\nexact, both argument orders, per kind: calls, disagreements with CGAL, calls that reached the "
+                "exact stage (all, and among clear pairs):\n");
+    long long total_calls = 0, total_wrong = 0, total_stage = 0;
+    for (CaseKind kind : k_case_kinds) {
+        long long calls = 0, wrong = 0, stage_calls = 0, clear = 0, clear_stage = 0;
+        for (const Case& c : cases) {
+            if (c.kind != kind) continue;
+            for (int order = 0; order < 2; ++order) {
+                bool stage = false;
+                const bool got = order ? kdet::tets_intersect_exact(c.b, c.a, stage) : kdet::tets_intersect_exact(c.a, c.b, stage);
+                ++calls;
+                wrong += got != c.truth;
+                stage_calls += stage;
+                if (bucket_of(c.margin) == Bucket::clear) {
+                    ++clear;
+                    clear_stage += stage;
+                }
+            }
+        }
+        std::printf("  %-24s %9lld  wrong %lld  exact stage %8lld (%5.2f%%), clear pairs %7lld of %8lld (%.3f%%)\n",
+                    case_kind_name(kind), calls, wrong, stage_calls, 100.0 * static_cast<double>(stage_calls) / static_cast<double>(calls),
+                    clear_stage, clear, clear ? 100.0 * static_cast<double>(clear_stage) / static_cast<double>(clear) : 0.0);
+        total_calls += calls;
+        total_wrong += wrong;
+        total_stage += stage_calls;
+    }
+    std::printf("  %-24s %9lld  wrong %lld  exact stage %8lld\n", "all", total_calls, total_wrong, total_stage);
+
+    const std::vector<DegenerateCase> degenerate = generate_degenerate_cases(0x7a65726fu, degenerate_count);
+    long long by_dimensions[4][4] = {}, wrong = 0, intersecting = 0, lattice = 0;
+    for (const DegenerateCase& c : degenerate) {
+        ++by_dimensions[c.dim_a][c.dim_b];
+        intersecting += c.truth;
+        lattice += c.lattice;
+        wrong += (kdet::tets_intersect_exact(c.a, c.b) != c.truth) + (kdet::tets_intersect_exact(c.b, c.a) != c.truth);
+    }
+    std::printf("\nexact on %zu zero-volume pairs (%lld on lattices, %lld intersecting), both orders: %lld "
+                "disagreements with CGAL's polytope distance. Pairs by hull dimension (rows: first tet):\n",
+                degenerate.size(), lattice, intersecting, wrong);
+    for (const auto& row : by_dimensions) std::printf("  %7lld %7lld %7lld %7lld\n", row[0], row[1], row[2], row[3]);
 }
 
 } // namespace
 
 int main(int argc, char** argv) {
     const int per_combination = argc > 1 ? std::atoi(argv[1]) : 3000;
+    const int degenerate_count = argc > 2 ? std::atoi(argv[2]) : 20000;
     std::printf("compiler: %s\n", __VERSION__);
     const std::vector<Case> cases = generate_cases(0x7265706f7274u, per_combination);
 
     long long bucket_count[k_bucket_count][2] = {};
     for (const Case& c : cases) ++bucket_count[static_cast<int>(bucket_of(c.margin))][c.truth];
-    std::printf("\n%zu pairs (%d kinds x 3 sizes x 4 offsets x %d), CGAL truth per bucket:\n", cases.size(),
-                k_case_kind_count, per_combination);
+    std::printf("\n%zu pairs (%d kinds x %d sizes x 4 offsets x %d), CGAL truth per bucket:\n", cases.size(),
+                k_case_kind_count, k_size_count, per_combination);
     for (int b = 0; b < k_bucket_count; ++b)
         std::printf("  %-24s intersecting %7lld  separated %7lld\n", bucket_name(static_cast<Bucket>(b)),
                     bucket_count[b][1], bucket_count[b][0]);
@@ -101,6 +152,8 @@ int main(int argc, char** argv) {
         for (int b = 0; b < k_bucket_count; ++b) std::printf(" | FP %7lld  FN %7lld    ", fp[b], fn[b]);
         std::printf("\n");
     }
+
+    exact_report(cases, degenerate_count);
 
     std::printf("\nFalse positives of sat_no_edges on clear separated pairs, per kind:\n");
     for (CaseKind kind : k_case_kinds) {
