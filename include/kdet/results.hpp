@@ -45,15 +45,15 @@ struct StageTimes {
     double bounding_boxes = 0;  ///< per-tet boxes and sizes, object boxes and their overlap
     double populate_grid = 0;
     double find_candidates = 0; ///< for kdet_no_pairs this includes its inline narrow phase
-    double sort_unique = 0;
-    double narrow_phase = 0;    ///< includes compacting the colliding pairs
+    double sort_unique = 0;     ///< sorting the colliding pairs into the output order (candidates are unique as found)
+    double narrow_phase = 0;    ///< includes compacting the colliding pairs, contacts and copying them out
     double total = 0;           ///< the whole detect() call, positions copied in and results copied out included
 };
 
 /// @brief Sizes of one detection.
 struct FrameCounts {
-    std::uint64_t candidates = 0;        ///< candidate pairs written, duplicates included
-    std::uint64_t unique_candidates = 0; ///< after sort+unique: the narrow phase runs once on each
+    std::uint64_t candidates = 0;        ///< candidate pairs found (boxes overlap, not adjacent), each once
+    std::uint64_t unique_candidates = 0; ///< of which the face-plane pre-test could not reject: the narrow phase runs on these
     std::uint64_t colliding_pairs = 0;
     std::uint64_t colliding_tets = 0;    ///< tets flagged as colliding, all objects together
     std::uint64_t exact_stage_pairs = 0; ///< NarrowPhase::exact: pairs its float filter left to the exact stage

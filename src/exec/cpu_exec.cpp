@@ -12,14 +12,11 @@ namespace kdet {
 CpuExec::CpuExec(const DetectorOptions& options)
     : threads_(options.threads > 0 ? options.threads : omp_get_max_threads()) {}
 
-std::size_t CpuExec::sort_unique(std::uint64_t* keys, std::size_t n) const {
-    if (n == 0) return 0;
-    ++host_waits_;
+void CpuExec::sort(std::uint64_t* keys, std::size_t n) const {
     if (n > 1 << 14 && threads_ > 1)
         __gnu_parallel::sort(keys, keys + n, __gnu_parallel::multiway_mergesort_tag(static_cast<__gnu_parallel::_ThreadIndex>(threads_)));
     else
         std::sort(keys, keys + n);
-    return static_cast<std::size_t>(std::unique(keys, keys + n) - keys);
 }
 
 std::uint64_t CpuExec::exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {

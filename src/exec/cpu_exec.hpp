@@ -81,8 +81,8 @@ public:
         for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
     }
 
-    /// @brief Sorts keys[0, n) ascending and removes repeats; returns the unique count.
-    std::size_t sort_unique(std::uint64_t* keys, std::size_t n) const;
+    /// @brief Sorts keys[0, n) ascending.
+    void sort(std::uint64_t* keys, std::size_t n) const;
 
     /// @brief out[i] = sum of in[0, i); returns the total.
     std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const;
@@ -91,7 +91,7 @@ public:
     void upload(T* device, const T* host, std::size_t n) const {
         if (n) std::memcpy(device, host, n * sizeof(T));
     }
-    /// @brief Copies out of the backend's memory. Like sort_unique and exclusive_scan, whose results
+    /// @brief Copies out of the backend's memory. Like exclusive_scan, whose result
     /// the host reads, it is a point where the GPU backend waits for the device: counted here too, so
     /// both backends report the same number of host waits.
     template <class T>

@@ -166,22 +166,15 @@ public:
         return kernel_limit >= 32 ? kernel_limit / 32 * 32 : kernel_limit; // whole warps
     }
 
-    std::size_t sort_unique(std::uint64_t* keys, std::size_t n) const {
-        if (n == 0) return 0;
+    void sort(std::uint64_t* keys, std::size_t n) const {
+        if (n < 2) return;
         sorted_.resize_discard(n);
-        unique_count_.resize_discard(1);
-        std::size_t sort_bytes = 0, unique_bytes = 0;
-        cub::DeviceRadixSort::SortKeys(nullptr, sort_bytes, keys, sorted_.data(), n, 0, 64, stream_);
-        cub::DeviceSelect::Unique(nullptr, unique_bytes, sorted_.data(), keys, unique_count_.data(), n, stream_);
-        temp_.resize_discard(sort_bytes > unique_bytes ? sort_bytes : unique_bytes);
-        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), sort_bytes, keys, sorted_.data(), n, 0, 64, stream_),
+        std::size_t bytes = 0;
+        cub::DeviceRadixSort::SortKeys(nullptr, bytes, keys, sorted_.data(), n, 0, 64, stream_);
+        temp_.resize_discard(bytes);
+        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, keys, sorted_.data(), n, 0, 64, stream_),
                    "radix sort");
-        cuda_check(
-            cub::DeviceSelect::Unique(temp_.data(), unique_bytes, sorted_.data(), keys, unique_count_.data(), n, stream_),
-            "unique");
-        unsigned long long count = 0;
-        download(&count, unique_count_.data(), 1);
-        return static_cast<std::size_t>(count);
+        copy(keys, sorted_.data(), n);
     }
 
     std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
@@ -234,7 +227,7 @@ public:
 
     /// @brief Bytes of the scratch buffers CUB needs, for memory reports (device memory only).
     std::size_t scratch_bytes() const {
-        return temp_.capacity_bytes() + sorted_.capacity_bytes() + unique_count_.capacity_bytes();
+        return temp_.capacity_bytes() + sorted_.capacity_bytes();
     }
 
 private:
@@ -249,7 +242,6 @@ private:
     mutable std::uint64_t host_waits_ = 0;
     mutable DeviceBuffer<unsigned char> temp_;
     mutable DeviceBuffer<std::uint64_t> sorted_;
-    mutable DeviceBuffer<unsigned long long> unique_count_;
 };
 
 } // namespace kdet

@@ -12,6 +12,7 @@
 #include "grid/hash.hpp"
 
 #include <cstdint>
+#include <cstring>
 
 namespace kdet {
 
@@ -40,11 +41,18 @@ KDET_HD inline int layer_of(const GridParams& grid, float diameter) {
     return layer;
 }
 
+/// @brief 2^-layer as a float, built from its bits (exact for 0 <= layer < 127).
+KDET_HD inline float layer_scale(int layer) {
+    const std::uint32_t bits = static_cast<std::uint32_t>(127 - layer) << 23;
+    float scale;
+    memcpy(&scale, &bits, sizeof scale);
+    return scale;
+}
+
 /// @brief Cell index along one axis on `layer`; monotone in x, clamped, and safe for NaN.
 KDET_HD inline std::uint32_t cell_index(const GridParams& grid, float x, float origin, int layer) {
     // Scaling by a power of two keeps the map monotone, which the completeness argument needs.
-    float scaled = (x - origin) * grid.inv_cell_size0;
-    for (int l = 0; l < layer; ++l) scaled *= 0.5f;
+    float scaled = (x - origin) * grid.inv_cell_size0 * layer_scale(layer);
     const float limit = 1073741824.0f; // 2^30: stays exact and inside uint32
     if (!(scaled >= 0.0f)) scaled = 0.0f;
     if (scaled > limit) scaled = limit;

@@ -4,6 +4,7 @@
 /// in an OpenMP loop and the CUDA layer runs as a kernel. Views hold raw pointers and counts only.
 
 #include "geometry/enclosing_sphere.hpp"
+#include "geometry/face_planes.hpp"
 #include "geometry/tet_intersect.hpp"
 #include "grid/bucket_table.hpp"
 
@@ -35,6 +36,7 @@ struct SceneView {
     const TetIndices* tets;
     const std::uint32_t* tet_object;
     TetInfo* info;
+    TetPlanes* planes; ///< per tet, for the pre-test; computed for the tets that can collide this frame
     const std::uint8_t* pair_active; ///< [object_count * object_count]; diagonal = self-collision
     const Aabb* object_boxes;
     std::uint32_t tet_count;
@@ -65,18 +67,42 @@ KDET_HD inline std::uint64_t pair_key(std::uint32_t t, std::uint32_t u) {
 KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
 KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
 
-/// @brief The predicate every method applies to a pair that may collide: adjacency, boxes, narrow phase.
-/// The lower stored id always goes first so every method sees the same floating-point computation.
-/// `exact_stage` is set when the pair reached the exact stage of NarrowPhase::exact.
-KDET_HD inline bool tets_collide(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u,
-                                 bool& exact_stage) {
-    const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
-    if (s.tet_object[first] == s.tet_object[second] && share_vertex(s.tets[first], s.tets[second])) return false;
-    if (!boxes_overlap(s.info[first].box, s.info[second].box)) return false;
+/// @brief The narrow-phase test alone on stored tets first < second: the lower stored id goes first, so
+/// every method sees the same floating-point computation. `exact_stage` is set when the pair reached
+/// the exact stage of NarrowPhase::exact.
+KDET_HD inline bool test_pair(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second,
+                              bool& exact_stage) {
     vec3 a[4], b[4];
     load_tet(s, first, a);
     load_tet(s, second, b);
     return tets_intersect(test, a, b, exact_stage);
+}
+
+/// @brief The decision for a pair whose boxes overlap and that is not adjacent (first < second): the
+/// face-plane pre-test where it is sure (the answer the test gives, see face_planes.hpp), else the test.
+KDET_HD inline bool candidate_collides(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second,
+                                       bool& exact_stage) {
+    vec3 a[4], b[4];
+    load_tet(s, first, a);
+    load_tet(s, second, b);
+    const PlaneVerdict verdict = face_plane_pretest(s.planes[first], a, s.planes[second], b, false);
+    if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
+    return tets_intersect(test, a, b, exact_stage);
+}
+
+/// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, and
+/// their boxes overlap.
+KDET_HD inline bool may_collide(const SceneView& s, std::uint32_t first, std::uint32_t second) {
+    if (s.tet_object[first] == s.tet_object[second] && share_vertex(s.tets[first], s.tets[second])) return false;
+    return boxes_overlap(s.info[first].box, s.info[second].box);
+}
+
+/// @brief The brute-force methods' predicate: adjacency, boxes, then the test itself, without the
+/// pre-test, so that they stay the oracle the grid methods (which use it) are compared with.
+KDET_HD inline bool tets_collide_tested(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u,
+                                       bool& exact_stage) {
+    const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
+    return may_collide(s, first, second) && test_pair(s, test, first, second, exact_stage);
 }
 
 /// @brief Stage 1: box of each tet; no size and no layer yet.
@@ -148,6 +174,7 @@ struct TetSizeKernel {
         load_tet(scene, static_cast<std::uint32_t>(t), v);
         info.diameter = enclosing_sphere_diameter(v);
         info.layer = 0;
+        scene.planes[t] = tet_planes(v);
         // Reading first keeps the atomics few: after the first tets, almost none widens the range.
         const std::uint32_t size = float_to_ordered(info.diameter);
         if (size < atomic_load_acquire(min_size)) atomic_min(min_size, size);
@@ -155,25 +182,58 @@ struct TetSizeKernel {
     }
 };
 
-/// @brief Stage 2: picks each relevant tet's layer and inserts it into every cell its box overlaps.
+/// @brief Stage 2, before populating: picks each relevant tet's layer and counts, per layer, the
+/// cells the tets there will be inserted into, so that the host can size the table before filling it.
+/// One work item per chunk of tets; neighbouring tets (spatial order) mostly share a layer, so a
+/// count is added atomically only when the layer changes along the chunk.
+struct GridPlanKernel {
+    SceneView scene;
+    GridParams params;
+    std::uint32_t chunk;
+    unsigned long long* layer_entries; ///< [max_grid_layers]
+    std::uint32_t* layer_mask;
+
+    KDET_HD void operator()(std::uint64_t c) const {
+        const std::uint64_t begin = c * chunk;
+        const std::uint64_t end = begin + chunk < scene.tet_count ? begin + chunk : scene.tet_count;
+        int run_layer = -1;
+        unsigned long long run_entries = 0;
+        std::uint32_t mask = 0;
+        for (std::uint64_t t = begin; t < end; ++t) {
+            TetInfo& info = scene.info[t];
+            if (info.layer < 0) continue;
+            const int layer = layer_of(params, info.diameter);
+            info.layer = layer;
+            const CellRange r = cell_range(params, info.box, layer);
+            if (layer != run_layer) {
+                if (run_entries) atomic_fetch_add(&layer_entries[run_layer], run_entries);
+                run_layer = layer;
+                run_entries = 0;
+            }
+            run_entries += static_cast<unsigned long long>(r.hi[0] - r.lo[0] + 1) * (r.hi[1] - r.lo[1] + 1) *
+                           (r.hi[2] - r.lo[2] + 1);
+            mask |= 1u << layer;
+        }
+        if (run_entries) atomic_fetch_add(&layer_entries[run_layer], run_entries);
+        if (mask) atomic_fetch_or(layer_mask, mask);
+    }
+};
+
+/// @brief Stage 2: inserts each relevant tet into every cell its box overlaps on its layer. Once an
+/// insert has failed (the table must grow), the remaining tets give up at once: the pass reruns anyway.
 struct PopulateKernel {
     SceneView scene;
     GridView grid;
     GridParams params;
-    std::uint32_t* layer_mask;
 
     KDET_HD void operator()(std::uint64_t t) const {
-        TetInfo& info = scene.info[t];
-        if (info.layer < 0) return;
-        const int layer = layer_of(params, info.diameter);
-        info.layer = layer;
-        const std::uint32_t bit = 1u << layer;
-        if (!(atomic_load_acquire(layer_mask) & bit)) atomic_fetch_or(layer_mask, bit);
-        const CellRange r = cell_range(params, info.box, layer);
+        const TetInfo& info = scene.info[t];
+        if (info.layer < 0 || atomic_load_acquire(grid.failure)) return;
+        const CellRange r = cell_range(params, info.box, info.layer);
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
-                    if (!grid_insert(grid, make_cell(x, y, z, layer), static_cast<std::uint32_t>(t))) return;
+                    if (!grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t))) return;
     }
 };
 
@@ -210,10 +270,11 @@ struct LargerNeighbourFilter {
     KDET_HD void operator()(std::uint32_t u) const {
         // A cell holds only tets of its own layer, so the tie-break needs no load of u's data.
         if (same_layer && u <= t) return;
-        if (!pair_is_active(*scene, object, scene->tet_object[u])) return;
+        // Most entries fail the box test, so it comes before anything that loads more of u's data.
         const Aabb& other = scene->info[u].box;
         if (!boxes_overlap(box, other)) return;
         if (!reports_from_this_cell(other)) return;
+        if (!pair_is_active(*scene, object, scene->tet_object[u])) return;
         (*visit)(u);
     }
 };
@@ -273,13 +334,16 @@ struct KeyBatch {
     }
 };
 
-/// @brief Stage 3 (kdet): writes candidate pairs, duplicates included.
+/// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the face-plane pre-test cannot
+/// prove separated (those it can are only counted): a rejected pair is never written, sorted or
+/// loaded again.
 struct FindCandidatesKernel {
     SceneView scene;
     GridView grid;
     GridParams params;
     std::uint32_t layer_mask;
     KeyAppender out;
+    unsigned long long* rejected; ///< pairs the pre-test proved separated
 
     struct Emit {
         const SceneView* scene;
@@ -287,18 +351,31 @@ struct FindCandidatesKernel {
         std::uint32_t t;
         TetIndices tet;
         std::uint32_t object;
-        KDET_HD void operator()(std::uint32_t u) const {
-            if (scene->tet_object[u] == object && share_vertex(tet, scene->tets[u])) return;
+        vec3 vertices[4];
+        TetPlanes planes;
+        unsigned long long rejected;
+        KDET_HD void operator()(std::uint32_t u) {
+            const TetIndices other = scene->tets[u];
+            if (scene->tet_object[u] == object && share_vertex(tet, other)) return;
+            vec3 w[4];
+            for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
+            if (face_plane_pretest(planes, vertices, scene->planes[u], w, true) == PlaneVerdict::separated) {
+                ++rejected;
+                return;
+            }
             batch->push(pair_key(t, u));
         }
     };
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto t = static_cast<std::uint32_t>(i);
+        if (scene.info[t].layer < 0) return;
         KeyBatch batch(&out);
-        Emit emit{&scene, &batch, t, scene.tets[t], scene.tet_object[t]};
+        Emit emit{&scene, &batch, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
+        load_tet(scene, t, emit.vertices);
         for_each_larger_neighbour(scene, grid, params, layer_mask, t, emit);
         batch.flush();
+        if (emit.rejected) atomic_fetch_add(rejected, emit.rejected);
     }
 };
 
@@ -323,8 +400,10 @@ struct NoPairsKernel {
             std::uint32_t* flags = kernel->colliding;
             if (atomic_load_acquire(&flags[t]) && atomic_load_acquire(&flags[u])) return;
             ++tests;
+            const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
             bool reached_exact = false;
-            if (tets_collide(kernel->scene, kernel->test, t, u, reached_exact)) {
+            if (may_collide(kernel->scene, first, second) &&
+                candidate_collides(kernel->scene, kernel->test, first, second, reached_exact)) {
                 atomic_store_relaxed(&flags[t], 1u);
                 atomic_store_relaxed(&flags[u], 1u);
             }
@@ -358,7 +437,7 @@ struct BruteForceLoopKernel {
             const std::uint32_t begin = other == object ? t + 1 : object_tet_begin[other];
             for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u) {
                 bool reached_exact = false;
-                if (tets_collide(scene, test, t, u, reached_exact)) batch.push(pair_key(t, u));
+                if (tets_collide_tested(scene, test, t, u, reached_exact)) batch.push(pair_key(t, u));
                 exact_stage += reached_exact;
             }
         }
@@ -403,15 +482,18 @@ struct BruteForcePairsKernel {
         const auto t = static_cast<std::uint32_t>(object_tet_begin[oa] + i);
         const auto u = static_cast<std::uint32_t>(object_tet_begin[ob] + j);
         bool reached_exact = false;
-        if (tets_collide(scene, test, t, u, reached_exact)) out.push(pair_key(t, u));
+        if (tets_collide_tested(scene, test, t, u, reached_exact)) out.push(pair_key(t, u));
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull);
     }
 };
 
-/// @brief Stage 5: runs the narrow phase once per unique candidate and flags colliding tets.
+/// @brief Stage 5: decides each candidate once and flags colliding tets. The grid methods decide with
+/// candidate_collides (their tets have face planes); brute force, whose pairs come tested, with the
+/// test alone.
 struct NarrowPhaseKernel {
     SceneView scene;
     NarrowPhase test;
+    bool pretest;
     const std::uint64_t* keys;
     std::uint32_t* hit;
     std::uint32_t* colliding;
@@ -419,11 +501,9 @@ struct NarrowPhaseKernel {
 
     KDET_HD void operator()(std::uint64_t k) const {
         const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
-        vec3 a[4], b[4];
-        load_tet(scene, t, a);
-        load_tet(scene, u, b);
         bool reached_exact = false;
-        const bool collides = tets_intersect(test, a, b, reached_exact);
+        const bool collides = pretest ? candidate_collides(scene, test, t, u, reached_exact)
+                                      : test_pair(scene, test, t, u, reached_exact);
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
         hit[k] = collides ? 1u : 0u;
         if (!collides) return;

@@ -17,6 +17,7 @@ namespace kdet {
 struct FrameCounters {
     unsigned long long candidates;
     unsigned long long tests_run;
+    unsigned long long rejected; ///< candidate pairs the face-plane pre-test proved separated
     unsigned long long exact_stage_pairs; ///< pairs that reached the exact stage of NarrowPhase::exact
     std::uint32_t grid_failure;
     std::uint32_t overflow_used;
@@ -25,6 +26,7 @@ struct FrameCounters {
     std::uint32_t cells_claimed;
     std::uint32_t min_size; ///< float_to_ordered, over the relevant tets
     std::uint32_t max_size;
+    unsigned long long layer_entries[max_grid_layers]; ///< cell entries the relevant tets need, per layer
 };
 
 template <class Exec>
@@ -53,6 +55,7 @@ public:
         exec_.upload(object_tet_begin_.data(), topology.object_tet_begin.data(), topology.object_tet_begin.size());
         positions_.resize_discard(topology.vertex_count);
         info_.resize_discard(tets);
+        planes_.resize_discard(tets);
         colliding_.resize_discard(tets);
         user_colliding_.resize_discard(tets);
         user_flags_set_ = true; // new memory: unknown until cleared
@@ -82,7 +85,7 @@ public:
     std::size_t memory_bytes() const override {
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
                user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() +
-               info_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
+               info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                bounds_.capacity_bytes() + object_boxes_.capacity_bytes() + pair_active_.capacity_bytes() +
                headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + hit_.capacity_bytes() + position_.capacity_bytes() +
@@ -97,7 +100,7 @@ public:
 
 private:
     SceneView scene_view() {
-        return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), pair_active_.data(),
+        return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), pair_active_.data(),
                          object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
                          static_cast<std::uint32_t>(bounds_.size())};
     }
@@ -118,12 +121,14 @@ private:
 
     bool compute_bounds_and_culling(const std::vector<std::uint8_t>& pair_enabled);
     bool size_relevant_tets();
+    void plan_grid();
     GridView populate(FrameCounts& counts);
     template <class Launch>
-    void append_candidates_growing(const Launch& launch, FrameCounts& counts);
+    FrameCounters append_candidates_growing(const Launch& launch, FrameCounts& counts);
     void find_candidates(const GridView& grid, FrameCounts& counts);
     void brute_force(FrameCounts& counts);
-    void narrow_phase_and_compact(std::size_t unique, FrameResult& result);
+    std::size_t narrow_phase(std::size_t candidates, FrameCounts& counts);
+    void contacts_and_pairs(std::size_t colliding, FrameResult& result);
     void count_and_copy_flags(bool any, FrameResult& result);
     KeyAppender candidate_appender() {
         return KeyAppender{candidates_.data(), candidates_.size(), &counters_.data()->candidates};
@@ -131,7 +136,7 @@ private:
     void ensure_candidate_capacity(std::size_t relevant_tets);
 
     /// Marks between the stages of a frame, for StageTimes.
-    enum StageMark { frame_start, boxes_done, grid_done, candidates_done, sorted, narrow_phase_done, frame_end };
+    enum StageMark { frame_start, boxes_done, grid_done, candidates_done, narrow_phase_done, sorted, results_done, frame_end };
 
     Exec exec_;
     typename Exec::stage_clock clock_; // kept between frames: on the GPU it holds CUDA events, created once
@@ -141,6 +146,7 @@ private:
     std::uint32_t stamp_ = 0;
     std::size_t relevant_estimate_ = 0;
     vec3 grid_origin_{};
+    vec3 grid_extent_{}; ///< of the region that is gridded (the boxes of the objects that can collide)
 
     buffer<TetIndices> tets_;
     buffer<std::uint32_t> tet_object_;
@@ -149,6 +155,7 @@ private:
     buffer<std::uint32_t> stored_id_; ///< caller's global id -> stored tet
     buffer<vec3> positions_;
     buffer<TetInfo> info_;
+    buffer<TetPlanes> planes_;
     buffer<std::uint32_t> colliding_;      ///< per stored tet
     buffer<std::uint32_t> user_colliding_; ///< per tet in the caller's numbering
     buffer<ObjectBounds> bounds_;
@@ -215,12 +222,15 @@ bool Pipeline<Exec>::compute_bounds_and_culling(const std::vector<std::uint8_t>&
 
     const float inf = std::numeric_limits<float>::infinity();
     grid_origin_ = vec3{inf, inf, inf};
+    vec3 grid_top{-inf, -inf, -inf};
     relevant_estimate_ = 0;
     for (std::size_t o = 0; o < objects; ++o) {
         if (!involved[o]) continue;
         grid_origin_ = min_v(grid_origin_, boxes[o].lo);
+        grid_top = max_v(grid_top, boxes[o].hi);
         relevant_estimate_ += topology_.object_tet_begin[o + 1] - topology_.object_tet_begin[o];
     }
+    grid_extent_ = grid_top - grid_origin_;
     return true;
 }
 
@@ -251,14 +261,45 @@ bool Pipeline<Exec>::size_relevant_tets() {
     return true;
 }
 
+/// @brief Stage 2: each relevant tet's layer, and a table large enough for the cells they need.
+/// A cell holds at least one entry and lies in the gridded region, so per layer the occupied cells
+/// are at most the entries and at most the region's cells; the table gets a quarter more slots than
+/// that bound (probing stays short), and the overflow pool one bucket per bucket_capacity entries,
+/// which holds every chain whatever the cells' fill. Both only grow, so a scene that keeps its size
+/// sizes them once.
+template <class Exec>
+void Pipeline<Exec>::plan_grid() {
+    reset_counters();
+    FrameCounters* c = counters_.data();
+    constexpr std::uint32_t chunk = 256;
+    exec_.for_each((tets_.size() + chunk - 1) / chunk,
+                   GridPlanKernel{scene_view(), params_, chunk, c->layer_entries, &c->layer_mask});
+    const FrameCounters plan = read_counters();
+    layer_mask_ = plan.layer_mask;
+
+    double cells = 0.0, entries = 0.0;
+    for (int layer = 0; layer < params_.layer_count; ++layer) {
+        const double n = static_cast<double>(plan.layer_entries[layer]);
+        if (n == 0.0) continue;
+        const double cell = std::ldexp(static_cast<double>(params_.cell_size0), layer);
+        double region = 1.0;
+        for (int a = 0; a < 3; ++a) region *= std::floor(static_cast<double>(component(grid_extent_, a)) / cell) + 2.0;
+        cells += std::min(n, region);
+        entries += n;
+    }
+    const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
+    std::uint32_t wanted_slots = 1024;
+    while (wanted_slots < 1.25 * cells && wanted_slots < (1u << 30)) wanted_slots *= 2;
+    const double wanted_pool = std::min(std::ceil(entries / capacity) + 1.0, static_cast<double>(1u << 30));
+    slot_count_ = std::max(slot_count_, wanted_slots);
+    overflow_capacity_ = std::max(overflow_capacity_, static_cast<std::uint32_t>(wanted_pool));
+}
+
 /// @brief Stage 2: fills the hash table; grows it and reruns when probing or the overflow pool fails.
 template <class Exec>
 GridView Pipeline<Exec>::populate(FrameCounts& counts) {
+    plan_grid();
     const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
-    std::uint32_t wanted_slots = 1024;
-    while (wanted_slots < relevant_estimate_ / 8 && wanted_slots < (1u << 30)) wanted_slots *= 2;
-    slot_count_ = std::max(slot_count_, wanted_slots);
-    overflow_capacity_ = std::max(overflow_capacity_, slot_count_ / 4);
     for (;;) {
         const std::size_t buckets = static_cast<std::size_t>(slot_count_) + overflow_capacity_;
         if (headers_.size() != buckets) {
@@ -277,10 +318,9 @@ GridView Pipeline<Exec>::populate(FrameCounts& counts) {
         while ((1u << slot_bits) < slot_count_) ++slot_bits;
         GridView grid{headers_.data(), ids_.data(), &c->overflow_used, &c->grid_failure, &c->cells_claimed,
                       slot_count_, slot_bits, capacity, overflow_capacity_, stamp_, 64u, options_.hash};
-        exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, params_, &c->layer_mask});
+        exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, params_});
         const FrameCounters after = read_counters();
         if (!after.grid_failure) {
-            layer_mask_ = after.layer_mask;
             counts.grid_cells = after.cells_claimed;
             counts.grid_slots = slot_count_;
             counts.grid_overflow_buckets = after.overflow_used;
@@ -303,30 +343,34 @@ void Pipeline<Exec>::ensure_candidate_capacity(std::size_t relevant_tets) {
 
 /// @brief Runs a stage that appends to the candidate buffer until the buffer held everything: an
 /// overflowing run still counts what it needed, so the buffer grows to that size and the stage reruns.
+/// Returns the counters of the last run.
 template <class Exec>
 template <class Launch>
-void Pipeline<Exec>::append_candidates_growing(const Launch& launch, FrameCounts& counts) {
+FrameCounters Pipeline<Exec>::append_candidates_growing(const Launch& launch, FrameCounts& counts) {
     for (;;) {
         reset_counters();
         launch(candidate_appender());
         const FrameCounters after = read_counters();
         counts.candidates = after.candidates;
         counts.exact_stage_pairs = after.exact_stage_pairs; // brute force tests while it appends
-        if (after.candidates <= candidates_.size()) return;
+        if (after.candidates <= candidates_.size()) return after;
         candidates_.resize_discard(after.candidates + after.candidates / 4);
         ++counts.buffer_regrows;
     }
 }
 
-/// @brief Stage 3: candidate pairs with duplicates.
+/// @brief Stage 3: candidate pairs, each written once.
 template <class Exec>
 void Pipeline<Exec>::find_candidates(const GridView& grid, FrameCounts& counts) {
     ensure_candidate_capacity(relevant_estimate_);
-    append_candidates_growing(
+    const FrameCounters after = append_candidates_growing(
         [&](const KeyAppender& out) {
-            exec_.for_each(tets_.size(), FindCandidatesKernel{scene_view(), grid, params_, layer_mask_, out});
+            exec_.for_each(tets_.size(), FindCandidatesKernel{scene_view(), grid, params_, layer_mask_, out,
+                                                              &counters_.data()->rejected});
         },
         counts);
+    counts.unique_candidates = counts.candidates;
+    counts.candidates += after.rejected;
 }
 
 /// @brief Both brute-force methods: every pair of enabled objects is tested, colliding pairs appended.
@@ -369,28 +413,35 @@ void Pipeline<Exec>::brute_force(FrameCounts& counts) {
         counts);
 }
 
-/// @brief Stage 5: the narrow phase once per unique candidate; then (stage 6) the colliding pairs
-/// under the caller's tet ids in sorted order, and their contacts.
+/// @brief Stage 5: the narrow phase once per candidate (they are unique, see LargerNeighbourFilter, so
+/// they need no sorting); the colliding pairs are compacted and renamed to the caller's tet ids.
+/// Returns their number.
 template <class Exec>
-void Pipeline<Exec>::narrow_phase_and_compact(std::size_t unique, FrameResult& result) {
-    hit_.resize_discard(unique);
-    position_.resize_discard(unique);
+std::size_t Pipeline<Exec>::narrow_phase(std::size_t candidates, FrameCounts& counts) {
+    hit_.resize_discard(candidates);
+    position_.resize_discard(candidates);
+    const bool grid_method = options_.method == Method::kdet || options_.method == Method::kdet_no_pairs;
     const bool exact = options_.narrow_phase == NarrowPhase::exact;
     if (exact) reset_counters();
-    exec_.for_each(unique, NarrowPhaseKernel{scene_view(), options_.narrow_phase, candidates_.data(), hit_.data(),
-                                             colliding_.data(), &counters_.data()->exact_stage_pairs});
-    if (exact) result.counts.exact_stage_pairs = read_counters().exact_stage_pairs;
-    const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), unique);
+    exec_.for_each(candidates, NarrowPhaseKernel{scene_view(), options_.narrow_phase, grid_method, candidates_.data(),
+                                                 hit_.data(), colliding_.data(), &counters_.data()->exact_stage_pairs});
+    if (exact) counts.exact_stage_pairs = read_counters().exact_stage_pairs;
+    const std::size_t colliding = exec_.exclusive_scan(hit_.data(), position_.data(), candidates);
     out_keys_.resize_discard(colliding);
-    exec_.for_each(unique, CompactKernel{candidates_.data(), hit_.data(), position_.data(), out_keys_.data()});
+    exec_.for_each(candidates, CompactKernel{candidates_.data(), hit_.data(), position_.data(), out_keys_.data()});
     exec_.for_each(colliding, UserPairKernel{user_id_.data(), out_keys_.data()});
-    exec_.sort_unique(out_keys_.data(), colliding); // renaming keeps pairs distinct: only the order changes
+    colliding_count_ = colliding;
+    return colliding;
+}
+
+/// @brief Stage 6: contacts of the sorted colliding pairs, and the pairs copied out when results go
+/// to the host.
+template <class Exec>
+void Pipeline<Exec>::contacts_and_pairs(std::size_t colliding, FrameResult& result) {
     if (options_.contacts) {
         out_contacts_.resize_discard(colliding);
         exec_.for_each(colliding, ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), out_contacts_.data()});
     }
-
-    colliding_count_ = colliding;
     result.counts.colliding_pairs = colliding;
     if (!options_.results_to_host) return;
     std::vector<std::uint64_t> keys(colliding);
@@ -482,11 +533,13 @@ void Pipeline<Exec>::detect(const std::vector<PositionUpload>& uploads, const st
         }
         clock_.mark(candidates_done);
         if (method != Method::kdet_no_pairs) {
-            const std::size_t unique = exec_.sort_unique(candidates_.data(), counts.candidates);
-            counts.unique_candidates = unique;
-            clock_.mark(sorted);
-            narrow_phase_and_compact(unique, result);
+            if (!grid_method) counts.unique_candidates = counts.candidates;
+            const std::size_t colliding = narrow_phase(counts.unique_candidates, counts);
             clock_.mark(narrow_phase_done);
+            exec_.sort(out_keys_.data(), colliding); // the deterministic output order
+            clock_.mark(sorted);
+            contacts_and_pairs(colliding, result);
+            clock_.mark(results_done);
         }
     }
 
@@ -500,8 +553,8 @@ void Pipeline<Exec>::detect(const std::vector<PositionUpload>& uploads, const st
     t.bounding_boxes = clock_.between_ms(frame_start, boxes_done);
     t.populate_grid = clock_.between_ms(boxes_done, grid_done);
     t.find_candidates = clock_.between_ms(grid_method ? grid_done : boxes_done, candidates_done);
-    t.sort_unique = clock_.between_ms(candidates_done, sorted);
-    t.narrow_phase = clock_.between_ms(sorted, narrow_phase_done);
+    t.sort_unique = clock_.between_ms(narrow_phase_done, sorted);
+    t.narrow_phase = clock_.between_ms(candidates_done, narrow_phase_done) + clock_.between_ms(sorted, results_done);
     t.total = clock_.between_ms(frame_start, frame_end);
     counts.host_waits = static_cast<std::uint32_t>(exec_.host_waits() - waits_before);
 }

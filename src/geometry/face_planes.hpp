@@ -1,0 +1,173 @@
+#pragma once
+/// @file face_planes.hpp
+/// @brief A pre-test for tet pairs from each tet's four face planes, computed once per tet and frame.
+/// It proves a pair separated (one tet lies beyond a face plane of the other) or intersecting (a vertex
+/// of one tet lies inside the other), each only by a margin far above every rounding involved, and
+/// leaves all other pairs to the narrow-phase test. So it never changes what a test reports.
+///
+/// Bounds, with u = 2^-24, L the pair's longest edge, l the plane owner's shortest edge, s = 1/64 the
+/// smallest sine between the two edges a used face normal is built from, and pairs whose boxes overlap
+/// (the pipeline runs the pre-test on no other), so every vertex lies within 2 sqrt(3) L of the owner's
+/// vertex 0, the origin of its planes:
+/// - Rounding of the pre-test. A signed distance dot(n, w - origin) - offset, with |n| = 1 within 2u,
+///   is off by at most 4u |w - origin| + 4u L + u |d| < 23u L (1.4e-6 L) from the exact distance to
+///   the stored plane (n, offset), and the stored offset is the owner's highest projection within 4u L.
+/// - Its normals against the true face normals. An owner edge is one rounded difference (error below
+///   3u L), so a normal is within (6u L / l + 3u) / s of the face's (below 2.3e-5 L / l + 1.2e-5).
+///   Over the 4.5 L that the projections of the pair span, that moves a distance by 1.1e-4 L^2 / l
+///   + 0.6e-4 L at most.
+/// - The float tests' own face axes. They build the same normal from the same two edges in the pair's
+///   frame (origin at the first tet's vertex 0, unit longest edge), where an edge of the other tet
+///   carries up to 14u L of rounding; their normal is within (34u L / l + 8u) / s of the pre-test's
+///   (1.3e-4 L / l + 3.1e-5), which moves a gap by 5.8e-4 L^2 / l + 1.4e-4 L at most.
+/// - The float tests' tolerance: a separation needs a gap above 32 eps L (3.8e-6 L).
+/// A face's margin is k_plane_margin L^2 / l, k_plane_margin = 2^-9 (1.95e-3), more than 2.5 times
+/// what the first, third and fourth add up to (7.3e-4 L^2 / l at most, as l <= L), so a pair the
+/// pre-test separates shows a gap above 1.2e-3 L^2 / l
+/// along a face axis that sat, sat_no_edges and sat_mtv compute and report as separating. A vertex
+/// found inside all four planes of a tet whose opposite vertices lie below their faces by the margin
+/// (`solid`) lies inside the true tet by more than 1.7e-3 L^2 / l, so the tets overlap by that much
+/// along every axis. Both decisions are therefore true for the exact float input (the `exact` test
+/// agrees) and lie far inside the clear band (beyond 1e-5 L) where gjk and fast agree with CGAL
+/// (tests/cgal/test_narrow_phase_cgal.cpp), and no test misses an intersecting pair.
+///
+/// The bounds need every intermediate value normal: a tet is used only when its coordinates relative
+/// to its vertex 0 lie within [2^-60, 2^60] in magnitude and its shortest edge is at least 2^-20 of
+/// its longest (a thinner tet's margin exceeds what any pair could show anyway). Its normals are built
+/// from the edges scaled by a power of two (exact), so no square underflows or overflows. An unused
+/// tet gets an infinite margin scale: every margin involving it is infinite or NaN, and decides nothing.
+
+#include "geometry/vec3.hpp"
+
+#include <cstdint>
+
+namespace kdet {
+
+/// @brief Margin of the pre-test in units of L^2 / l_min (see the file comment).
+constexpr float k_plane_margin = 1.0f / 512.0f;
+
+/// @brief Faces whose two normal-building edges meet at an angle with a smaller sine are not used.
+constexpr float k_plane_min_sine = 1.0f / 64.0f;
+
+/// @brief A tet is used when its largest coordinate relative to its vertex 0 lies within
+/// [2^-k_plane_exponent_range, 2^k_plane_exponent_range] ...
+constexpr int k_plane_exponent_range = 60;
+
+/// @brief ... and its shortest edge is at least this fraction of its longest.
+constexpr float k_plane_min_edge_ratio = 0x1p-20f;
+
+/// @brief The four face planes of one tet, relative to its vertex 0, coordinate by coordinate so that
+/// the four faces are evaluated together (vector instructions on the CPU).
+struct TetPlanes {
+    float nx[4], ny[4], nz[4]; ///< unit normal of face k (opposite vertex k), pointing away from vertex k; 0 if unused
+    float offset[4];           ///< the tet's highest projection onto normal k, relative to origin
+    vec3 origin;               ///< the tet's vertex 0
+    float longest;             ///< longest edge
+    float margin_scale;        ///< k_plane_margin / shortest edge: a face's margin is margin_scale * L^2;
+                               ///< infinite for a tet the pre-test does not use
+    std::uint32_t solid;       ///< 1 when all four faces are used and each opposite vertex lies clearly below
+                               ///< its face: only then can the pre-test prove a vertex inside
+};
+
+/// @brief The face planes of tet v.
+KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
+    TetPlanes p;
+    p.origin = v[0];
+    const vec3 q[4] = {make_vec3(0.0f, 0.0f, 0.0f), v[1] - v[0], v[2] - v[0], v[3] - v[0]};
+    float largest = 0.0f;
+    for (int i = 1; i < 4; ++i) largest = max_f(largest, max_f(fabsf(q[i].x), max_f(fabsf(q[i].y), fabsf(q[i].z))));
+    int exponent = 0;
+    frexpf(largest, &exponent);
+    // Scaled by a power of two, edges keep their exact directions and ratios, and their squares stay normal.
+    const float scale = ldexpf(1.0f, -exponent);
+    vec3 e[4];
+    for (int i = 0; i < 4; ++i) e[i] = q[i] * scale;
+    float longest2 = 0.0f, shortest2 = 3.4e38f;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+            const float l2 = length_squared(e[j] - e[i]);
+            longest2 = max_f(longest2, l2);
+            shortest2 = min_f(shortest2, l2);
+        }
+    p.longest = ldexpf(sqrtf(longest2), exponent);
+    const bool used = largest >= 0x1p-60f && largest <= 0x1p60f &&
+                      shortest2 >= k_plane_min_edge_ratio * k_plane_min_edge_ratio * longest2;
+    p.margin_scale = used ? k_plane_margin / ldexpf(sqrtf(shortest2), exponent) : INFINITY;
+    p.solid = used ? 1u : 0u;
+    for (int k = 0; k < 4; ++k) {
+        const vec3 a = e[(k + 1) & 3], b = e[(k + 2) & 3], c = e[(k + 3) & 3];
+        // The normal comes from the two edges at the face's largest angle (opposite its longest edge).
+        const vec3 ab = b - a, ac = c - a, bc = c - b;
+        const float lab = length_squared(ab), lac = length_squared(ac), lbc = length_squared(bc);
+        vec3 f = ab, g = ac;
+        float lf = lab, lg = lac;
+        if (lab >= lbc && lab >= lac) {
+            f = ac;
+            g = bc;
+            lf = lac;
+            lg = lbc;
+        } else if (lac >= lbc) {
+            g = bc;
+            lg = lbc;
+        }
+        vec3 n = cross(f, g);
+        const float n2 = length_squared(n);
+        if (!used || !(n2 > k_plane_min_sine * k_plane_min_sine * lf * lg)) {
+            p.nx[k] = p.ny[k] = p.nz[k] = p.offset[k] = 0.0f;
+            p.solid = 0u;
+            continue;
+        }
+        n = n * (1.0f / sqrtf(n2));
+        if (dot(n, e[k] - a) > 0.0f) n = -n;
+        float offset = 0.0f; // q[0] projects to 0
+        for (int i = 1; i < 4; ++i) offset = max_f(offset, dot(n, q[i]));
+        p.nx[k] = n.x;
+        p.ny[k] = n.y;
+        p.nz[k] = n.z;
+        p.offset[k] = offset;
+        if (!(offset - dot(n, q[k]) > p.margin_scale * p.longest * p.longest)) p.solid = 0u;
+    }
+    return p;
+}
+
+/// @brief What the four face planes of p show about the four vertices w, with a margin: whether all
+/// of w lies beyond one face plane (`separated`), and whether some vertex lies inside all four
+/// (`inside`). The four faces are evaluated side by side (vector instructions on the CPU).
+struct PlaneSides {
+    bool separated;
+    bool inside;
+};
+
+KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float margin) {
+    float nearest[4] = {3.4e38f, 3.4e38f, 3.4e38f, 3.4e38f};
+    int inside = 0;
+    for (int j = 0; j < 4; ++j) {
+        const vec3 r = w[j] - p.origin;
+        float distance[4];
+        for (int k = 0; k < 4; ++k) distance[k] = p.nx[k] * r.x + p.ny[k] * r.y + p.nz[k] * r.z - p.offset[k];
+        for (int k = 0; k < 4; ++k) nearest[k] = min_f(nearest[k], distance[k]);
+        const float farthest = max_f(max_f(distance[0], distance[1]), max_f(distance[2], distance[3]));
+        inside |= farthest < -margin ? 1 : 0;
+    }
+    int separated = 0;
+    for (int k = 0; k < 4; ++k) separated |= nearest[k] > margin ? 1 : 0;
+    return PlaneSides{separated != 0, inside != 0 && p.solid != 0};
+}
+
+/// @brief What the face planes prove about two tets whose boxes overlap.
+enum class PlaneVerdict { unsure, separated, intersecting };
+
+/// @brief The face-plane pre-test of tets a and b (with their planes pa and pb). With
+/// `separation_only`, an intersection is not looked for (the caller only rejects).
+KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
+                                               const vec3 b[4], bool separation_only) {
+    const float longest = max_f(pa.longest, pb.longest);
+    const PlaneSides b_by_a = plane_sides(pa, b, pa.margin_scale * longest * longest);
+    if (b_by_a.separated) return PlaneVerdict::separated;
+    const PlaneSides a_by_b = plane_sides(pb, a, pb.margin_scale * longest * longest);
+    if (a_by_b.separated) return PlaneVerdict::separated;
+    if (!separation_only && (b_by_a.inside || a_by_b.inside)) return PlaneVerdict::intersecting;
+    return PlaneVerdict::unsure;
+}
+
+} // namespace kdet

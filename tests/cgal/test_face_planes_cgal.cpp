@@ -1,0 +1,96 @@
+/// @file test_face_planes_cgal.cpp
+/// @brief The face-plane pre-test (src/geometry/face_planes.hpp) against CGAL's exact predicate and
+/// against every narrow-phase test: wherever it decides a pair, it must give the exact answer and the
+/// answer of every test, in both argument orders, so that running it first changes no reported pair.
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include "geometry/face_planes.hpp"
+#include "geometry/tet_intersect.hpp"
+#include "../near_touching.hpp"
+#include "narrow_cases.hpp"
+
+namespace {
+
+using kdet::NarrowPhase;
+using kdet::PlaneVerdict;
+using namespace kdet::cgal_check;
+
+/// The pre-test's verdict on a pair (both argument orders) where it decides, against CGAL and every
+/// test; counts the decisions and prints the first few disagreements.
+struct VerdictCheck {
+    std::vector<NarrowPhase> tests = kdet::test::every_narrow_phase_test();
+    long long pairs = 0, separated = 0, intersecting = 0, wrong = 0;
+
+    void check(const kdet::vec3 a[4], const kdet::vec3 b[4], bool truth, const char* what) {
+        ++pairs;
+        const kdet::TetPlanes pa = kdet::tet_planes(a), pb = kdet::tet_planes(b);
+        const PlaneVerdict verdict = kdet::face_plane_pretest(pa, a, pb, b, false);
+        EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, true) == PlaneVerdict::separated,
+                  verdict == PlaneVerdict::separated);
+        if (verdict == PlaneVerdict::unsure) return;
+        const bool said = verdict == PlaneVerdict::intersecting;
+        ++(said ? intersecting : separated);
+        bool agree = said == truth;
+        for (NarrowPhase test : tests)
+            agree = agree && kdet::tets_intersect(test, a, b) == said && kdet::tets_intersect(test, b, a) == said;
+        if (!agree && ++wrong <= 5)
+            std::printf("pre-test says %s, CGAL %d: %s\n", said ? "intersecting" : "separated", truth, what);
+    }
+};
+
+TEST(FacePlanesCgal, DecidesOnlyWhereTheOracleAndEveryTestAgree) {
+    const std::vector<Case> cases = generate_cases(0x70726574u, 1500);
+    VerdictCheck check;
+    ASSERT_GE(check.tests.size(), 5u);
+    for (const Case& c : cases) {
+        // The pipeline runs the pre-test on pairs whose boxes overlap only (its bounds rely on it).
+        if (!kdet::boxes_overlap(kdet::tet_box(c.a), kdet::tet_box(c.b))) continue;
+        char what[96];
+        std::snprintf(what, sizeof what, "margin %.3e, kind %s, size %g", c.margin, case_kind_name(c.kind), c.size);
+        check.check(c.a, c.b, c.truth, what);
+        check.check(c.b, c.a, c.truth, what);
+    }
+    std::printf("box-overlapping pairs %lld: pre-test separated %lld, intersecting %lld\n", check.pairs,
+                check.separated, check.intersecting);
+    EXPECT_EQ(check.wrong, 0);
+    // Not vacuous: the cases hold plenty of pairs it must be able to decide.
+    EXPECT_GT(check.separated, check.pairs / 20);
+    EXPECT_GT(check.intersecting, check.pairs / 50);
+}
+
+/// Pairs placed within three margins of the pre-test's decision and near the tests' tolerance: where
+/// it decides, CGAL and every test agree, and it does decide a good part of them.
+TEST(FacePlanesCgal, NearItsMarginItDecidesOnlyWhatEveryTestDecides) {
+    const kdet::test::NearTouchingPairs pairs = kdet::test::near_touching_pairs(512, 0x6e656172u);
+    VerdictCheck check;
+    const std::size_t count = pairs.first.tets.size() / 4;
+    for (std::size_t i = 0; i < count; ++i) {
+        kdet::vec3 a[4], b[4];
+        d3 ad[4], bd[4];
+        for (int v = 0; v < 4; ++v) {
+            const double* p = &pairs.first.positions[3 * pairs.first.tets[4 * i + v]];
+            const double* q = &pairs.second.positions[3 * pairs.second.tets[4 * i + v]];
+            a[v] = kdet::make_vec3(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
+            b[v] = kdet::make_vec3(static_cast<float>(q[0]), static_cast<float>(q[1]), static_cast<float>(q[2]));
+        }
+        widen(a, ad);
+        widen(b, bd);
+        const bool truth = cgal_intersect(ad, bd);
+        char what[48];
+        std::snprintf(what, sizeof what, "near-touching pair %zu", i);
+        check.check(a, b, truth, what);
+        check.check(b, a, truth, what);
+    }
+    std::printf("near-touching pairs %lld: pre-test separated %lld, intersecting %lld\n", check.pairs,
+                check.separated, check.intersecting);
+    EXPECT_EQ(check.wrong, 0);
+    EXPECT_GT(check.separated, check.pairs / 8);
+    EXPECT_GT(check.intersecting, check.pairs / 20);
+}
+
+} // namespace
