@@ -12,7 +12,7 @@ namespace kdet {
 CpuExec::CpuExec(const DetectorOptions& options)
     : threads_(options.threads > 0 ? options.threads : omp_get_max_threads()) {}
 
-void CpuExec::sort(std::uint64_t* keys, std::size_t n) const {
+void CpuExec::sort(std::uint64_t* keys, std::size_t n, int) const {
     if (n > 1 << 14 && threads_ > 1)
         __gnu_parallel::sort(keys, keys + n, __gnu_parallel::multiway_mergesort_tag(static_cast<__gnu_parallel::_ThreadIndex>(threads_)));
     else

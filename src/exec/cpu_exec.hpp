@@ -8,6 +8,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <algorithm>
+#include <utility>
+#include <vector>
 #include <memory>
 #include <string>
 
@@ -81,8 +84,44 @@ public:
         for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
     }
 
-    /// @brief Sorts keys[0, n) ascending.
-    void sort(std::uint64_t* keys, std::size_t n) const;
+    /// @brief Sorts keys[0, n) ascending. `bits` (every key is below 2^bits) only shortens the GPU's
+    /// radix sort; a comparison sort has no use for it.
+    void sort(std::uint64_t* keys, std::size_t n, int bits) const;
+
+    /// @brief Reduces each run of equal consecutive keys: run r's key and the merge of value_of(i) over
+    /// its items go to run_keys[r] and run_values[r], the number of runs to *run_count (in the
+    /// backend's memory: nothing is read back). Each thread reduces a slice; runs that cross a
+    /// slice's end are merged afterwards.
+    template <class Key, class Value, class ValueOf, class Merge>
+    void reduce_runs(const Key* keys, const ValueOf& value_of, std::size_t n, const Merge& merge, Key* run_keys,
+                     Value* run_values, std::uint32_t* run_count) const {
+        const int slices = std::max(1, std::min<int>(threads_, static_cast<int>(n / 4096)));
+        const std::size_t per_slice = (n + slices - 1) / slices;
+        std::vector<std::vector<std::pair<Key, Value>>> slice_runs(static_cast<std::size_t>(slices));
+#pragma omp parallel for num_threads(slices)
+        for (int s = 0; s < slices; ++s) {
+            auto& runs = slice_runs[static_cast<std::size_t>(s)];
+            const std::size_t lo = std::min(n, s * per_slice), hi = std::min(n, lo + per_slice);
+            for (std::size_t i = lo; i < hi; ++i) {
+                if (runs.empty() || !(runs.back().first == keys[i]))
+                    runs.emplace_back(keys[i], value_of(i));
+                else
+                    runs.back().second = merge(runs.back().second, value_of(i));
+            }
+        }
+        std::uint32_t runs = 0;
+        for (const auto& slice : slice_runs)
+            for (const auto& [key, value] : slice) {
+                if (runs && run_keys[runs - 1] == key) {
+                    run_values[runs - 1] = merge(run_values[runs - 1], value);
+                    continue;
+                }
+                run_keys[runs] = key;
+                run_values[runs] = value;
+                ++runs;
+            }
+        *run_count = runs;
+    }
 
     /// @brief out[i] = sum of in[0, i); returns the total.
     std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const;

@@ -9,9 +9,12 @@
 #include <kdet/options.hpp>
 
 #include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_reduce.cuh>
 #include <cub/device/device_scan.cuh>
 #include <cub/device/device_select.cuh>
 #include <cuda_runtime.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
 
 #include <cstdint>
 #include <cstring>
@@ -166,15 +169,38 @@ public:
         return kernel_limit >= 32 ? kernel_limit / 32 * 32 : kernel_limit; // whole warps
     }
 
-    void sort(std::uint64_t* keys, std::size_t n) const {
+    /// @brief Sorts keys[0, n) ascending; every key is below 2^bits, so the radix passes stop there.
+    /// The double-buffer form needs n keys of spare memory and no copy of the keys inside CUB's scratch.
+    void sort(std::uint64_t* keys, std::size_t n, int bits) const {
         if (n < 2) return;
-        sorted_.resize_discard(n);
+        spare_keys_.resize_discard(n);
+        cub::DoubleBuffer<std::uint64_t> buffers(keys, spare_keys_.data());
         std::size_t bytes = 0;
-        cub::DeviceRadixSort::SortKeys(nullptr, bytes, keys, sorted_.data(), n, 0, 64, stream_);
+        cub::DeviceRadixSort::SortKeys(nullptr, bytes, buffers, n, 0, bits, stream_);
         temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, keys, sorted_.data(), n, 0, 64, stream_),
-                   "radix sort");
-        copy(keys, sorted_.data(), n);
+        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, buffers, n, 0, bits, stream_), "radix sort");
+        if (buffers.Current() != keys) copy(keys, buffers.Current(), n);
+    }
+
+    /// @brief Reduces each run of equal consecutive keys: run r's key and the merge of value_of(i) over
+    /// its items go to run_keys[r] and run_values[r], the number of runs to *run_count (device memory:
+    /// nothing is read back). Parallel over the items, however long the runs.
+    template <class Key, class Value, class ValueOf, class Merge>
+    void reduce_runs(const Key* keys, const ValueOf& value_of, std::size_t n, const Merge& merge, Key* run_keys,
+                     Value* run_values, std::uint32_t* run_count) const {
+        if (n == 0) {
+            cuda_check(cudaMemsetAsync(run_count, 0, sizeof(std::uint32_t), stream_), "memset");
+            return;
+        }
+        const auto values = thrust::make_transform_iterator(thrust::make_counting_iterator<std::uint64_t>(0), value_of);
+        const auto items = static_cast<std::int64_t>(n);
+        std::size_t bytes = 0;
+        cub::DeviceReduce::ReduceByKey(nullptr, bytes, keys, run_keys, values, run_values, run_count, merge, items,
+                                       stream_);
+        temp_.resize_discard(bytes);
+        cuda_check(cub::DeviceReduce::ReduceByKey(temp_.data(), bytes, keys, run_keys, values, run_values, run_count,
+                                                  merge, items, stream_),
+                   "reduce by key");
     }
 
     std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
@@ -227,7 +253,7 @@ public:
 
     /// @brief Bytes of the scratch buffers CUB needs, for memory reports (device memory only).
     std::size_t scratch_bytes() const {
-        return temp_.capacity_bytes() + sorted_.capacity_bytes();
+        return temp_.capacity_bytes() + spare_keys_.capacity_bytes();
     }
 
 private:
@@ -241,7 +267,7 @@ private:
     mutable PinnedBuffer staging_;
     mutable std::uint64_t host_waits_ = 0;
     mutable DeviceBuffer<unsigned char> temp_;
-    mutable DeviceBuffer<std::uint64_t> sorted_;
+    mutable DeviceBuffer<std::uint64_t> spare_keys_;
 };
 
 } // namespace kdet

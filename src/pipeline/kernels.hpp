@@ -25,11 +25,6 @@ struct TetInfo {
     std::int32_t layer; ///< grid layer, or -1 when the tet cannot collide with anything enabled
 };
 
-/// @brief Box of one object, as order-preserving integers so threads can merge boxes atomically.
-struct ObjectBounds {
-    std::uint32_t lo[3], hi[3];
-};
-
 /// @brief All objects' geometry, concatenated; tets of one object are contiguous.
 struct SceneView {
     const vec3* positions;
@@ -63,6 +58,13 @@ KDET_HD inline bool pair_is_active(const SceneView& s, std::uint32_t object_a, s
 KDET_HD inline std::uint64_t pair_key(std::uint32_t t, std::uint32_t u) {
     const std::uint32_t lo = t < u ? t : u, hi = t < u ? u : t;
     return (static_cast<std::uint64_t>(lo) << 32) | hi;
+}
+/// @brief Bits a pair key of tet ids below tet_count needs: the lower id fills the high word from bit 32
+/// on, so every key is below 2^(32 + bits of the largest id) and a radix sort can stop there.
+inline int pair_key_bits(std::uint32_t tet_count) {
+    int bits = 32;
+    for (std::uint32_t largest = tet_count ? tet_count - 1 : 0; largest; largest >>= 1) ++bits;
+    return bits;
 }
 KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
 KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
@@ -115,38 +117,26 @@ struct TetBoundsKernel {
     }
 };
 
-/// @brief Stage 1: merges tet boxes into their objects' boxes, one chunk of tets per item so that
-/// threads rarely contend on the same object.
-struct ObjectBoundsKernel {
-    SceneView scene;
-    ObjectBounds* bounds;
-    std::uint32_t chunk;
+/// @brief Stage 1: the box of tet t, the value the per-object box reduction merges.
+struct TetBoxOf {
+    const TetInfo* info;
+    KDET_HD Aabb operator()(std::uint64_t t) const { return info[t].box; }
+};
 
-    KDET_HD static void flush(ObjectBounds& target, const Aabb& box) {
-        atomic_min(&target.lo[0], float_to_ordered(box.lo.x));
-        atomic_min(&target.lo[1], float_to_ordered(box.lo.y));
-        atomic_min(&target.lo[2], float_to_ordered(box.lo.z));
-        atomic_max(&target.hi[0], float_to_ordered(box.hi.x));
-        atomic_max(&target.hi[1], float_to_ordered(box.hi.y));
-        atomic_max(&target.hi[2], float_to_ordered(box.hi.z));
-    }
+/// @brief The smallest box holding two boxes.
+struct BoxUnion {
+    KDET_HD Aabb operator()(const Aabb& a, const Aabb& b) const { return Aabb{min_v(a.lo, b.lo), max_v(a.hi, b.hi)}; }
+};
 
-    KDET_HD void operator()(std::uint64_t c) const {
-        const std::uint64_t begin = c * chunk;
-        const std::uint64_t end = begin + chunk < scene.tet_count ? begin + chunk : scene.tet_count;
-        std::uint32_t object = scene.tet_object[begin];
-        Aabb box = scene.info[begin].box;
-        for (std::uint64_t t = begin + 1; t < end; ++t) {
-            const Aabb& tet_box = scene.info[t].box;
-            if (scene.tet_object[t] != object) {
-                flush(bounds[object], box);
-                object = scene.tet_object[t];
-                box = tet_box;
-                continue;
-            }
-            box = Aabb{min_v(box.lo, tet_box.lo), max_v(box.hi, tet_box.hi)};
-        }
-        flush(bounds[object], box);
+/// @brief Stage 1: puts the box of each run of tets (one run per non-empty object: its tets are
+/// contiguous) at its object's place.
+struct ObjectBoxesKernel {
+    const std::uint32_t* run_objects;
+    const Aabb* run_boxes;
+    const std::uint32_t* run_count;
+    Aabb* object_boxes;
+    KDET_HD void operator()(std::uint64_t r) const {
+        if (r < *run_count) object_boxes[run_objects[r]] = run_boxes[r];
     }
 };
 

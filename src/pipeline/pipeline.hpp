@@ -23,6 +23,7 @@ struct FrameCounters {
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
     std::uint32_t non_finite;
+    std::uint32_t object_runs; ///< runs of tets of one object, i.e. non-empty objects
     std::uint32_t cells_claimed;
     std::uint32_t min_size; ///< float_to_ordered, over the relevant tets
     std::uint32_t max_size;
@@ -60,8 +61,13 @@ public:
         user_colliding_.resize_discard(tets);
         user_flags_set_ = true; // new memory: unknown until cleared
         const std::size_t objects = topology.object_tet_begin.size() - 1;
-        bounds_.resize_discard(objects);
+        run_objects_.resize_discard(objects);
+        run_boxes_.resize_discard(objects);
         object_boxes_.resize_discard(objects);
+        // An empty object has no run of tets, so the reduction never writes its box: empty once here.
+        const float inf = std::numeric_limits<float>::infinity();
+        fill(object_boxes_, Aabb{{inf, inf, inf}, {-inf, -inf, -inf}});
+        counters_.resize_discard(1);
         pair_active_.resize_discard(objects * objects);
     }
 
@@ -86,7 +92,7 @@ public:
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
                user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() +
                info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
-               bounds_.capacity_bytes() + object_boxes_.capacity_bytes() + pair_active_.capacity_bytes() +
+               run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() + pair_active_.capacity_bytes() +
                headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + hit_.capacity_bytes() + position_.capacity_bytes() +
                out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
@@ -102,7 +108,7 @@ private:
     SceneView scene_view() {
         return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), pair_active_.data(),
                          object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
-                         static_cast<std::uint32_t>(bounds_.size())};
+                         static_cast<std::uint32_t>(object_boxes_.size())};
     }
     template <class T>
     void fill(buffer<T>& b, T value) {
@@ -158,7 +164,8 @@ private:
     buffer<TetPlanes> planes_;
     buffer<std::uint32_t> colliding_;      ///< per stored tet
     buffer<std::uint32_t> user_colliding_; ///< per tet in the caller's numbering
-    buffer<ObjectBounds> bounds_;
+    buffer<std::uint32_t> run_objects_; ///< per run of tets of one object (stage 1's reduction)
+    buffer<Aabb> run_boxes_;
     buffer<Aabb> object_boxes_;
     buffer<std::uint8_t> pair_active_;
     buffer<BucketHeader> headers_;
@@ -181,28 +188,17 @@ private:
 /// @brief Stage 1. Returns false when no enabled pair of objects can collide this frame.
 template <class Exec>
 bool Pipeline<Exec>::compute_bounds_and_culling(const std::vector<std::uint8_t>& pair_enabled) {
-    const std::size_t objects = bounds_.size();
+    const std::size_t objects = object_boxes_.size();
     const std::uint32_t tets = static_cast<std::uint32_t>(tets_.size());
     SceneView scene = scene_view();
     exec_.for_each(tets, TetBoundsKernel{scene});
-
-    std::vector<ObjectBounds> bounds(objects);
-    for (auto& b : bounds)
-        for (int a = 0; a < 3; ++a) {
-            b.lo[a] = float_to_ordered(std::numeric_limits<float>::infinity());
-            b.hi[a] = float_to_ordered(-std::numeric_limits<float>::infinity());
-        }
-    exec_.upload(bounds_.data(), bounds.data(), objects);
-    constexpr std::uint32_t chunk = 256;
-    exec_.for_each((tets + chunk - 1) / chunk, ObjectBoundsKernel{scene, bounds_.data(), chunk});
-    exec_.download(bounds.data(), bounds_.data(), objects);
-
+    // Tets of one object are contiguous: their boxes reduce run by run, in parallel over all tets.
+    std::uint32_t* runs = &counters_.data()->object_runs;
+    exec_.reduce_runs(tet_object_.data(), TetBoxOf{info_.data()}, tets, BoxUnion{}, run_objects_.data(),
+                      run_boxes_.data(), runs);
+    exec_.for_each(objects, ObjectBoxesKernel{run_objects_.data(), run_boxes_.data(), runs, object_boxes_.data()});
     std::vector<Aabb> boxes(objects);
-    for (std::size_t o = 0; o < objects; ++o)
-        boxes[o] = Aabb{{ordered_to_float(bounds[o].lo[0]), ordered_to_float(bounds[o].lo[1]),
-                         ordered_to_float(bounds[o].lo[2])},
-                        {ordered_to_float(bounds[o].hi[0]), ordered_to_float(bounds[o].hi[1]),
-                         ordered_to_float(bounds[o].hi[2])}};
+    exec_.download(boxes.data(), object_boxes_.data(), objects);
 
     // Object-level culling: a pair of objects is only checked when their boxes overlap.
     std::vector<std::uint8_t> active(objects * objects, 0);
@@ -217,7 +213,6 @@ bool Pipeline<Exec>::compute_bounds_and_culling(const std::vector<std::uint8_t>&
             if (on) involved[a] = involved[b] = any = true;
         }
     exec_.upload(pair_active_.data(), active.data(), active.size());
-    exec_.upload(object_boxes_.data(), boxes.data(), objects);
     if (!any) return false;
 
     const float inf = std::numeric_limits<float>::infinity();
@@ -376,7 +371,7 @@ void Pipeline<Exec>::find_candidates(const GridView& grid, FrameCounts& counts) 
 /// @brief Both brute-force methods: every pair of enabled objects is tested, colliding pairs appended.
 template <class Exec>
 void Pipeline<Exec>::brute_force(FrameCounts& counts) {
-    const std::size_t objects = bounds_.size();
+    const std::size_t objects = object_boxes_.size();
     std::vector<std::uint8_t> active(objects * objects);
     exec_.download(active.data(), pair_active_.data(), active.size());
     std::vector<std::uint64_t> block_begin{0};
@@ -467,7 +462,7 @@ void Pipeline<Exec>::contacts_and_pairs(std::size_t colliding, FrameResult& resu
 template <class Exec>
 void Pipeline<Exec>::count_and_copy_flags(bool any, FrameResult& result) {
     const std::size_t tets = tets_.size();
-    const std::size_t objects = bounds_.size();
+    const std::size_t objects = object_boxes_.size();
     result.colliding.resize(options_.results_to_host ? objects : 0);
     if (!any) {
         if (user_flags_set_) fill(user_colliding_, 0u);
@@ -536,7 +531,8 @@ void Pipeline<Exec>::detect(const std::vector<PositionUpload>& uploads, const st
             if (!grid_method) counts.unique_candidates = counts.candidates;
             const std::size_t colliding = narrow_phase(counts.unique_candidates, counts);
             clock_.mark(narrow_phase_done);
-            exec_.sort(out_keys_.data(), colliding); // the deterministic output order
+            // The deterministic output order; the keys hold the caller's ids, which are below the tet count.
+            exec_.sort(out_keys_.data(), colliding, pair_key_bits(static_cast<std::uint32_t>(tets_.size())));
             clock_.mark(sorted);
             contacts_and_pairs(colliding, result);
             clock_.mark(results_done);

@@ -1,0 +1,72 @@
+// The execution layer's primitives and the pipeline's helpers around them, on the CPU backend.
+#include "exec/cpu_exec.hpp"
+#include "pipeline/kernels.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace kdet {
+namespace {
+
+TEST(PairKeyBits, EveryKeyOfTheTetsFitsAndNoBitIsSpare) {
+    for (std::uint32_t tets : {2u, 3u, 4u, 5u, 1000u, 1u << 20, (1u << 20) + 2, 0xfffffff0u}) {
+        const int bits = pair_key_bits(tets);
+        const std::uint64_t largest = pair_key(tets - 2, tets - 1);
+        EXPECT_LT(largest, bits == 64 ? ~0ull : 1ull << bits) << tets << " tets";
+        EXPECT_LE(bits, 64);
+    }
+    // When the lower id of the largest pair has its own top bit set, the bound is tight.
+    EXPECT_EQ(pair_key(1u << 20, (1u << 20) + 1) >> (pair_key_bits((1u << 20) + 2) - 1), 1u);
+    EXPECT_EQ(pair_key_bits(2), 33);
+    EXPECT_EQ(pair_key_bits(1000), 42);
+}
+
+TEST(ReduceRuns, MergesEachRunOfEqualKeysWhereverTheThreadsSplitTheItems) {
+    // Runs of every length, one crossing each slice boundary, and a key that comes back after another
+    // (a run of its own, as on the GPU).
+    std::vector<std::uint32_t> keys;
+    std::mt19937 random(7);
+    for (std::uint32_t key : {0u, 1u, 2u, 5u, 1u, 6u, 7u})
+        keys.insert(keys.end(), key == 2u ? 1u : 1u + random() % 9000u, key);
+    std::vector<Aabb> boxes(keys.size());
+    std::uniform_real_distribution<float> coordinate(-10.0f, 10.0f);
+    for (Aabb& b : boxes) {
+        b.lo = vec3{coordinate(random), coordinate(random), coordinate(random)};
+        b.hi = b.lo + vec3{1.0f, 2.0f, 3.0f};
+    }
+    std::vector<std::uint32_t> expected_keys;
+    std::vector<Aabb> expected_boxes;
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+        if (i == 0 || keys[i] != keys[i - 1]) {
+            expected_keys.push_back(keys[i]);
+            expected_boxes.push_back(boxes[i]);
+        } else {
+            expected_boxes.back() = BoxUnion{}(expected_boxes.back(), boxes[i]);
+        }
+    }
+    ASSERT_EQ(expected_keys.size(), 7u);
+    for (int threads : {1, 2, 3}) {
+        DetectorOptions options;
+        options.threads = threads;
+        const CpuExec exec(options);
+        std::vector<std::uint32_t> run_keys(keys.size(), 99);
+        std::vector<Aabb> run_boxes(keys.size());
+        std::uint32_t runs = 0;
+        exec.reduce_runs(keys.data(), [&](std::uint64_t i) { return boxes[i]; }, keys.size(), BoxUnion{},
+                         run_keys.data(), run_boxes.data(), &runs);
+        ASSERT_EQ(runs, expected_keys.size()) << threads << " threads";
+        for (std::uint32_t r = 0; r < runs; ++r) {
+            EXPECT_EQ(run_keys[r], expected_keys[r]);
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_EQ(component(run_boxes[r].lo, a), component(expected_boxes[r].lo, a)) << "run " << r;
+                EXPECT_EQ(component(run_boxes[r].hi, a), component(expected_boxes[r].hi, a)) << "run " << r;
+            }
+        }
+    }
+}
+
+} // namespace
+} // namespace kdet
