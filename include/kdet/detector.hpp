@@ -57,10 +57,27 @@ public:
     /// @brief Switches collision between two different objects (on by default).
     void set_pair_collision(ObjectId a, ObjectId b, bool enabled);
 
-    /// @brief Runs one detection; the result stays valid until the next call.
+    /// @brief Runs one detection; the result stays valid until the next call. The same as
+    /// detect_async() followed by finish(): once a detector's buffers have grown (after its first
+    /// frame), the host waits for the backend once per call (FrameCounts::host_waits).
     const FrameResult& detect();
 
-    /// @brief The last detection's pairs, flags and contacts in the backend's memory.
+    /// @brief Starts one detection and returns without waiting for the backend: on Backend::cuda every
+    /// kernel and copy is enqueued on DetectorOptions::cuda_stream, so the host can prepare the
+    /// simulation's next step meanwhile. A detector's first frame (and the first after objects were
+    /// added) still reads a few sizes back to size its buffers. On Backend::cpu the work is done before
+    /// it returns. Call finish() before reading any result, device_results() included.
+    void detect_async();
+
+    /// @brief Completes the detection detect_async() started: waits for it once, checks that every
+    /// buffer was large enough (if not, grows it and runs the frame again, so no pair is ever lost),
+    /// and returns the result, as detect() does. After it, device_results() holds the frame's pairs
+    /// and flags, and work the caller enqueues on the stream sees them. Without a pending frame it
+    /// returns the last result.
+    const FrameResult& finish();
+
+    /// @brief The last detection's pairs, flags and contacts in the backend's memory. Throws
+    /// kdet::Error while a detect_async() frame is not finished.
     DeviceResults device_results() const;
     /// @brief Global id of the first tet of `object` (see DeviceResults).
     std::uint32_t first_tet(ObjectId object) const;

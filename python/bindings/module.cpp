@@ -284,19 +284,22 @@ void set_positions(PyDetector& self, std::int64_t object, nb::handle positions) 
         self.detector.set_positions(id, contiguous_host(c, floats), c.rows);
 }
 
-nb::object detect(nb::handle handle, bool device_results) {
+/// What detect() and finish() return: the frame that `complete` (Detector::detect or Detector::finish)
+/// completes, on the host or as DLPack arrays of the detector's buffers.
+nb::object completed_frame(nb::handle handle, bool device_results, const FrameResult& (Detector::*complete)(),
+                           const char* name) {
     PyDetector& self = nb::cast<PyDetector&>(handle);
     const DetectorOptions& options = self.detector.options();
     if (!device_results && !options.results_to_host)
-        throw Error("detect: this detector keeps its results on the device (results_to_host=False); call "
-                    "detect(device_results=True)");
+        throw Error(std::string(name) + ": this detector keeps its results on the device (results_to_host=False); "
+                    "call " + name + "(device_results=True)");
     std::unique_ptr<Frame> frame;
     auto device_frame = std::make_unique<DeviceFrame>();
     DeviceResults buffers;
     {
         nb::gil_scoped_release release;
         std::lock_guard<std::mutex> lock(self.mutex);
-        const FrameResult& result = self.detector.detect();
+        const FrameResult& result = (self.detector.*complete)();
         if (device_results) {
             buffers = self.detector.device_results();
             device_frame->counts = result.counts;
@@ -322,6 +325,14 @@ nb::object detect(nb::handle handle, bool device_results) {
                                                handle, device_type, device_id)
                                  : nb::none();
     return nb::cast(device_frame.release(), nb::rv_policy::take_ownership);
+}
+
+nb::object detect(nb::handle handle, bool device_results) {
+    return completed_frame(handle, device_results, &Detector::detect, "detect");
+}
+
+nb::object finish(nb::handle handle, bool device_results) {
+    return completed_frame(handle, device_results, &Detector::finish, "finish");
 }
 
 nb::dict options_dict(const DetectorOptions& o) {
@@ -554,6 +565,14 @@ NB_MODULE(_kdet, m) {
              nb::sig("def detect(self, device_results: bool = False) -> FrameResult | DeviceFrameResult"),
              "Runs one detection (without the GIL). Returns a FrameResult, or with device_results=True a "
              "DeviceFrameResult of DLPack arrays in the backend's memory.")
+        .def(
+            "detect_async", [](PyDetector& self) { locked(self, [&] { self.detector.detect_async(); }); },
+            "Starts one detection and returns without waiting for the backend (on the CUDA backend everything "
+            "is enqueued on the detector's cuda_stream). finish() completes it; results cannot be read before.")
+        .def("finish", &finish, "device_results"_a = false,
+             nb::sig("def finish(self, device_results: bool = False) -> FrameResult | DeviceFrameResult"),
+             "Completes the detection detect_async() started (one wait; a buffer that was too small grows and "
+             "the frame runs again) and returns what detect() returns.")
         .def(
             "first_tet",
             [](PyDetector& self, std::int64_t object) { return self.detector.first_tet(object_id(self, object)); },

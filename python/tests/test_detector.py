@@ -86,6 +86,28 @@ def test_device_results_on_the_cpu_backend_are_dlpack_arrays(octopus):
     assert np.from_dlpack(result.contacts).shape == (len(keys), 4)
 
 
+def test_detect_async_then_finish_gives_detect_s_result_with_one_wait(octopus):
+    other = moved(octopus, 0.3, (0.1 * extent(octopus), 0.0, 0.0))
+    detector, reference = kdet.Detector(), kdet.Detector()
+    for d in (detector, reference):
+        d.add_object(octopus)
+        d.add_object(other)
+    detector.detect()  # the first frame sizes the buffers
+    expected = reference.detect()
+    detector.detect_async()
+    result = detector.finish()
+    np.testing.assert_array_equal(result.pairs, expected.pairs)
+    assert result.counts.host_waits == 1
+    device_detector = kdet.Detector(results_to_host=False)
+    device_detector.add_object(octopus)
+    device_detector.add_object(other)
+    device_detector.detect_async()
+    keys = np.from_dlpack(device_detector.finish(device_results=True).pair_keys)
+    assert len(keys) == len(expected.pairs) > 0
+    with pytest.raises(kdet.Error, match="finish: this detector keeps its results on the device"):
+        device_detector.finish()
+
+
 def test_detect_releases_the_gil(models):
     bunny = kdet.read_tet_mesh(models / "bunny.mesh")
     detector = kdet.Detector(threads=1)

@@ -84,9 +84,20 @@ public:
         for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
     }
 
-    /// @brief Sorts keys[0, n) ascending. `bits` (every key is below 2^bits) only shortens the GPU's
-    /// radix sort; a comparison sort has no use for it.
-    void sort(std::uint64_t* keys, std::size_t n, int bits) const;
+    /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`): a stage
+    /// whose size an earlier stage counted is launched without the host reading the count.
+    template <class F>
+    void for_each_counted(const unsigned long long* count, std::uint64_t capacity, const F& f) const {
+        for_each(std::min<std::uint64_t>(*count, capacity), f);
+    }
+
+    /// @brief Sorts the first min(*count, capacity) keys ascending (the count in the backend's memory);
+    /// keys after them up to `capacity` may change. Every key is below 2^bits, which only shortens the
+    /// GPU's radix sort: a comparison sort has no use for it.
+    void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const;
+
+    /// @brief *total = the sum of in[0, n), left in the backend's memory.
+    void sum(const std::uint32_t* in, std::size_t n, unsigned long long* total) const;
 
     /// @brief Reduces each run of equal consecutive keys: run r's key and the merge of value_of(i) over
     /// its items go to run_keys[r] and run_values[r], the number of runs to *run_count (in the
@@ -123,28 +134,38 @@ public:
         *run_count = runs;
     }
 
-    /// @brief out[i] = sum of in[0, i); returns the total.
-    std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const;
-
     template <class T>
     void upload(T* device, const T* host, std::size_t n) const {
         if (n) std::memcpy(device, host, n * sizeof(T));
     }
-    /// @brief Copies out of the backend's memory. Like exclusive_scan, whose result
-    /// the host reads, it is a point where the GPU backend waits for the device: counted here too, so
-    /// both backends report the same number of host waits.
+    /// @brief Copies out of the backend's memory: a point where the GPU backend waits for the device,
+    /// counted here too so that both backends report the same number of host waits.
     template <class T>
     void download(T* host, const T* device, std::size_t n) const {
         if (!n) return;
         ++host_waits_;
         std::memcpy(host, device, n * sizeof(T));
     }
+    /// @brief Queues a copy out of the backend's memory; every queued copy is done by the next
+    /// finish_downloads(), with one wait for all of them.
+    template <class T>
+    void download_later(T* host, const T* device, std::size_t n) const {
+        if (n) pending_.push_back(PendingDownload{host, device, n * sizeof(T)});
+    }
+    /// @brief Does the queued copies: one host wait (none when nothing was queued).
+    void finish_downloads() const {
+        if (pending_.empty()) return;
+        ++host_waits_;
+        for (const PendingDownload& d : pending_) std::memcpy(d.host, d.device, d.bytes);
+        pending_.clear();
+    }
     /// @brief Copies within the backend's memory.
     template <class T>
     void copy(T* destination, const T* source, std::size_t n) const {
         if (n) std::memmove(destination, source, n * sizeof(T));
     }
-    /// @brief Times the host has waited for the backend so far: once per download, scan and sort.
+    /// @brief Times the host has waited for the backend so far: once per download and per
+    /// finish_downloads().
     std::uint64_t host_waits() const { return host_waits_; }
 
     /// @brief Bytes of scratch memory the layer keeps (none on the CPU).
@@ -154,8 +175,14 @@ public:
     std::string device_name() const;
 
 private:
+    struct PendingDownload {
+        void* host;
+        const void* device;
+        std::size_t bytes;
+    };
     int threads_;
     mutable std::uint64_t host_waits_ = 0;
+    mutable std::vector<PendingDownload> pending_;
 };
 
 } // namespace kdet

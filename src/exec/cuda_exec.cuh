@@ -10,15 +10,16 @@
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
-#include <cub/device/device_scan.cuh>
 #include <cub/device/device_select.cuh>
 #include <cuda_runtime.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <vector>
 
 namespace kdet {
 
@@ -131,6 +132,24 @@ __global__ void for_each_kernel(std::uint64_t n, F f) {
     for (std::uint64_t i = static_cast<std::uint64_t>(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) f(i);
 }
 
+/// @brief for_each_kernel over a count that an earlier kernel left in device memory, at most `capacity`.
+template <class F>
+__global__ void for_each_counted_kernel(const unsigned long long* count, std::uint64_t capacity, F f) {
+    const std::uint64_t n = *count < capacity ? *count : capacity;
+    const std::uint64_t stride = static_cast<std::uint64_t>(gridDim.x) * blockDim.x;
+    for (std::uint64_t i = static_cast<std::uint64_t>(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) f(i);
+}
+
+/// @brief Sets the keys after the first *count (up to capacity) to all ones, which sort after every key
+/// below 2^bits whatever bits the sort looks at.
+struct PadKeysKernel {
+    std::uint64_t* keys;
+    const unsigned long long* count;
+    __device__ void operator()(std::uint64_t i) const {
+        if (i >= *count) keys[i] = ~0ull;
+    }
+};
+
 class CudaExec {
 public:
     template <class T>
@@ -149,37 +168,63 @@ public:
     template <class F>
     void for_each(std::uint64_t n, const F& f) const {
         if (n == 0) return;
-        const int block = launchable_block_size<F>();
-        const std::uint64_t wanted = (n + block - 1) / block;
-        const auto blocks = static_cast<unsigned>(wanted < (1u << 30) ? wanted : (1u << 30));
-        for_each_kernel<<<blocks, block, 0, stream_>>>(n, f);
+        const int block = launchable_block_size(for_each_kernel<F>);
+        for_each_kernel<<<blocks_for(n, block), block, 0, stream_>>>(n, f);
         cuda_check(cudaGetLastError(), "kernel launch");
     }
 
-    /// @brief The requested block size, capped at what the kernel for F can launch with: heavy
-    /// kernels need so many registers per thread that 1024 (or 512) threads do not fit a block.
+    /// @brief Runs f(i) for every i below the count in device memory (at most `capacity`): a stage whose
+    /// size an earlier stage counted is launched without the host reading the count. The grid covers
+    /// at most counted_blocks blocks; their threads stride over the rest.
     template <class F>
-    int launchable_block_size() const {
-        static const int kernel_limit = [] {
+    void for_each_counted(const unsigned long long* count, std::uint64_t capacity, const F& f) const {
+        if (capacity == 0) return;
+        const int block = launchable_block_size(for_each_counted_kernel<F>);
+        const unsigned blocks = std::min(blocks_for(capacity, block), counted_blocks);
+        for_each_counted_kernel<<<blocks, block, 0, stream_>>>(count, capacity, f);
+        cuda_check(cudaGetLastError(), "kernel launch");
+    }
+
+    /// @brief The requested block size, capped at what `kernel` can launch with: heavy kernels need so
+    /// many registers per thread that 1024 (or 512) threads do not fit a block.
+    template <class Kernel>
+    int launchable_block_size(Kernel kernel) const {
+        static const int kernel_limit = [kernel] {
             cudaFuncAttributes attributes{};
-            cuda_check(cudaFuncGetAttributes(&attributes, for_each_kernel<F>), "cudaFuncGetAttributes");
+            cuda_check(cudaFuncGetAttributes(&attributes, kernel), "cudaFuncGetAttributes");
             return attributes.maxThreadsPerBlock;
         }();
         if (block_size_ <= kernel_limit) return block_size_;
         return kernel_limit >= 32 ? kernel_limit / 32 * 32 : kernel_limit; // whole warps
     }
 
-    /// @brief Sorts keys[0, n) ascending; every key is below 2^bits, so the radix passes stop there.
-    /// The double-buffer form needs n keys of spare memory and no copy of the keys inside CUB's scratch.
-    void sort(std::uint64_t* keys, std::size_t n, int bits) const {
-        if (n < 2) return;
-        spare_keys_.resize_discard(n);
+    /// @brief Sorts the first min(*count, capacity) keys ascending, the count in device memory; every key
+    /// is below 2^bits, so the radix passes stop there. The host does not know the count, so all
+    /// `capacity` keys are sorted, those after the count set to all ones first: they sort last.
+    /// The double-buffer form needs `capacity` spare keys and no copy of the keys inside CUB's scratch.
+    void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
+        if (capacity < 2) return;
+        for_each(capacity, PadKeysKernel{keys, count});
+        spare_keys_.resize_discard(capacity);
         cub::DoubleBuffer<std::uint64_t> buffers(keys, spare_keys_.data());
         std::size_t bytes = 0;
-        cub::DeviceRadixSort::SortKeys(nullptr, bytes, buffers, n, 0, bits, stream_);
+        cub::DeviceRadixSort::SortKeys(nullptr, bytes, buffers, capacity, 0, bits, stream_);
         temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, buffers, n, 0, bits, stream_), "radix sort");
-        if (buffers.Current() != keys) copy(keys, buffers.Current(), n);
+        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, buffers, capacity, 0, bits, stream_),
+                   "radix sort");
+        if (buffers.Current() != keys) copy(keys, buffers.Current(), capacity);
+    }
+
+    /// @brief *total = the sum of in[0, n), left in device memory.
+    void sum(const std::uint32_t* in, std::size_t n, unsigned long long* total) const {
+        if (n == 0) {
+            cuda_check(cudaMemsetAsync(total, 0, sizeof *total, stream_), "memset");
+            return;
+        }
+        std::size_t bytes = 0;
+        cub::DeviceReduce::Sum(nullptr, bytes, in, total, n, stream_);
+        temp_.resize_discard(bytes);
+        cuda_check(cub::DeviceReduce::Sum(temp_.data(), bytes, in, total, n, stream_), "sum");
     }
 
     /// @brief Reduces each run of equal consecutive keys: run r's key and the merge of value_of(i) over
@@ -203,21 +248,6 @@ public:
                    "reduce by key");
     }
 
-    std::uint64_t exclusive_scan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
-        if (n == 0) return 0;
-        std::size_t bytes = 0;
-        cub::DeviceScan::ExclusiveSum(nullptr, bytes, in, out, n, stream_);
-        temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, in, out, n, stream_), "exclusive scan");
-        // The total is the last offset plus the last input: both read back with one wait.
-        auto* last = reinterpret_cast<std::uint32_t*>(staging_.reserve(2 * sizeof(std::uint32_t)));
-        cuda_check(cudaMemcpyAsync(last, in + n - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost, stream_), "download");
-        cuda_check(cudaMemcpyAsync(last + 1, out + n - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost, stream_),
-                   "download");
-        wait_for_stream();
-        return std::uint64_t{last[0]} + last[1];
-    }
-
     /// @brief Enqueues a copy from the library's own pageable host memory, which the driver stages
     /// before returning: the source may be reused at once.
     template <class T>
@@ -233,6 +263,32 @@ public:
         wait_for_stream();
         std::memcpy(static_cast<void*>(host), staging, n * sizeof(T));
     }
+    /// @brief Queues a copy to the host; every queued copy is done by the next finish_downloads(),
+    /// with one wait for all of them.
+    template <class T>
+    void download_later(T* host, const T* device, std::size_t n) const {
+        if (n) pending_.push_back(PendingDownload{host, device, n * sizeof(T)});
+    }
+    /// @brief Enqueues the queued copies into one pinned buffer, waits once (none when nothing was
+    /// queued), and hands each its bytes.
+    void finish_downloads() const {
+        if (pending_.empty()) return;
+        std::size_t total = 0;
+        for (const PendingDownload& d : pending_) total += (d.bytes + 15) / 16 * 16;
+        unsigned char* staging = staging_.reserve(total);
+        std::size_t offset = 0;
+        for (const PendingDownload& d : pending_) {
+            cuda_check(cudaMemcpyAsync(staging + offset, d.device, d.bytes, cudaMemcpyDeviceToHost, stream_), "download");
+            offset += (d.bytes + 15) / 16 * 16;
+        }
+        wait_for_stream();
+        offset = 0;
+        for (const PendingDownload& d : pending_) {
+            std::memcpy(d.host, staging + offset, d.bytes);
+            offset += (d.bytes + 15) / 16 * 16;
+        }
+        pending_.clear();
+    }
     /// @brief Copies within device memory.
     template <class T>
     void copy(T* destination, const T* source, std::size_t n) const {
@@ -240,7 +296,8 @@ public:
             cuda_check(cudaMemcpyAsync(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice, stream_),
                        "device copy");
     }
-    /// @brief Times the host has waited for the device so far: once per download, scan and sort.
+    /// @brief Times the host has waited for the device so far: once per download and per
+    /// finish_downloads().
     std::uint64_t host_waits() const { return host_waits_; }
 
     std::string device_name() const {
@@ -257,6 +314,19 @@ public:
     }
 
 private:
+    static constexpr unsigned counted_blocks = 4096;
+
+    struct PendingDownload {
+        void* host;
+        const void* device;
+        std::size_t bytes;
+    };
+
+    static unsigned blocks_for(std::uint64_t n, int block) {
+        const std::uint64_t wanted = (n + block - 1) / block;
+        return static_cast<unsigned>(wanted < (1u << 30) ? wanted : (1u << 30));
+    }
+
     void wait_for_stream() const {
         ++host_waits_;
         cuda_check(cudaStreamSynchronize(stream_), "synchronize");
@@ -265,6 +335,7 @@ private:
     int block_size_;
     cudaStream_t stream_;
     mutable PinnedBuffer staging_;
+    mutable std::vector<PendingDownload> pending_;
     mutable std::uint64_t host_waits_ = 0;
     mutable DeviceBuffer<unsigned char> temp_;
     mutable DeviceBuffer<std::uint64_t> spare_keys_;

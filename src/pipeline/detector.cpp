@@ -22,6 +22,7 @@ struct Detector::Impl {
     // Per object: positions were last given on the device, so only the pipeline holds them.
     std::vector<std::uint8_t> positions_on_device;
     FrameResult result;
+    bool frame_pending = false; // detect_async() ran, finish() not yet
 
     std::size_t objects() const { return object_vertex_begin.size() - 1; }
 
@@ -182,11 +183,17 @@ void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
 }
 
 const FrameResult& Detector::detect() {
+    detect_async();
+    return finish();
+}
+
+void Detector::detect_async() {
     Impl& d = *impl_;
+    if (d.frame_pending) finish(); // its counters are checked before the next frame overwrites them
     if (d.topology_changed) d.rebuild_pipeline();
     if (d.objects() == 0) {
         d.result = FrameResult{};
-        return d.result;
+        return;
     }
     std::vector<PositionUpload> uploads;
     for (std::size_t o = 0; o < d.objects(); ++o)
@@ -194,12 +201,24 @@ const FrameResult& Detector::detect() {
             const std::uint32_t first = d.object_vertex_begin[o];
             uploads.push_back({first, d.positions.data() + first, d.object_vertex_begin[o + 1] - first});
         }
-    d.pipeline->detect(uploads, d.pair_enabled, d.result);
+    d.pipeline->start(uploads, d.pair_enabled);
     std::fill(d.positions_dirty.begin(), d.positions_dirty.end(), 0);
+    d.frame_pending = true;
+}
+
+const FrameResult& Detector::finish() {
+    Impl& d = *impl_;
+    if (!d.frame_pending) return d.result;
+    d.frame_pending = false;
+    d.pipeline->finish(d.result);
     return d.result;
 }
 
-DeviceResults Detector::device_results() const { return impl_->pipeline->device_results(); }
+DeviceResults Detector::device_results() const {
+    if (impl_->frame_pending)
+        throw Error("device_results: the frame started by detect_async() is not finished; call finish() first");
+    return impl_->pipeline->device_results();
+}
 
 std::uint32_t Detector::first_tet(ObjectId object) const {
     impl_->check_object(object);

@@ -10,6 +10,8 @@
 
 #include <kdet/results.hpp>
 
+#include <cfloat>
+#include <cmath>
 #include <cstdint>
 
 namespace kdet {
@@ -140,6 +142,44 @@ struct ObjectBoxesKernel {
     }
 };
 
+/// @brief A box as order-preserving integers (float_to_ordered), so that threads can merge boxes atomically.
+struct OrderedBox {
+    std::uint32_t lo[3], hi[3];
+};
+
+/// @brief Stage 1, one work item per object a: which pairs (a, b) are checked this frame (enabled,
+/// both objects hold tets, their boxes overlap; the diagonal is self-collision), and, when a is in
+/// one, its box merged into the region the grid covers and its tets counted. No tets counted: nothing
+/// can collide, and every later stage finds nothing to do.
+struct ObjectCullingKernel {
+    const std::uint8_t* pair_enabled; ///< [object_count * object_count]
+    std::uint8_t* pair_active;
+    const Aabb* object_boxes;
+    const std::uint32_t* object_tet_begin; ///< [object_count + 1]
+    std::uint32_t object_count;
+    OrderedBox* region;
+    unsigned long long* involved_tets;
+
+    KDET_HD void operator()(std::uint64_t a) const {
+        const std::uint32_t tets = object_tet_begin[a + 1] - object_tet_begin[a];
+        bool involved = false;
+        for (std::uint32_t b = 0; b < object_count; ++b) {
+            const std::uint64_t k = a * object_count + b;
+            const bool on = tets && object_tet_begin[b + 1] != object_tet_begin[b] && pair_enabled[k] &&
+                            (a == b || boxes_overlap(object_boxes[a], object_boxes[b]));
+            pair_active[k] = on ? 1 : 0;
+            involved = involved || on;
+        }
+        if (!involved) return;
+        const Aabb& box = object_boxes[a];
+        for (int axis = 0; axis < 3; ++axis) {
+            atomic_min(&region->lo[axis], float_to_ordered(component(box.lo, axis)));
+            atomic_max(&region->hi[axis], float_to_ordered(component(box.hi, axis)));
+        }
+        atomic_fetch_add(involved_tets, static_cast<unsigned long long>(tets));
+    }
+};
+
 /// @brief Stage 1, grid methods only: sizes the relevant tets and keeps the range of their sizes.
 /// A tet is relevant when its object's self-collision is on, or when its box overlaps another object
 /// it is checked against (inter-object culling: only tets in the overlap region are sized and gridded).
@@ -172,13 +212,40 @@ struct TetSizeKernel {
     }
 };
 
+/// @brief Stage 1, grid methods only, one work item: the grid's geometry from the relevant tets' sizes
+/// (TetSizeKernel) and the region (ObjectCullingKernel), written where the later kernels read it.
+/// c0 is the smallest size, so the smallest tets sit on layer 0; enough layers to hold the largest,
+/// capped at max_grid_layers. No relevant tet: no layer, nothing is gridded.
+struct GridParamsKernel {
+    const std::uint32_t* min_size; ///< float_to_ordered
+    const std::uint32_t* max_size;
+    const OrderedBox* region;
+    GridParams* params;
+
+    KDET_HD void operator()(std::uint64_t) const {
+        if (*min_size == float_to_ordered(INFINITY)) {
+            *params = GridParams{{0.0f, 0.0f, 0.0f}, 1.0f, 1.0f, 0};
+            return;
+        }
+        const float dmin = ordered_to_float(*min_size), dmax = ordered_to_float(*max_size);
+        // Zero-size tets (allowed only when the caller asked for degenerate input) must not make c0 zero.
+        const float floor_size = max_f(dmax * 1e-6f, FLT_MIN * 1e6f);
+        const float c0 = max_f(dmin, floor_size);
+        int layers = 1;
+        for (float top = c0; layers < max_grid_layers && top < dmax; top *= 2.0f) ++layers;
+        const vec3 origin{ordered_to_float(region->lo[0]), ordered_to_float(region->lo[1]),
+                          ordered_to_float(region->lo[2])};
+        *params = GridParams{origin, c0, 1.0f / c0, layers};
+    }
+};
+
 /// @brief Stage 2, before populating: picks each relevant tet's layer and counts, per layer, the
 /// cells the tets there will be inserted into, so that the host can size the table before filling it.
 /// One work item per chunk of tets; neighbouring tets (spatial order) mostly share a layer, so a
 /// count is added atomically only when the layer changes along the chunk.
 struct GridPlanKernel {
     SceneView scene;
-    GridParams params;
+    const GridParams* grid_params; ///< GridParamsKernel's
     std::uint32_t chunk;
     unsigned long long* layer_entries; ///< [max_grid_layers]
     std::uint32_t* layer_mask;
@@ -186,6 +253,7 @@ struct GridPlanKernel {
     KDET_HD void operator()(std::uint64_t c) const {
         const std::uint64_t begin = c * chunk;
         const std::uint64_t end = begin + chunk < scene.tet_count ? begin + chunk : scene.tet_count;
+        const GridParams params = *grid_params;
         int run_layer = -1;
         unsigned long long run_entries = 0;
         std::uint32_t mask = 0;
@@ -214,12 +282,12 @@ struct GridPlanKernel {
 struct PopulateKernel {
     SceneView scene;
     GridView grid;
-    GridParams params;
+    const GridParams* params; ///< GridParamsKernel's
 
     KDET_HD void operator()(std::uint64_t t) const {
         const TetInfo& info = scene.info[t];
         if (info.layer < 0 || atomic_load_acquire(grid.failure)) return;
-        const CellRange r = cell_range(params, info.box, info.layer);
+        const CellRange r = cell_range(*params, info.box, info.layer);
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
@@ -330,8 +398,8 @@ struct KeyBatch {
 struct FindCandidatesKernel {
     SceneView scene;
     GridView grid;
-    GridParams params;
-    std::uint32_t layer_mask;
+    const GridParams* params;        ///< GridParamsKernel's
+    const std::uint32_t* layer_mask; ///< GridPlanKernel's
     KeyAppender out;
     unsigned long long* rejected; ///< pairs the pre-test proved separated
 
@@ -363,7 +431,8 @@ struct FindCandidatesKernel {
         KeyBatch batch(&out);
         Emit emit{&scene, &batch, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
         load_tet(scene, t, emit.vertices);
-        for_each_larger_neighbour(scene, grid, params, layer_mask, t, emit);
+        const GridParams grid_params = *params;
+        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit);
         batch.flush();
         if (emit.rejected) atomic_fetch_add(rejected, emit.rejected);
     }
@@ -374,8 +443,8 @@ struct FindCandidatesKernel {
 struct NoPairsKernel {
     SceneView scene;
     GridView grid;
-    GridParams params;
-    std::uint32_t layer_mask;
+    const GridParams* params;        ///< GridParamsKernel's
+    const std::uint32_t* layer_mask; ///< GridPlanKernel's
     NarrowPhase test;
     std::uint32_t* colliding;
     unsigned long long* tests_run;
@@ -403,7 +472,8 @@ struct NoPairsKernel {
 
     KDET_HD void operator()(std::uint64_t i) const {
         TestAndFlag visit{this, static_cast<std::uint32_t>(i), 0, 0};
-        for_each_larger_neighbour(scene, grid, params, layer_mask, visit.t, visit);
+        const GridParams grid_params = *params;
+        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, visit.t, visit);
         if (visit.tests) atomic_fetch_add(tests_run, visit.tests);
         if (visit.exact_stage) atomic_fetch_add(exact_stage_pairs, visit.exact_stage);
     }
@@ -477,16 +547,18 @@ struct BruteForcePairsKernel {
     }
 };
 
-/// @brief Stage 5: decides each candidate once and flags colliding tets. The grid methods decide with
-/// candidate_collides (their tets have face planes); brute force, whose pairs come tested, with the
-/// test alone.
+/// @brief Stage 5: decides each candidate once, flags colliding tets and appends each colliding pair
+/// under the caller's tet ids (lower id first; sorted afterwards, so the order of appends does not
+/// matter). The grid methods decide with candidate_collides (their tets have face planes); brute
+/// force, whose pairs come tested, with the test alone.
 struct NarrowPhaseKernel {
     SceneView scene;
     NarrowPhase test;
     bool pretest;
     const std::uint64_t* keys;
-    std::uint32_t* hit;
     std::uint32_t* colliding;
+    const std::uint32_t* user_id; ///< [tets] stored id -> caller's global id
+    KeyAppender out;
     unsigned long long* exact_stage_pairs;
 
     KDET_HD void operator()(std::uint64_t k) const {
@@ -495,30 +567,10 @@ struct NarrowPhaseKernel {
         const bool collides = pretest ? candidate_collides(scene, test, t, u, reached_exact)
                                       : test_pair(scene, test, t, u, reached_exact);
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
-        hit[k] = collides ? 1u : 0u;
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);
         atomic_store_relaxed(&colliding[u], 1u);
-    }
-};
-
-/// @brief Stage 5: moves the colliding pairs to the front, keeping their sorted order.
-struct CompactKernel {
-    const std::uint64_t* keys;
-    const std::uint32_t* hit;
-    const std::uint32_t* position;
-    std::uint64_t* out_keys;
-    KDET_HD void operator()(std::uint64_t k) const {
-        if (hit[k]) out_keys[position[k]] = keys[k];
-    }
-};
-
-/// @brief Stage 6: renames a pair from stored tet ids to the caller's ids, lower id first.
-struct UserPairKernel {
-    const std::uint32_t* user_id; ///< [tets] stored id -> caller's global id
-    std::uint64_t* keys;
-    KDET_HD void operator()(std::uint64_t k) const {
-        keys[k] = pair_key(user_id[key_first(keys[k])], user_id[key_second(keys[k])]);
+        out.push(pair_key(user_id[t], user_id[u]));
     }
 };
 

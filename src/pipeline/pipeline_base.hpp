@@ -39,10 +39,13 @@ public:
     virtual void set_positions_on_device(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
     /// @brief Copies `count` positions starting at global vertex `first` back to the host.
     virtual void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count) = 0;
-    /// @brief One detection, after copying in the positions that changed on the host (counted in
-    /// its total time); pair_enabled is [objects * objects], symmetric, diagonal = self-collision.
-    virtual void detect(const std::vector<PositionUpload>& uploads, const std::vector<std::uint8_t>& pair_enabled,
-                        FrameResult& result) = 0;
+    /// @brief Enqueues one detection, after copying in the positions that changed on the host (counted
+    /// in its total time); pair_enabled is [objects * objects], symmetric, diagonal = self-collision.
+    /// Waits for nothing, except on a first frame (it sizes the buffers from what it reads).
+    virtual void start(const std::vector<PositionUpload>& uploads, const std::vector<std::uint8_t>& pair_enabled) = 0;
+    /// @brief Completes the detection start() enqueued: reads its counters (and results when they go
+    /// to the host) with one wait, and grows a buffer and reruns the frame if one was too small.
+    virtual void finish(FrameResult& result) = 0;
     virtual DeviceResults device_results() = 0;
     virtual std::size_t memory_bytes() const = 0;
     virtual std::string device_name() const = 0;
