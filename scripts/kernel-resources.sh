@@ -38,7 +38,7 @@ for line in run.stderr.splitlines():
     m = re.search(r"Compiling entry function '(\S+)'", line)
     if m:
         plain = subprocess.run(["c++filt", m.group(1)], capture_output=True, text=True).stdout.strip()
-        k = re.search(r"for_each_kernel<kdet::(\w+)", plain)
+        k = re.search(r"for_each(?:_counted)?_kernel<kdet::(\w+)", plain)
         name = k.group(1) if k else None  # CUB's own kernels are left out
     m = re.search(r"(\d+) bytes stack frame", line)
     if m:
