@@ -165,6 +165,24 @@ TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
     const Outcome small = run({a, b}, true, tiny);
     EXPECT_EQ(small.pairs, reference.pairs);
     EXPECT_GT(small.counts.buffer_regrows, 0u);
+    // The tets that did not fit resume where they stopped: no candidate is written twice or lost,
+    // and no rejection is counted twice. Dense soups give tets several batches of candidates, so
+    // some stop after storing a batch.
+    EXPECT_EQ(small.counts.unique_candidates, reference.counts.unique_candidates);
+    EXPECT_EQ(small.counts.candidates, reference.counts.candidates);
+    const TetMesh c = random_soup(3000, 1.0, 0.05, 41), d = random_soup(3000, 1.0, 0.05, 42);
+    const Outcome dense = run({c, d}, true, with_method(Method::kdet));
+    ASSERT_GT(dense.counts.unique_candidates, 8u * 6000u); // 16 keys to a batch
+    for (const auto& [meshes, whole] : {std::pair{std::vector<TetMesh>{a, b}, reference}, std::pair{std::vector<TetMesh>{c, d}, dense}})
+        for (std::size_t capacity : {std::size_t{17}, whole.counts.unique_candidates / 3, whole.counts.unique_candidates - 1}) {
+            DetectorOptions part = with_method(Method::kdet);
+            part.initial_candidate_capacity = capacity;
+            const Outcome grown = run(meshes, true, part);
+            EXPECT_EQ(grown.pairs, whole.pairs) << capacity;
+            EXPECT_EQ(grown.counts.unique_candidates, whole.counts.unique_candidates) << capacity;
+            EXPECT_EQ(grown.counts.candidates, whole.counts.candidates) << capacity;
+            EXPECT_GT(grown.counts.buffer_regrows, 0u) << capacity;
+        }
     DetectorOptions tiny_brute = with_method(Method::brute_force_pairs);
     tiny_brute.initial_candidate_capacity = 1;
     EXPECT_EQ(run({a, b}, true, tiny_brute).pairs, reference.pairs);

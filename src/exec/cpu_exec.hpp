@@ -31,6 +31,12 @@ public:
         }
         size_ = n;
     }
+    /// @brief Exchanges the memory of two buffers (growing one while keeping its contents).
+    void swap(HostBuffer& other) noexcept {
+        data_.swap(other.data_);
+        std::swap(size_, other.size_);
+        std::swap(capacity_, other.capacity_);
+    }
     T* data() { return data_.get(); }
     const T* data() const { return data_.get(); }
     std::size_t size() const { return size_; }

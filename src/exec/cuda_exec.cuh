@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kdet {
@@ -50,6 +51,12 @@ public:
             capacity_ = n;
         }
         size_ = n;
+    }
+    /// @brief Exchanges the memory of two buffers (growing one while keeping its contents).
+    void swap(DeviceBuffer& other) noexcept {
+        std::swap(data_, other.data_);
+        std::swap(size_, other.size_);
+        std::swap(capacity_, other.capacity_);
     }
     T* data() { return data_; }
     const T* data() const { return data_; }

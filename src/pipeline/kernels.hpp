@@ -360,41 +360,77 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     }
 }
 
+/// @brief A buffer slot that holds no pair: a batch that did not fit leaves it in the slots it got
+/// below the capacity, so every slot below the count is defined. (t, t) is never a pair.
+constexpr std::uint64_t no_pair_key = ~0ull;
+
 /// @brief Appends to a buffer of `capacity` keys; the counter keeps counting past it so the host
-/// learns the size it needs, grows the buffer and reruns the stage.
+/// learns the size it needs. A batch is stored whole or not at all.
 struct KeyAppender {
     std::uint64_t* keys;
     std::uint64_t capacity;
     unsigned long long* count;
-    KDET_HD void push(std::uint64_t key) const { write(&key, 1); }
-    KDET_HD void write(const std::uint64_t* batch, std::uint32_t n) const {
+    /// Slots filled with no_pair_key by a batch that straddled the capacity; null where every batch
+    /// is a single key, which fits or not.
+    unsigned long long* padding;
+    KDET_HD bool push(std::uint64_t key) const { return write(&key, 1); }
+    KDET_HD bool write(const std::uint64_t* batch, std::uint32_t n) const {
         const unsigned long long first = atomic_fetch_add(count, static_cast<unsigned long long>(n));
-        for (std::uint32_t k = 0; k < n; ++k)
-            if (first + k < capacity) keys[first + k] = batch[k];
+        if (first + n <= capacity) {
+            for (std::uint32_t k = 0; k < n; ++k) keys[first + k] = batch[k];
+            return true;
+        }
+        if (first < capacity && padding) {
+            for (unsigned long long k = first; k < capacity; ++k) keys[k] = no_pair_key;
+            atomic_fetch_add(padding, static_cast<unsigned long long>(capacity - first));
+        }
+        return false;
     }
 };
 
+/// @brief Where a work item stopped when the buffer it appends to was full: after growing, the
+/// stage reruns only such items, each skipping the keys it had already stored.
+struct ResumePoint {
+    std::uint32_t item;
+    std::uint32_t stored;
+};
+
 /// @brief One work item's keys, handed to a KeyAppender a batch at a time: one atomic per batch
-/// instead of one per key, which matters when many threads append at once.
+/// instead of one per key, which matters when many threads append at once. Once a batch has not
+/// fit, the item is `stopped`: later batches only count (every later slot is past the capacity).
 struct KeyBatch {
     static constexpr std::uint32_t size = 16;
     const KeyAppender* out;
+    std::uint32_t skip;   ///< keys an earlier run of this item stored: not written again
+    std::uint32_t stored; ///< keys of this item in the buffer, the skipped ones included
+    bool stopped = false;
     std::uint64_t keys[size];
     std::uint32_t n = 0;
-    KDET_HD explicit KeyBatch(const KeyAppender* appender) : out(appender) {}
+    KDET_HD explicit KeyBatch(const KeyAppender* appender, std::uint32_t already_stored = 0)
+        : out(appender), skip(already_stored), stored(already_stored) {}
     KDET_HD void push(std::uint64_t key) {
+        if (skip) {
+            --skip;
+            return;
+        }
         keys[n++] = key;
         if (n == size) flush();
     }
     KDET_HD void flush() {
-        if (n) out->write(keys, n);
+        if (!n) return;
+        // Once a batch has not fit, none does: the count only grows.
+        if (out->write(keys, n))
+            stored += n;
+        else
+            stopped = true;
         n = 0;
     }
 };
 
 /// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the face-plane pre-test cannot
 /// prove separated (those it can are only counted): a rejected pair is never written, sorted or
-/// loaded again.
+/// loaded again. A tet whose keys did not all fit leaves a ResumePoint instead of counting its
+/// rejections; a rerun after growing (`resume_from` set) visits only those tets.
 struct FindCandidatesKernel {
     SceneView scene;
     GridView grid;
@@ -402,6 +438,9 @@ struct FindCandidatesKernel {
     const std::uint32_t* layer_mask; ///< GridPlanKernel's
     KeyAppender out;
     unsigned long long* rejected; ///< pairs the pre-test proved separated
+    const ResumePoint* resume_from; ///< null: every tet, from the start; else item i resumes resume_from[i]
+    ResumePoint* stopped;           ///< [tets] where the tets that did not fit stopped
+    std::uint32_t* stopped_count;
 
     struct Emit {
         const SceneView* scene;
@@ -426,14 +465,18 @@ struct FindCandidatesKernel {
     };
 
     KDET_HD void operator()(std::uint64_t i) const {
-        const auto t = static_cast<std::uint32_t>(i);
+        const auto t = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
         if (scene.info[t].layer < 0) return;
-        KeyBatch batch(&out);
+        KeyBatch batch(&out, resume_from ? resume_from[i].stored : 0u);
         Emit emit{&scene, &batch, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
         load_tet(scene, t, emit.vertices);
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit);
         batch.flush();
+        if (batch.stopped) {
+            stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{t, batch.stored};
+            return;
+        }
         if (emit.rejected) atomic_fetch_add(rejected, emit.rejected);
     }
 };
@@ -547,9 +590,9 @@ struct BruteForcePairsKernel {
     }
 };
 
-/// @brief Stage 5: decides each candidate once, flags colliding tets and appends each colliding pair
-/// under the caller's tet ids (lower id first; sorted afterwards, so the order of appends does not
-/// matter). The grid methods decide with candidate_collides (their tets have face planes); brute
+/// @brief Stage 5: decides each candidate once (a no_pair_key slot is none), flags colliding tets and
+/// appends each colliding pair under the caller's tet ids (lower id first; sorted afterwards, so
+/// the order of appends does not matter). The grid methods decide with candidate_collides (their tets have face planes); brute
 /// force, whose pairs come tested, with the test alone.
 struct NarrowPhaseKernel {
     SceneView scene;
@@ -562,6 +605,7 @@ struct NarrowPhaseKernel {
     unsigned long long* exact_stage_pairs;
 
     KDET_HD void operator()(std::uint64_t k) const {
+        if (keys[k] == no_pair_key) return;
         const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
         bool reached_exact = false;
         const bool collides = pretest ? candidate_collides(scene, test, t, u, reached_exact)

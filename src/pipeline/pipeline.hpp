@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace kdet {
 
@@ -20,6 +21,7 @@ namespace kdet {
 /// memory; the host reads it once, when the frame is done.
 struct FrameCounters {
     unsigned long long candidates; ///< appended (counts past the buffer's end)
+    unsigned long long candidate_padding; ///< of which slots hold no_pair_key (see KeyAppender)
     unsigned long long tests_run;
     unsigned long long rejected; ///< candidate pairs the face-plane pre-test proved separated
     unsigned long long exact_stage_pairs; ///< pairs that reached the exact stage of NarrowPhase::exact
@@ -29,6 +31,7 @@ struct FrameCounters {
     unsigned long long colliding_pairs;   ///< appended (counts past the window's end)
     unsigned long long colliding_tets;
     unsigned long long involved_tets; ///< tets of the objects in a pair checked this frame
+    std::uint32_t stopped_tets; ///< ResumePoints the candidate search left: its buffer was full
     std::uint32_t grid_failure;
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
@@ -124,7 +127,8 @@ public:
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() +
                headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
-               candidates_.capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
+               candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
+               resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
                blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes() + exec_.scratch_bytes();
     }
 
@@ -160,6 +164,7 @@ private:
     void grid_geometry();
     void size_grid(const FrameCounters& plan);
     GridView populate();
+    std::optional<FrameCounters> find_candidates(const GridView& grid);
     void brute_force();
     void narrow_phase_and_results();
     bool grow_for(const FrameCounters& c);
@@ -192,6 +197,8 @@ private:
     buffer<std::uint32_t> ids_;
     buffer<FrameCounters> counters_;
     buffer<std::uint64_t> candidates_;
+    buffer<std::uint64_t> candidates_grown_; ///< the next candidate buffer while one grows keeping its contents
+    buffer<ResumePoint> resume_points_[2];  ///< where tets stopped, read by one run and written by the next
     buffer<std::uint64_t> out_keys_;  ///< the colliding pairs; its size is the window they are appended to
     buffer<Contact> out_contacts_;
     buffer<std::uint64_t> blocks_begin_;
@@ -297,12 +304,47 @@ GridView Pipeline<Exec>::populate() {
     return grid;
 }
 
+/// @brief Stage 3 (kdet): candidate pairs, each written once. A frame that reads its counters back
+/// here (a first frame, to size the pairs' window) does not rerun when the buffer overflows: the
+/// buffer grows keeping what was stored and only the tets that did not fit search again, each
+/// resuming after the keys it had stored. Later frames read nothing here; an overflow shows in the
+/// frame's counters and the frame reruns (grow_for). Returns the counters when it read them.
+template <class Exec>
+std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
+    for (auto& points : resume_points_) points.resize_discard(tets_.size());
+    std::size_t items = tets_.size();
+    const ResumePoint* resume_from = nullptr;
+    for (int run = 0;; ++run) {
+        FrameCounters* c = counters_.data();
+        ResumePoint* stopped = resume_points_[run % 2].data();
+        const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
+        exec_.for_each(items, FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected,
+                                                   resume_from, stopped, &c->stopped_tets});
+        if (pairs_sized_) return std::nullopt;
+        FrameCounters after = read_counters_now();
+        if (!after.stopped_tets) return after;
+        // Every slot below the size holds a key or padding; the tets that stopped need at most the
+        // slots claimed past it, plus the padding of the one batch that straddled it.
+        const std::size_t kept = candidates_.size();
+        candidates_grown_.resize_discard(after.candidates + KeyBatch::size);
+        exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
+        candidates_.swap(candidates_grown_);
+        ++regrows_;
+        after.candidates = kept;
+        items = after.stopped_tets;
+        after.stopped_tets = 0;
+        exec_.upload(counters_.data(), &after, 1);
+        resume_from = stopped;
+    }
+}
+
 /// @brief Both brute-force methods: every pair of enabled objects is tested, colliding pairs appended.
 /// brute_force_pairs lays its work out per pair of objects on the host, so it reads pair_active_ (one
 /// wait more per frame).
 template <class Exec>
 void Pipeline<Exec>::brute_force() {
-    const KeyAppender out{candidates_.data(), candidates_.size(), &counters_.data()->candidates};
+    FrameCounters* c = counters_.data();
+    const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
     unsigned long long* exact_stage = &counters_.data()->brute_force_exact_stage;
     if (options_.method == Method::brute_force_loop) {
         exec_.for_each(tets_.size(), BruteForceLoopKernel{scene_view(), options_.narrow_phase, object_tet_begin_.data(),
@@ -341,7 +383,7 @@ template <class Exec>
 void Pipeline<Exec>::narrow_phase_and_results() {
     FrameCounters* c = counters_.data();
     out_keys_.resize_discard(pairs_window_);
-    const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs};
+    const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
     exec_.for_each_counted(&c->candidates, candidates_.size(),
                            NarrowPhaseKernel{scene_view(), options_.narrow_phase, grid_method(), candidates_.data(),
                                              colliding_.data(), user_id_.data(), out, &c->exact_stage_pairs});
@@ -365,6 +407,7 @@ template <class Exec>
 void Pipeline<Exec>::enqueue_frame() {
     const Method method = options_.method;
     FrameCounters* c = counters_.data();
+    std::optional<FrameCounters> found; ///< the counters after the candidate stage, when read back
     reset_counters();
     fill(colliding_, 0u);
     bounds_and_culling();
@@ -385,9 +428,7 @@ void Pipeline<Exec>::enqueue_frame() {
         const GridView grid = populate();
         clock_.mark(grid_done);
         if (method == Method::kdet) {
-            const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates};
-            exec_.for_each(tets_.size(), FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out,
-                                                              &c->rejected});
+            found = find_candidates(grid);
         } else {
             exec_.for_each(tets_.size(), NoPairsKernel{scene_view(), grid, &c->params, &c->layer_mask,
                                                        options_.narrow_phase, colliding_.data(), &c->tests_run,
@@ -403,8 +444,8 @@ void Pipeline<Exec>::enqueue_frame() {
     if (method != Method::kdet_no_pairs) {
         if (!pairs_sized_) {
             // The colliding pairs are at most the candidates.
-            const FrameCounters found = read_counters_now();
-            pairs_window_ = std::max<std::size_t>(pairs_window_, std::min<std::size_t>(found.candidates, candidates_.size()));
+            if (!found) found = read_counters_now();
+            pairs_window_ = std::max<std::size_t>(pairs_window_, std::min<std::size_t>(found->candidates, candidates_.size()));
             pairs_sized_ = true;
         }
         narrow_phase_and_results();
@@ -484,8 +525,8 @@ void Pipeline<Exec>::finish(FrameResult& result) {
     if (method == Method::kdet_no_pairs) {
         counts.candidates = counts.unique_candidates = c.tests_run;
     } else {
-        counts.unique_candidates = c.candidates;
-        counts.candidates = c.candidates + c.rejected;
+        counts.unique_candidates = c.candidates - c.candidate_padding;
+        counts.candidates = counts.unique_candidates + c.rejected;
     }
     counts.exact_stage_pairs = c.exact_stage_pairs;
     counts.colliding_pairs = colliding_count_;
