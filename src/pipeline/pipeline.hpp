@@ -324,9 +324,10 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         FrameCounters after = read_counters_now();
         if (!after.stopped_tets) return after;
         // Every slot below the size holds a key or padding; the tets that stopped need at most the
-        // slots claimed past it, plus the padding of the one batch that straddled it.
+        // slots claimed past it, plus the padding of the one batch that straddled it. A quarter
+        // more leaves room for the next frames, whose overflow would rerun the whole frame.
         const std::size_t kept = candidates_.size();
-        candidates_grown_.resize_discard(after.candidates + KeyBatch::size);
+        candidates_grown_.resize_discard(after.candidates + after.candidates / 4 + KeyBatch::size);
         exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
         candidates_.swap(candidates_grown_);
         ++regrows_;
