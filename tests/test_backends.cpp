@@ -184,6 +184,14 @@ TEST_F(CudaBackend, AFrameOnTheCallersStreamReadsPositionsWrittenBeforeItOnThatS
     EXPECT_EQ(got.pairs, expected.pairs);
     EXPECT_EQ(got.colliding, expected.colliding);
     ASSERT_EQ(got.contacts.size(), expected.contacts.size());
+
+    // The same frame enqueued without a wait: finish() waits once and gives the same answer.
+    detector.set_positions_on_device(ib, device_xyz, b.num_vertices());
+    detector.detect_async();
+    const FrameResult& finished = detector.finish();
+    EXPECT_EQ(finished.counts.host_waits, 1u);
+    EXPECT_EQ(finished.pairs, expected.pairs);
+    EXPECT_EQ(finished.colliding, expected.colliding);
     cudaFree(device_xyz);
     cudaFreeHost(pinned);
     cudaStreamDestroy(stream);
