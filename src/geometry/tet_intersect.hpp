@@ -19,6 +19,8 @@
 #include "geometry/gpr.hpp"
 #include "geometry/sat.hpp"
 
+#include <type_traits>
+
 namespace kdet {
 
 /// @brief Separating axis test over the 44 axes (4 + 4 face normals, 36 edge cross products).
@@ -70,29 +72,55 @@ KDET_HD inline bool tets_intersect_exact(const vec3 a[4], const vec3 b[4]) {
     return narrow::exact_intersect(a, b, exact_stage);
 }
 
-/// @brief Runs the test selected by `test`; `exact_stage` as for tets_intersect_exact (only that test
-/// has an exact stage).
-KDET_HD inline bool tets_intersect(NarrowPhase test, const vec3 a[4], const vec3 b[4], bool& exact_stage) {
-    switch (test) {
-    case NarrowPhase::exact:
+/// @brief The test `Test`, chosen at compile time, so that a kernel instantiated for one test holds
+/// only that test's code (registers and stack are those of the test in use); `exact_stage` as for
+/// tets_intersect_exact (only that test has an exact stage).
+template <NarrowPhase Test>
+KDET_HD inline bool tets_intersect_as(const vec3 a[4], const vec3 b[4], bool& exact_stage) {
+    if constexpr (Test == NarrowPhase::exact) {
         return tets_intersect_exact(a, b, exact_stage);
-    case NarrowPhase::sat_no_edges:
+    } else if constexpr (Test == NarrowPhase::sat_no_edges) {
         return tets_intersect_sat_no_edges(a, b);
-    case NarrowPhase::sat_mtv: {
+    } else if constexpr (Test == NarrowPhase::sat_mtv) {
         float depth;
         vec3 direction;
         return tets_intersect_sat_mtv(a, b, depth, direction);
-    }
-    case NarrowPhase::gjk:
+    } else if constexpr (Test == NarrowPhase::gjk) {
         return tets_intersect_gjk(a, b);
-    case NarrowPhase::fast:
+    } else if constexpr (Test == NarrowPhase::fast) {
         return tets_intersect_fast(a, b);
+    } else {
+        static_assert(Test == NarrowPhase::sat, "every NarrowPhase has its test");
+        return tets_intersect_sat(a, b);
+    }
+}
+
+/// @brief Calls `f` with std::integral_constant<NarrowPhase, test>: turns a test chosen at run time
+/// into one chosen at compile time, once per launch instead of once per pair.
+template <class F>
+KDET_HD inline decltype(auto) with_narrow_phase(NarrowPhase test, F&& f) {
+    switch (test) {
+    case NarrowPhase::exact:
+        return f(std::integral_constant<NarrowPhase, NarrowPhase::exact>{});
+    case NarrowPhase::sat_no_edges:
+        return f(std::integral_constant<NarrowPhase, NarrowPhase::sat_no_edges>{});
+    case NarrowPhase::sat_mtv:
+        return f(std::integral_constant<NarrowPhase, NarrowPhase::sat_mtv>{});
+    case NarrowPhase::gjk:
+        return f(std::integral_constant<NarrowPhase, NarrowPhase::gjk>{});
+    case NarrowPhase::fast:
+        return f(std::integral_constant<NarrowPhase, NarrowPhase::fast>{});
     case NarrowPhase::sat:
         break;
     }
-    return tets_intersect_sat(a, b);
+    return f(std::integral_constant<NarrowPhase, NarrowPhase::sat>{});
 }
 
+/// @brief Runs the test selected by `test` (for code that tests a few pairs; kernels take the test
+/// as a template argument); `exact_stage` as for tets_intersect_exact.
+KDET_HD inline bool tets_intersect(NarrowPhase test, const vec3 a[4], const vec3 b[4], bool& exact_stage) {
+    return with_narrow_phase(test, [&](auto chosen) { return tets_intersect_as<decltype(chosen)::value>(a, b, exact_stage); });
+}
 KDET_HD inline bool tets_intersect(NarrowPhase test, const vec3 a[4], const vec3 b[4]) {
     bool exact_stage = false;
     return tets_intersect(test, a, b, exact_stage);

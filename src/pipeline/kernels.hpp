@@ -74,24 +74,25 @@ KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<
 /// @brief The narrow-phase test alone on stored tets first < second: the lower stored id goes first, so
 /// every method sees the same floating-point computation. `exact_stage` is set when the pair reached
 /// the exact stage of NarrowPhase::exact.
-KDET_HD inline bool test_pair(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second,
-                              bool& exact_stage) {
+template <NarrowPhase Test>
+KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint32_t second, bool& exact_stage) {
     vec3 a[4], b[4];
     load_tet(s, first, a);
     load_tet(s, second, b);
-    return tets_intersect(test, a, b, exact_stage);
+    return tets_intersect_as<Test>(a, b, exact_stage);
 }
 
 /// @brief The decision for a pair whose boxes overlap and that is not adjacent (first < second): the
 /// face-plane pre-test where it is sure (the answer the test gives, see face_planes.hpp), else the test.
-KDET_HD inline bool candidate_collides(const SceneView& s, NarrowPhase test, std::uint32_t first, std::uint32_t second,
+template <NarrowPhase Test>
+KDET_HD inline bool candidate_collides(const SceneView& s, std::uint32_t first, std::uint32_t second,
                                        bool& exact_stage) {
     vec3 a[4], b[4];
     load_tet(s, first, a);
     load_tet(s, second, b);
     const PlaneVerdict verdict = face_plane_pretest(s.planes[first], a, s.planes[second], b, false);
     if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
-    return tets_intersect(test, a, b, exact_stage);
+    return tets_intersect_as<Test>(a, b, exact_stage);
 }
 
 /// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, and
@@ -103,10 +104,10 @@ KDET_HD inline bool may_collide(const SceneView& s, std::uint32_t first, std::ui
 
 /// @brief The brute-force methods' predicate: adjacency, boxes, then the test itself, without the
 /// pre-test, so that they stay the oracle the grid methods (which use it) are compared with.
-KDET_HD inline bool tets_collide_tested(const SceneView& s, NarrowPhase test, std::uint32_t t, std::uint32_t u,
-                                       bool& exact_stage) {
+template <NarrowPhase Test>
+KDET_HD inline bool tets_collide_tested(const SceneView& s, std::uint32_t t, std::uint32_t u, bool& exact_stage) {
     const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
-    return may_collide(s, first, second) && test_pair(s, test, first, second, exact_stage);
+    return may_collide(s, first, second) && test_pair<Test>(s, first, second, exact_stage);
 }
 
 /// @brief Stage 1: box of each tet; no size and no layer yet.
@@ -483,12 +484,12 @@ struct FindCandidatesKernel {
 
 /// @brief The thesis's old method (algorithm 4.2): test inline and only flag colliding tets,
 /// skipping a pair when both tets are already flagged.
+template <NarrowPhase Test>
 struct NoPairsKernel {
     SceneView scene;
     GridView grid;
     const GridParams* params;        ///< GridParamsKernel's
     const std::uint32_t* layer_mask; ///< GridPlanKernel's
-    NarrowPhase test;
     std::uint32_t* colliding;
     unsigned long long* tests_run;
     unsigned long long* exact_stage_pairs;
@@ -505,7 +506,7 @@ struct NoPairsKernel {
             const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
             bool reached_exact = false;
             if (may_collide(kernel->scene, first, second) &&
-                candidate_collides(kernel->scene, kernel->test, first, second, reached_exact)) {
+                candidate_collides<Test>(kernel->scene, first, second, reached_exact)) {
                 atomic_store_relaxed(&flags[t], 1u);
                 atomic_store_relaxed(&flags[u], 1u);
             }
@@ -523,9 +524,9 @@ struct NoPairsKernel {
 };
 
 /// @brief Brute force, one work item per tet: tests it against every later tet it may collide with.
+template <NarrowPhase Test>
 struct BruteForceLoopKernel {
     SceneView scene;
-    NarrowPhase test;
     const std::uint32_t* object_tet_begin; ///< [object_count + 1]
     KeyAppender out;
     unsigned long long* exact_stage_pairs;
@@ -540,7 +541,7 @@ struct BruteForceLoopKernel {
             const std::uint32_t begin = other == object ? t + 1 : object_tet_begin[other];
             for (std::uint32_t u = begin; u < object_tet_begin[other + 1]; ++u) {
                 bool reached_exact = false;
-                if (tets_collide_tested(scene, test, t, u, reached_exact)) batch.push(pair_key(t, u));
+                if (tets_collide_tested<Test>(scene, t, u, reached_exact)) batch.push(pair_key(t, u));
                 exact_stage += reached_exact;
             }
         }
@@ -551,9 +552,9 @@ struct BruteForceLoopKernel {
 
 /// @brief Brute force, one work item per pair. Work is laid out in blocks, one per active object
 /// pair; a self block enumerates i < j row by row.
+template <NarrowPhase Test>
 struct BruteForcePairsKernel {
     SceneView scene;
-    NarrowPhase test;
     const std::uint32_t* object_tet_begin; ///< [object_count + 1]
     const std::uint64_t* block_begin;      ///< [block_count + 1] work offsets
     const std::uint32_t* block_objects;    ///< [2 * block_count]
@@ -585,7 +586,7 @@ struct BruteForcePairsKernel {
         const auto t = static_cast<std::uint32_t>(object_tet_begin[oa] + i);
         const auto u = static_cast<std::uint32_t>(object_tet_begin[ob] + j);
         bool reached_exact = false;
-        if (tets_collide_tested(scene, test, t, u, reached_exact)) out.push(pair_key(t, u));
+        if (tets_collide_tested<Test>(scene, t, u, reached_exact)) out.push(pair_key(t, u));
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull);
     }
 };
@@ -594,9 +595,9 @@ struct BruteForcePairsKernel {
 /// appends each colliding pair under the caller's tet ids (lower id first; sorted afterwards, so
 /// the order of appends does not matter). The grid methods decide with candidate_collides (their tets have face planes); brute
 /// force, whose pairs come tested, with the test alone.
+template <NarrowPhase Test>
 struct NarrowPhaseKernel {
     SceneView scene;
-    NarrowPhase test;
     bool pretest;
     const std::uint64_t* keys;
     std::uint32_t* colliding;
@@ -608,8 +609,8 @@ struct NarrowPhaseKernel {
         if (keys[k] == no_pair_key) return;
         const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
         bool reached_exact = false;
-        const bool collides = pretest ? candidate_collides(scene, test, t, u, reached_exact)
-                                      : test_pair(scene, test, t, u, reached_exact);
+        const bool collides = pretest ? candidate_collides<Test>(scene, t, u, reached_exact)
+                                      : test_pair<Test>(scene, t, u, reached_exact);
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);

@@ -348,8 +348,10 @@ void Pipeline<Exec>::brute_force() {
     const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
     unsigned long long* exact_stage = &counters_.data()->brute_force_exact_stage;
     if (options_.method == Method::brute_force_loop) {
-        exec_.for_each(tets_.size(), BruteForceLoopKernel{scene_view(), options_.narrow_phase, object_tet_begin_.data(),
-                                                          out, exact_stage});
+        with_narrow_phase(options_.narrow_phase, [&](auto test) {
+            exec_.for_each(tets_.size(), BruteForceLoopKernel<decltype(test)::value>{scene_view(), object_tet_begin_.data(), out,
+                                                                          exact_stage});
+        });
         return;
     }
     const std::size_t objects = object_boxes_.size();
@@ -370,10 +372,13 @@ void Pipeline<Exec>::brute_force() {
     exec_.upload(blocks_begin_.data(), block_begin.data(), block_begin.size());
     block_objects_.resize_discard(block_objects.size());
     exec_.upload(block_objects_.data(), block_objects.data(), block_objects.size());
-    exec_.for_each(block_begin.back(),
-                   BruteForcePairsKernel{scene_view(), options_.narrow_phase, object_tet_begin_.data(),
-                                         blocks_begin_.data(), block_objects_.data(),
-                                         static_cast<std::uint32_t>(block_objects.size() / 2), out, exact_stage});
+    with_narrow_phase(options_.narrow_phase, [&](auto test) {
+        exec_.for_each(block_begin.back(),
+                       BruteForcePairsKernel<decltype(test)::value>{scene_view(), object_tet_begin_.data(), blocks_begin_.data(),
+                                                         block_objects_.data(),
+                                                         static_cast<std::uint32_t>(block_objects.size() / 2), out,
+                                                         exact_stage});
+    });
 }
 
 /// @brief Stages 5 and 6: the narrow phase once per candidate (they are unique, see
@@ -385,9 +390,12 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     FrameCounters* c = counters_.data();
     out_keys_.resize_discard(pairs_window_);
     const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
-    exec_.for_each_counted(&c->candidates, candidates_.size(),
-                           NarrowPhaseKernel{scene_view(), options_.narrow_phase, grid_method(), candidates_.data(),
-                                             colliding_.data(), user_id_.data(), out, &c->exact_stage_pairs});
+    with_narrow_phase(options_.narrow_phase, [&](auto test) {
+        exec_.for_each_counted(&c->candidates, candidates_.size(),
+                               NarrowPhaseKernel<decltype(test)::value>{scene_view(), grid_method(), candidates_.data(),
+                                                             colliding_.data(), user_id_.data(), out,
+                                                             &c->exact_stage_pairs});
+    });
     clock_.mark(narrow_phase_done);
     // The keys hold the caller's ids, which are below the tet count.
     exec_.sort(out_keys_.data(), out_keys_.size(), &c->colliding_pairs,
@@ -431,9 +439,11 @@ void Pipeline<Exec>::enqueue_frame() {
         if (method == Method::kdet) {
             found = find_candidates(grid);
         } else {
-            exec_.for_each(tets_.size(), NoPairsKernel{scene_view(), grid, &c->params, &c->layer_mask,
-                                                       options_.narrow_phase, colliding_.data(), &c->tests_run,
-                                                       &c->exact_stage_pairs});
+            with_narrow_phase(options_.narrow_phase, [&](auto test) {
+                exec_.for_each(tets_.size(), NoPairsKernel<decltype(test)::value>{scene_view(), grid, &c->params, &c->layer_mask,
+                                                                       colliding_.data(), &c->tests_run,
+                                                                       &c->exact_stage_pairs});
+            });
         }
     } else {
         if (candidates_.size() == 0)
