@@ -315,6 +315,7 @@ struct LargerNeighbourFilter {
     Visitor* visit;
     int layer;                 ///< layer being visited
     bool same_layer;           ///< visiting t's own layer: every id there is on t's layer
+    bool self_collides;        ///< t's object is checked against itself
     std::uint32_t first[3];    ///< t's first cell per axis on this layer
     std::uint32_t cell[3];     ///< cell being visited (not wrapped)
 
@@ -329,11 +330,13 @@ struct LargerNeighbourFilter {
     KDET_HD void operator()(std::uint32_t u) const {
         // A cell holds only tets of its own layer, so the tie-break needs no load of u's data.
         if (same_layer && u <= t) return;
-        // Most entries fail the box test, so it comes before anything that loads more of u's data.
+        // Without self-collision most entries of a cell belong to t's own object, and the object check
+        // rejects them before u's box is loaded; with it, most entries fail the box test, so it goes first.
+        if (!self_collides && !pair_is_active(*scene, object, scene->tet_object[u])) return;
         const Aabb& other = scene->info[u].box;
         if (!boxes_overlap(box, other)) return;
+        if (self_collides && !pair_is_active(*scene, object, scene->tet_object[u])) return;
         if (!reports_from_this_cell(other)) return;
-        if (!pair_is_active(*scene, object, scene->tet_object[u])) return;
         (*visit)(u);
     }
 };
@@ -343,7 +346,9 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
                                              std::uint32_t layer_mask, std::uint32_t t, Visitor& visit) {
     const TetInfo self = scene.info[t];
     if (self.layer < 0) return;
-    LargerNeighbourFilter<Visitor> filter{&scene, &params, t, scene.tet_object[t], self.box, &visit, 0, true, {}, {}};
+    const std::uint32_t object = scene.tet_object[t];
+    LargerNeighbourFilter<Visitor> filter{&scene, &params, t, object, self.box, &visit, 0, true,
+                                          pair_is_active(scene, object, object), {}, {}};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
         filter.layer = layer;
