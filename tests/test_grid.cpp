@@ -3,12 +3,14 @@
 #include "exec/cpu_exec.hpp"
 #include "geometry/enclosing_sphere.hpp"
 #include "grid/bucket_table.hpp"
+#include "pipeline/kernels.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <set>
+#include <tuple>
 #include <vector>
 
 namespace kdet {
@@ -138,6 +140,60 @@ struct TestTable {
         return found;
     }
 };
+
+TEST(GridPlan, CountsEveryEntryAndBoundsTheOccupiedCellsInAnyOrder) {
+    // Boxes of three sizes along a walk (neighbours share cells, as in spatial order), then the
+    // same boxes shuffled: the bound on the occupied cells must hold whatever the order.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> step(-0.1f, 0.1f), unit(0.0f, 1.0f);
+    std::vector<TetInfo> walk;
+    vec3 at{5.0f, 5.0f, 5.0f};
+    for (int i = 0; i < 3000; ++i) {
+        at = at + vec3{step(rng), step(rng), step(rng)};
+        const float size = (i / 100) % 3 == 0 ? 0.25f : (i / 100) % 3 == 1 ? 0.6f : 1.7f;
+        const vec3 extent{size * (0.5f + 0.5f * unit(rng)), size * 0.7f, size * unit(rng)};
+        walk.push_back(TetInfo{Aabb{at, at + extent}, size, 0});
+    }
+    std::vector<TetInfo> shuffled = walk;
+    std::shuffle(shuffled.begin(), shuffled.end(), rng);
+    const GridParams params{{0.0f, 0.0f, 0.0f}, 0.25f, 4.0f, 4};
+    for (std::vector<TetInfo>* infos : {&walk, &shuffled}) {
+        SceneView scene{};
+        scene.info = infos->data();
+        scene.tet_count = static_cast<std::uint32_t>(infos->size());
+        unsigned long long entries[max_grid_layers] = {}, cells[max_grid_layers] = {};
+        std::uint32_t mask = 0;
+        const std::uint32_t chunk = 64;
+        const GridPlanKernel plan{scene, &params, chunk, entries, cells, &mask};
+        for (std::uint64_t c = 0; c * chunk < infos->size(); ++c) plan(c);
+
+        std::set<std::tuple<int, std::uint32_t, std::uint32_t, std::uint32_t>> occupied[max_grid_layers];
+        unsigned long long expected_entries[max_grid_layers] = {};
+        for (const TetInfo& info : *infos) {
+            const CellRange r = cell_range(params, info.box, info.layer);
+            for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+                for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+                    for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
+                        occupied[info.layer].insert({info.layer, x, y, z});
+                        ++expected_entries[info.layer];
+                    }
+        }
+        EXPECT_EQ(mask, 0b1101u); // sizes 0.25, 0.6 and 1.7: layers 0, 2 and 3
+        for (int layer = 0; layer < max_grid_layers; ++layer) {
+            EXPECT_EQ(entries[layer], expected_entries[layer]) << "layer " << layer;
+            EXPECT_GE(cells[layer], occupied[layer].size()) << "layer " << layer;
+            EXPECT_LE(cells[layer], entries[layer]) << "layer " << layer;
+        }
+        if (infos == &walk) { // neighbours share cells: the bound is far below the entries
+            unsigned long long total_entries = 0, total_cells = 0;
+            for (int layer = 0; layer < max_grid_layers; ++layer) {
+                total_entries += entries[layer];
+                total_cells += cells[layer];
+            }
+            EXPECT_LT(2 * total_cells, total_entries);
+        }
+    }
+}
 
 TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
     TestTable table(64, 4, 4096, 32, HashFunction::fnv1a);

@@ -240,15 +240,37 @@ struct GridParamsKernel {
     }
 };
 
+/// @brief Cells in a range.
+KDET_HD inline unsigned long long cell_count(const CellRange& r) {
+    return static_cast<unsigned long long>(r.hi[0] - r.lo[0] + 1) * (r.hi[1] - r.lo[1] + 1) * (r.hi[2] - r.lo[2] + 1);
+}
+
+/// @brief Cells in both ranges.
+KDET_HD inline unsigned long long shared_cell_count(const CellRange& a, const CellRange& b) {
+    unsigned long long n = 1;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::uint32_t lo = a.lo[axis] > b.lo[axis] ? a.lo[axis] : b.lo[axis];
+        const std::uint32_t hi = a.hi[axis] < b.hi[axis] ? a.hi[axis] : b.hi[axis];
+        if (hi < lo) return 0;
+        n *= hi - lo + 1;
+    }
+    return n;
+}
+
 /// @brief Stage 2, before populating: picks each relevant tet's layer and counts, per layer, the
-/// cells the tets there will be inserted into, so that the host can size the table before filling it.
-/// One work item per chunk of tets; neighbouring tets (spatial order) mostly share a layer, so a
-/// count is added atomically only when the layer changes along the chunk.
+/// cell entries the tets there will be inserted into, and a bound on the cells they occupy, so that
+/// the host can size the table before filling it. One work item per chunk of tets; neighbouring tets
+/// (spatial order) mostly share a layer, so the counts are added atomically only when the layer
+/// changes along the chunk. The bound counts the cells of each tet that the chunk's previous tet did
+/// not cover: an occupied cell is counted at least once, in every chunk where it first appears, and
+/// neighbours in the spatial order share most of their cells, so the bound stays close to the truth
+/// where the entries overestimate the cells many times (every cell holds tens of tets).
 struct GridPlanKernel {
     SceneView scene;
     const GridParams* grid_params; ///< GridParamsKernel's
     std::uint32_t chunk;
     unsigned long long* layer_entries; ///< [max_grid_layers]
+    unsigned long long* layer_cells;   ///< [max_grid_layers]
     std::uint32_t* layer_mask;
 
     KDET_HD void operator()(std::uint64_t c) const {
@@ -256,7 +278,8 @@ struct GridPlanKernel {
         const std::uint64_t end = begin + chunk < scene.tet_count ? begin + chunk : scene.tet_count;
         const GridParams params = *grid_params;
         int run_layer = -1;
-        unsigned long long run_entries = 0;
+        unsigned long long run_entries = 0, run_cells = 0;
+        CellRange previous{};
         std::uint32_t mask = 0;
         for (std::uint64_t t = begin; t < end; ++t) {
             TetInfo& info = scene.info[t];
@@ -264,16 +287,25 @@ struct GridPlanKernel {
             const int layer = layer_of(params, info.diameter);
             info.layer = layer;
             const CellRange r = cell_range(params, info.box, layer);
+            const unsigned long long cells = cell_count(r);
             if (layer != run_layer) {
-                if (run_entries) atomic_fetch_add(&layer_entries[run_layer], run_entries);
+                if (run_entries) {
+                    atomic_fetch_add(&layer_entries[run_layer], run_entries);
+                    atomic_fetch_add(&layer_cells[run_layer], run_cells);
+                }
                 run_layer = layer;
-                run_entries = 0;
+                run_entries = run_cells = 0;
+                previous = CellRange{{1, 1, 1}, {0, 0, 0}}; // empty: shares no cell
             }
-            run_entries += static_cast<unsigned long long>(r.hi[0] - r.lo[0] + 1) * (r.hi[1] - r.lo[1] + 1) *
-                           (r.hi[2] - r.lo[2] + 1);
+            run_entries += cells;
+            run_cells += cells - shared_cell_count(r, previous);
+            previous = r;
             mask |= 1u << layer;
         }
-        if (run_entries) atomic_fetch_add(&layer_entries[run_layer], run_entries);
+        if (run_entries) {
+            atomic_fetch_add(&layer_entries[run_layer], run_entries);
+            atomic_fetch_add(&layer_cells[run_layer], run_cells);
+        }
         if (mask) atomic_fetch_or(layer_mask, mask);
     }
 };

@@ -43,6 +43,7 @@ struct FrameCounters {
     OrderedBox region; ///< the gridded region: the boxes of the objects in a checked pair
     GridParams params; ///< GridParamsKernel's
     unsigned long long layer_entries[max_grid_layers]; ///< cell entries the relevant tets need, per layer
+    unsigned long long layer_cells[max_grid_layers];   ///< bound on the cells they occupy, per layer
 
     /// The values a frame starts from: empty size range and region.
     static FrameCounters fresh() {
@@ -246,12 +247,12 @@ void Pipeline<Exec>::grid_geometry() {
     exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, &c->region, &c->params});
     constexpr std::uint32_t chunk = 256;
     exec_.for_each((tets_.size() + chunk - 1) / chunk,
-                   GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, &c->layer_mask});
+                   GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask});
 }
 
-/// @brief Sizes the table for a plan: a cell holds at least one entry and lies in the gridded region,
-/// so per layer the occupied cells are at most the entries and at most the region's cells; the table
-/// gets a quarter more slots than that bound (probing stays short), and the overflow pool one bucket
+/// @brief Sizes the table for a plan: per layer the occupied cells are at most the plan's bound
+/// (GridPlanKernel) and at most the region's cells; the table gets a quarter more slots than that
+/// bound (probing stays short), and the overflow pool one bucket
 /// per bucket_capacity entries, which holds every chain whatever the cells' fill. Both only grow, so
 /// a scene that keeps its size sizes them once.
 template <class Exec>
@@ -261,6 +262,7 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     for (int layer = 0; layer < params.layer_count; ++layer) {
         const double n = static_cast<double>(plan.layer_entries[layer]);
         if (n == 0.0) continue;
+        const double occupied = static_cast<double>(plan.layer_cells[layer]);
         const double cell = std::ldexp(static_cast<double>(params.cell_size0), layer);
         double region = 1.0;
         for (int a = 0; a < 3; ++a) {
@@ -268,7 +270,7 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
                                   static_cast<double>(ordered_to_float(plan.region.lo[a]));
             region *= std::floor(extent / cell) + 2.0;
         }
-        cells += std::min(n, region);
+        cells += std::min(occupied, region);
         entries += n;
     }
     const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
