@@ -117,6 +117,15 @@ TEST(CellRange, ClampsNonFiniteAndFarCoordinates) {
 }
 
 /// A table on the CPU execution layer with the given geometry.
+/// Visits every entry of a cell.
+struct EveryEntry {
+    std::multiset<std::uint32_t> found;
+    void operator()(const GridEntry& e) {
+        EXPECT_EQ(e.object, e.id);
+        found.insert(e.id);
+    }
+};
+
 struct TestTable {
     std::vector<BucketHeader> headers;
     std::vector<std::uint32_t> ids;
@@ -126,18 +135,38 @@ struct TestTable {
         : headers(slots + pool, BucketHeader{}), ids(static_cast<std::size_t>(slots + pool) * capacity) {
         std::uint32_t bits = 0;
         while ((1u << bits) < slots) ++bits;
-        view = GridView{headers.data(), ids.data(), &overflow_used, &failure, &claimed, slots, bits, capacity, pool, 1,
-                        probes, hash};
+        view = GridView{headers.data(), ids.data(), nullptr, nullptr, 0, &overflow_used, &failure, &claimed,
+                        slots, bits, capacity, pool, 1, probes, hash};
+    }
+    /// A compacted copy of the table (the table itself stays open for inserts), with room for
+    /// `room` entries; each entry carries its id, and its id again as the object.
+    struct Compacted {
+        std::vector<BucketHeader> headers;
+        std::vector<GridEntry> entries;
+        std::uint32_t used = 0, failure = 0;
+        GridView view;
+    };
+    Compacted compacted(std::size_t room) const {
+        Compacted c{headers, std::vector<GridEntry>(room), 0, 0, view};
+        c.view.headers = c.headers.data();
+        c.view.entries = c.entries.data();
+        c.view.entries_used = &c.used;
+        c.view.entry_capacity = static_cast<std::uint32_t>(room);
+        c.view.failure = &c.failure;
+        for (std::uint32_t slot = 0; slot < view.slot_count; ++slot)
+            compact_cell(c.view, slot, [](std::uint32_t id) { return GridEntry{Aabb{}, id, id}; });
+        return c;
     }
     void next_frame() {
         ++view.stamp;
         overflow_used = failure = claimed = 0;
     }
     std::multiset<std::uint32_t> contents(CellCoord cell) const {
-        std::multiset<std::uint32_t> found;
-        auto collect = [&](std::uint32_t id) { found.insert(id); };
-        grid_for_each_in_cell(view, cell, collect);
-        return found;
+        const Compacted c = compacted(ids.size());
+        EXPECT_EQ(c.failure, 0u);
+        EveryEntry collect;
+        grid_for_each_in_cell(c.view, cell, collect);
+        return collect.found;
     }
 };
 
@@ -233,6 +262,20 @@ TEST(BucketTable, ANewStampEmptiesTheTableWithoutClearing) {
     EXPECT_TRUE(table.contents(CellCoord{1, 2, 3, 0}).empty());
     grid_insert(table.view, CellCoord{1, 2, 3, 0}, 7);
     EXPECT_EQ(table.contents(CellCoord{1, 2, 3, 0}), std::multiset<std::uint32_t>{7});
+}
+
+TEST(BucketTable, CompactionThatDoesNotFitSaysSoAndLeavesEmptyCells) {
+    TestTable table(64, 4, 64, 32, HashFunction::djb2);
+    for (std::uint32_t i = 0; i < 30; ++i) grid_insert(table.view, CellCoord{i % 3, 0, 0, 0}, i);
+    const auto exact = table.compacted(30);
+    EXPECT_EQ(exact.failure, 0u);
+    EXPECT_EQ(exact.used, 30u);
+    const auto short_of_room = table.compacted(25);
+    EXPECT_EQ(short_of_room.failure, static_cast<std::uint32_t>(grid_entries_full));
+    EveryEntry readable;
+    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, readable);
+    EXPECT_EQ(readable.found.size(), 20u); // two cells of ten fit; the third reads as empty
+    for (std::uint32_t id : readable.found) EXPECT_LT(id, 30u);
 }
 
 TEST(CellKey, DistinguishesLayersAndCoordinates) {

@@ -1,13 +1,16 @@
 #pragma once
 /// @file bucket_table.hpp
 /// @brief The hash table that stores the grid: fixed-capacity buckets, rehash probing on misses,
-/// overflow buckets chained per cell, and a frame stamp so the table never needs clearing.
+/// overflow buckets chained per cell, and a frame stamp so the table never needs clearing. Once
+/// filled, each cell's chain is copied into one contiguous list of entries (compact_cell), which is
+/// what queries read.
 ///
 /// A bucket's `state` is stamp*2 while a thread is writing its header and stamp*2+1 once it is ready;
 /// any other stamp means the bucket is empty this frame. Overflow buckets come from a pool after the
 /// main slots. When probing or the pool runs out, the insert reports it and the host grows and reruns.
 
 #include "exec/atomic.hpp"
+#include "geometry/vec3.hpp"
 #include "grid/grid_math.hpp"
 
 #include <cstdint>
@@ -17,20 +20,33 @@ namespace kdet {
 constexpr std::uint32_t no_bucket = 0xffffffffu;
 
 /// @brief Bits of GridView::failure.
-enum GridFailure : std::uint32_t { grid_table_full = 1u, grid_overflow_pool_full = 2u };
+enum GridFailure : std::uint32_t { grid_table_full = 1u, grid_overflow_pool_full = 2u, grid_entries_full = 4u };
 
 struct BucketHeader {
     std::uint32_t state;
-    std::uint32_t count; ///< ids appended so far; may exceed the capacity, readers clamp
-    std::uint32_t next;  ///< overflow bucket for the same cell, or no_bucket
-    std::uint32_t unused;
+    /// Ids appended so far (may exceed the capacity: the chain holds the rest). Once the cell is
+    /// compacted, on its main bucket: the cell's entries, all of its chain.
+    std::uint32_t count;
+    std::uint32_t next;        ///< overflow bucket for the same cell, or no_bucket
+    std::uint32_t first_entry; ///< once compacted, on the main bucket: where the cell's entries start
     std::uint64_t key;
+};
+
+/// @brief One id of a compacted cell with what a query filters on, so that scanning a cell reads
+/// one contiguous list instead of each id's data wherever it lies.
+struct GridEntry {
+    Aabb box;
+    std::uint32_t id;
+    std::uint32_t object;
 };
 
 /// @brief A plain view of the table's buffers, passed by value into per-element code.
 struct GridView {
     BucketHeader* headers;          ///< slot_count main buckets, then overflow_capacity pool buckets
     std::uint32_t* ids;             ///< bucket_capacity ids per bucket
+    GridEntry* entries;             ///< the compacted cells' lists
+    std::uint32_t* entries_used;
+    std::uint32_t entry_capacity;
     std::uint32_t* overflow_used;   ///< pool buckets handed out this frame
     std::uint32_t* failure;         ///< GridFailure bits
     std::uint32_t* cells_claimed;   ///< main buckets claimed this frame (occupied cells)
@@ -115,15 +131,41 @@ KDET_HD inline std::uint32_t grid_find(const GridView& g, CellCoord cell) {
     return no_bucket;
 }
 
-/// @brief Calls visit(id) for every id stored in `cell`.
+/// @brief Copies the ids of the cell whose main bucket is `slot` (if it is occupied this frame) into
+/// one list of entries, entry_of(id) each, and points the main bucket at it. When the list does not
+/// fit, the cell reads as empty and grid_entries_full is set: the frame reruns with more room.
+template <class EntryOf>
+KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const EntryOf& entry_of) {
+    BucketHeader& main = g.headers[slot];
+    if ((main.state >> 1) != g.stamp) return;
+    std::uint32_t total = 0;
+    for (std::uint32_t b = slot; b != no_bucket; b = g.headers[b].next)
+        total += g.headers[b].count < g.bucket_capacity ? g.headers[b].count : g.bucket_capacity;
+    const std::uint32_t first = atomic_fetch_add(g.entries_used, total);
+    if (first > g.entry_capacity || total > g.entry_capacity - first) {
+        atomic_fetch_or(g.failure, static_cast<std::uint32_t>(grid_entries_full));
+        main.count = 0;
+        main.first_entry = 0;
+        return;
+    }
+    std::uint32_t k = first;
+    for (std::uint32_t b = slot; b != no_bucket; b = g.headers[b].next) {
+        const std::uint32_t n = g.headers[b].count < g.bucket_capacity ? g.headers[b].count : g.bucket_capacity;
+        const std::uint32_t* ids = g.ids + static_cast<std::uint64_t>(b) * g.bucket_capacity;
+        for (std::uint32_t i = 0; i < n; ++i) g.entries[k++] = entry_of(ids[i]);
+    }
+    main.count = total;
+    main.first_entry = first;
+}
+
+/// @brief Calls visit(entry) for every entry of `cell`, once the table is compacted.
 template <class Visitor>
 KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, Visitor& visit) {
-    for (std::uint32_t bucket = grid_find(g, cell); bucket != no_bucket; bucket = g.headers[bucket].next) {
-        const std::uint32_t stored = g.headers[bucket].count;
-        const std::uint32_t n = stored < g.bucket_capacity ? stored : g.bucket_capacity;
-        const std::uint32_t* ids = g.ids + static_cast<std::uint64_t>(bucket) * g.bucket_capacity;
-        for (std::uint32_t k = 0; k < n; ++k) visit(ids[k]);
-    }
+    const std::uint32_t bucket = grid_find(g, cell);
+    if (bucket == no_bucket) return;
+    const GridEntry* entries = g.entries + g.headers[bucket].first_entry;
+    const std::uint32_t n = g.headers[bucket].count;
+    for (std::uint32_t k = 0; k < n; ++k) visit(entries[k]);
 }
 
 } // namespace kdet

@@ -328,6 +328,22 @@ struct PopulateKernel {
     }
 };
 
+/// @brief Stage 2, after populating: one work item per main slot of the table; copies each occupied
+/// cell's ids, with their boxes and objects, into one contiguous list (compact_cell).
+struct CompactCellsKernel {
+    SceneView scene;
+    GridView grid;
+
+    struct EntryOf {
+        const SceneView* scene;
+        KDET_HD GridEntry operator()(std::uint32_t u) const { return GridEntry{scene->info[u].box, u, scene->tet_object[u]}; }
+    };
+
+    KDET_HD void operator()(std::uint64_t slot) const {
+        compact_cell(grid, static_cast<std::uint32_t>(slot), EntryOf{&scene});
+    }
+};
+
 /// @brief Calls visit(u) once for every tet u that tet t must test: u is stored in a cell that t's
 /// box overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
 /// higher id, so each direction of a pair is found by one tet only), the objects are checked against
@@ -347,7 +363,6 @@ struct LargerNeighbourFilter {
     Visitor* visit;
     int layer;                 ///< layer being visited
     bool same_layer;           ///< visiting t's own layer: every id there is on t's layer
-    bool self_collides;        ///< t's object is checked against itself
     std::uint32_t first[3];    ///< t's first cell per axis on this layer
     std::uint32_t cell[3];     ///< cell being visited (not wrapped)
 
@@ -359,17 +374,12 @@ struct LargerNeighbourFilter {
         return true;
     }
 
-    KDET_HD void operator()(std::uint32_t u) const {
+    KDET_HD void operator()(const GridEntry& e) const {
         // A cell holds only tets of its own layer, so the tie-break needs no load of u's data.
-        if (same_layer && u <= t) return;
-        // Without self-collision most entries of a cell belong to t's own object, and the object check
-        // rejects them before u's box is loaded; with it, most entries fail the box test, so it goes first.
-        if (!self_collides && !pair_is_active(*scene, object, scene->tet_object[u])) return;
-        const Aabb& other = scene->info[u].box;
-        if (!boxes_overlap(box, other)) return;
-        if (self_collides && !pair_is_active(*scene, object, scene->tet_object[u])) return;
-        if (!reports_from_this_cell(other)) return;
-        (*visit)(u);
+        if (same_layer && e.id <= t) return;
+        if (!pair_is_active(*scene, object, e.object)) return;
+        if (!boxes_overlap(box, e.box)) return;
+        if (reports_from_this_cell(e.box)) (*visit)(e.id);
     }
 };
 
@@ -379,8 +389,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     const TetInfo self = scene.info[t];
     if (self.layer < 0) return;
     const std::uint32_t object = scene.tet_object[t];
-    LargerNeighbourFilter<Visitor> filter{&scene, &params, t, object, self.box, &visit, 0, true,
-                                          pair_is_active(scene, object, object), {}, {}};
+    LargerNeighbourFilter<Visitor> filter{&scene, &params, t, object, self.box, &visit, 0, true, {}, {}};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
         filter.layer = layer;

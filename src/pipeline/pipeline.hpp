@@ -37,6 +37,7 @@ struct FrameCounters {
     std::uint32_t layer_mask;
     std::uint32_t non_finite;
     std::uint32_t cells_claimed;
+    std::uint32_t grid_entries; ///< entries of the compacted cells
     std::uint32_t object_runs; ///< runs of tets of one object, i.e. non-empty objects
     std::uint32_t min_size; ///< float_to_ordered, over the relevant tets
     std::uint32_t max_size;
@@ -127,7 +128,7 @@ public:
                info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() +
-               headers_.capacity_bytes() + ids_.capacity_bytes() + counters_.capacity_bytes() +
+               headers_.capacity_bytes() + ids_.capacity_bytes() + entries_.capacity_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
                resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
                blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes() + exec_.scratch_bytes();
@@ -196,6 +197,7 @@ private:
     buffer<std::uint8_t> pair_active_;  ///< enabled and the boxes overlap, this frame
     buffer<BucketHeader> headers_;
     buffer<std::uint32_t> ids_;
+    buffer<GridEntry> entries_; ///< the compacted cells' lists
     buffer<FrameCounters> counters_;
     buffer<std::uint64_t> candidates_;
     buffer<std::uint64_t> candidates_grown_; ///< the next candidate buffer while one grows keeping its contents
@@ -206,6 +208,7 @@ private:
     buffer<std::uint32_t> block_objects_;
     std::uint32_t slot_count_ = 0;
     std::uint32_t overflow_capacity_ = 0;
+    std::uint32_t entry_capacity_ = 0;
     std::size_t pairs_window_ = 0;   ///< room for colliding pairs this frame
     bool grid_planned_ = false;      ///< the grid has been sized from a plan read back once
     bool pairs_sized_ = false;       ///< the pairs' window has been sized from a count read back once
@@ -253,8 +256,9 @@ void Pipeline<Exec>::grid_geometry() {
 /// @brief Sizes the table for a plan: per layer the occupied cells are at most the plan's bound
 /// (GridPlanKernel) and at most the region's cells; the table gets a quarter more slots than that
 /// bound (probing stays short), and the overflow pool one bucket
-/// per bucket_capacity entries, which holds every chain whatever the cells' fill. Both only grow, so
-/// a scene that keeps its size sizes them once.
+/// per bucket_capacity entries, which holds every chain whatever the cells' fill; the compacted lists
+/// get room for the entries, which the plan counts exactly. All only grow, so a scene that keeps its
+/// size sizes them once.
 template <class Exec>
 void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     const GridParams& params = plan.params;
@@ -279,10 +283,15 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     const double wanted_pool = std::min(std::ceil(entries / capacity) + 1.0, static_cast<double>(1u << 30));
     slot_count_ = std::max(slot_count_, wanted_slots);
     overflow_capacity_ = std::max(overflow_capacity_, static_cast<std::uint32_t>(wanted_pool));
+    // An eighth more than the plan's count: a deforming scene's cells gain entries from frame to frame,
+    // and each time the lists outgrew their room the frame would run twice.
+    const double wanted_entries = std::min(std::ceil(1.125 * entries), 4294967295.0);
+    entry_capacity_ = std::max(entry_capacity_, static_cast<std::uint32_t>(wanted_entries));
 }
 
-/// @brief Stage 2: fills the hash table as sized so far; a failed insert sets grid_failure and the
-/// frame reruns with a larger table (grow_for).
+/// @brief Stage 2: fills the hash table as sized so far, then compacts each cell's ids into one list
+/// (what the queries read); a failed insert or a list that does not fit sets grid_failure and the
+/// frame reruns with more room (grow_for).
 template <class Exec>
 GridView Pipeline<Exec>::populate() {
     const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
@@ -300,9 +309,12 @@ GridView Pipeline<Exec>::populate() {
     FrameCounters* c = counters_.data();
     std::uint32_t slot_bits = 0;
     while ((1u << slot_bits) < slot_count_) ++slot_bits;
-    const GridView grid{headers_.data(), ids_.data(), &c->overflow_used, &c->grid_failure, &c->cells_claimed,
-                        slot_count_, slot_bits, capacity, overflow_capacity_, stamp_, 64u, options_.hash};
+    if (entries_.size() != entry_capacity_) entries_.resize_discard(entry_capacity_);
+    const GridView grid{headers_.data(), ids_.data(), entries_.data(), &c->grid_entries, entry_capacity_,
+                        &c->overflow_used, &c->grid_failure, &c->cells_claimed, slot_count_, slot_bits, capacity,
+                        overflow_capacity_, stamp_, 64u, options_.hash};
     exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, &c->params});
+    exec_.for_each(slot_count_, CompactCellsKernel{scene_view(), grid});
     return grid;
 }
 
@@ -573,7 +585,7 @@ void Pipeline<Exec>::finish(FrameResult& result) {
         }
     }
     result.memory_bytes = memory_bytes();
-    result.grid_bytes = headers_.capacity_bytes() + ids_.capacity_bytes();
+    result.grid_bytes = headers_.capacity_bytes() + ids_.capacity_bytes() + entries_.capacity_bytes();
     result.candidate_bytes = candidates_.capacity_bytes();
     StageTimes& t = result.times;
     t = StageTimes{};
