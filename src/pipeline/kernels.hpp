@@ -355,10 +355,11 @@ struct CompactCellsKernel {
 /// hence always visited. No duplicates are written, so the candidate buffer holds unique pairs.
 template <class Visitor>
 struct LargerNeighbourFilter {
-    const SceneView* scene;
+    /// t's object's row of the active pairs: one load per entry, where pair_is_active would reload
+    /// the scene's fields for each (the visitor's stores keep the compiler from hoisting them).
+    const std::uint8_t* checked_against;
     const GridParams* params;
     std::uint32_t t;
-    std::uint32_t object;
     Aabb box;
     Visitor* visit;
     int layer;                 ///< layer being visited
@@ -377,7 +378,7 @@ struct LargerNeighbourFilter {
     KDET_HD void operator()(const GridEntry& e) const {
         // A cell holds only tets of its own layer, so the tie-break needs no load of u's data.
         if (same_layer && e.id <= t) return;
-        if (!pair_is_active(*scene, object, e.object)) return;
+        if (!checked_against[e.object]) return;
         if (!boxes_overlap(box, e.box)) return;
         if (reports_from_this_cell(e.box)) (*visit)(e.id);
     }
@@ -389,7 +390,8 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     const TetInfo self = scene.info[t];
     if (self.layer < 0) return;
     const std::uint32_t object = scene.tet_object[t];
-    LargerNeighbourFilter<Visitor> filter{&scene, &params, t, object, self.box, &visit, 0, true, {}, {}};
+    const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
+    LargerNeighbourFilter<Visitor> filter{checked_against, &params, t, self.box, &visit, 0, true, {}, {}};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
         filter.layer = layer;
