@@ -344,7 +344,8 @@ struct CompactCellsKernel {
     }
 };
 
-/// @brief Calls visit(u) once for every tet u that tet t must test: u is stored in a cell that t's
+/// @brief Calls visit(entry) once for every tet u (entry.id) that tet t must test, with what the
+/// cell's list holds about u (box, object): u is stored in a cell that t's
 /// box overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
 /// higher id, so each direction of a pair is found by one tet only), the objects are checked against
 /// each other, and the boxes overlap. Adjacency and the narrow phase are left to the caller.
@@ -380,7 +381,7 @@ struct LargerNeighbourFilter {
         if (same_layer && e.id <= t) return;
         if (!checked_against[e.object]) return;
         if (!boxes_overlap(box, e.box)) return;
-        if (reports_from_this_cell(e.box)) (*visit)(e.id);
+        if (reports_from_this_cell(e.box)) (*visit)(e);
     }
 };
 
@@ -500,9 +501,10 @@ struct FindCandidatesKernel {
         vec3 vertices[4];
         TetPlanes planes;
         unsigned long long rejected;
-        KDET_HD void operator()(std::uint32_t u) {
+        KDET_HD void operator()(const GridEntry& e) {
+            const std::uint32_t u = e.id;
             const TetIndices other = scene->tets[u];
-            if (scene->tet_object[u] == object && share_vertex(tet, other)) return;
+            if (e.object == object && share_vertex(tet, other)) return;
             vec3 w[4];
             for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
             if (face_plane_pretest(planes, vertices, scene->planes[u], w, true) == PlaneVerdict::separated) {
@@ -547,7 +549,8 @@ struct NoPairsKernel {
         std::uint32_t t;
         unsigned long long tests;
         unsigned long long exact_stage;
-        KDET_HD void operator()(std::uint32_t u) {
+        KDET_HD void operator()(const GridEntry& e) {
+            const std::uint32_t u = e.id;
             std::uint32_t* flags = kernel->colliding;
             if (atomic_load_acquire(&flags[t]) && atomic_load_acquire(&flags[u])) return;
             ++tests;
