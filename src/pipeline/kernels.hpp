@@ -61,6 +61,13 @@ KDET_HD inline std::uint64_t pair_key(std::uint32_t t, std::uint32_t u) {
     const std::uint32_t lo = t < u ? t : u, hi = t < u ? u : t;
     return (static_cast<std::uint64_t>(lo) << 32) | hi;
 }
+
+/// @brief A candidate's key when the face-plane pre-test has already proven the pair intersecting:
+/// the higher id goes first, which no pair_key does, so the narrow phase knows without testing again.
+KDET_HD inline std::uint64_t proven_pair_key(std::uint32_t t, std::uint32_t u) {
+    const std::uint32_t lo = t < u ? t : u, hi = t < u ? u : t;
+    return (static_cast<std::uint64_t>(hi) << 32) | lo;
+}
 /// @brief Bits a pair key of tet ids below tet_count needs: the lower id fills the high word from bit 32
 /// on, so every key is below 2^(32 + bits of the largest id) and a radix sort can stop there.
 inline int pair_key_bits(std::uint32_t tet_count) {
@@ -479,7 +486,8 @@ struct KeyBatch {
 
 /// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the face-plane pre-test cannot
 /// prove separated (those it can are only counted): a rejected pair is never written, sorted or
-/// loaded again. A tet whose keys did not all fit leaves a ResumePoint instead of counting its
+/// loaded again. A pair it proves intersecting is written as a proven_pair_key, so that the narrow
+/// phase neither repeats the pre-test nor runs the test on it. A tet whose keys did not all fit leaves a ResumePoint instead of counting its
 /// rejections; a rerun after growing (`resume_from` set) visits only those tets.
 struct FindCandidatesKernel {
     SceneView scene;
@@ -507,11 +515,12 @@ struct FindCandidatesKernel {
             if (e.object == object && share_vertex(tet, other)) return;
             vec3 w[4];
             for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
-            if (face_plane_pretest(planes, vertices, scene->planes[u], w, true) == PlaneVerdict::separated) {
+            const PlaneVerdict verdict = face_plane_pretest(planes, vertices, scene->planes[u], w, false);
+            if (verdict == PlaneVerdict::separated) {
                 ++rejected;
                 return;
             }
-            batch->push(pair_key(t, u));
+            batch->push(verdict == PlaneVerdict::intersecting ? proven_pair_key(t, u) : pair_key(t, u));
         }
     };
 
@@ -644,12 +653,12 @@ struct BruteForcePairsKernel {
 
 /// @brief Stage 5: decides each candidate once (a no_pair_key slot is none), flags colliding tets and
 /// appends each colliding pair under the caller's tet ids (lower id first; sorted afterwards, so
-/// the order of appends does not matter). The grid methods decide with candidate_collides (their tets have face planes); brute
-/// force, whose pairs come tested, with the test alone.
+/// the order of appends does not matter). A proven_pair_key collides (the candidate search's pre-test
+/// proved it); every other pair, which the pre-test left undecided or never saw (brute force), gets
+/// the test.
 template <NarrowPhase Test>
 struct NarrowPhaseKernel {
     SceneView scene;
-    bool pretest;
     const std::uint64_t* keys;
     std::uint32_t* colliding;
     const std::uint32_t* user_id; ///< [tets] stored id -> caller's global id
@@ -658,10 +667,10 @@ struct NarrowPhaseKernel {
 
     KDET_HD void operator()(std::uint64_t k) const {
         if (keys[k] == no_pair_key) return;
-        const std::uint32_t t = key_first(keys[k]), u = key_second(keys[k]);
+        const std::uint32_t a = key_first(keys[k]), b = key_second(keys[k]);
+        const std::uint32_t t = a < b ? a : b, u = a < b ? b : a;
         bool reached_exact = false;
-        const bool collides = pretest ? candidate_collides<Test>(scene, t, u, reached_exact)
-                                      : test_pair<Test>(scene, t, u, reached_exact);
+        const bool collides = a > b || test_pair<Test>(scene, t, u, reached_exact);
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);

@@ -406,7 +406,7 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
     with_narrow_phase(options_.narrow_phase, [&](auto test) {
         exec_.for_each_counted(&c->candidates, candidates_.size(),
-                               NarrowPhaseKernel<decltype(test)::value>{scene_view(), grid_method(), candidates_.data(),
+                               NarrowPhaseKernel<decltype(test)::value>{scene_view(), candidates_.data(),
                                                              colliding_.data(), user_id_.data(), out,
                                                              &c->exact_stage_pairs});
     });
