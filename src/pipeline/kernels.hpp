@@ -355,7 +355,8 @@ struct CompactCellsKernel {
 /// cell's list holds about u (box, object): u is stored in a cell that t's
 /// box overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
 /// higher id, so each direction of a pair is found by one tet only), the objects are checked against
-/// each other, and the boxes overlap. Adjacency and the narrow phase are left to the caller.
+/// each other, and the boxes overlap. Adjacency and the narrow phase are left to the caller. The
+/// search ends early, after a cell, once visit.finished().
 ///
 /// A pair shares every cell that both boxes overlap; it is reported from one of them only, the cell
 /// holding the lower corner of the boxes' intersection. That corner is max(t.lo, u.lo) per axis, and
@@ -413,6 +414,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
                     filter.cell[1] = y;
                     filter.cell[2] = z;
                     grid_for_each_in_cell(grid, make_cell(x, y, z, layer), filter);
+                    if (visit.finished()) return;
                 }
     }
 }
@@ -499,10 +501,15 @@ struct FindCandidatesKernel {
     const ResumePoint* resume_from; ///< null: every tet, from the start; else item i resumes resume_from[i]
     ResumePoint* stopped;           ///< [tets] where the tets that did not fit stopped
     std::uint32_t* stopped_count;
+    /// A frame that resumes the tets that did not fit (a first frame): such a tet stops searching at
+    /// once, since its resumption searches again. Otherwise it searches on, counting the room the
+    /// whole frame needs, so that a single rerun fits.
+    bool stop_when_full;
 
     struct Emit {
         const SceneView* scene;
         KeyBatch* batch;
+        bool stop_when_full;
         std::uint32_t t;
         TetIndices tet;
         std::uint32_t object;
@@ -522,13 +529,14 @@ struct FindCandidatesKernel {
             }
             batch->push(verdict == PlaneVerdict::intersecting ? proven_pair_key(t, u) : pair_key(t, u));
         }
+        KDET_HD bool finished() const { return stop_when_full && batch->stopped; }
     };
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto t = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
         if (scene.info[t].layer < 0) return;
         KeyBatch batch(&out, resume_from ? resume_from[i].stored : 0u);
-        Emit emit{&scene, &batch, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
+        Emit emit{&scene, &batch, stop_when_full, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
         load_tet(scene, t, emit.vertices);
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit);
@@ -572,6 +580,7 @@ struct NoPairsKernel {
             }
             exact_stage += reached_exact;
         }
+        KDET_HD bool finished() const { return false; }
     };
 
     KDET_HD void operator()(std::uint64_t i) const {

@@ -321,31 +321,38 @@ GridView Pipeline<Exec>::populate() {
 /// @brief Stage 3 (kdet): candidate pairs, each written once. A frame that reads its counters back
 /// here (a first frame, to size the pairs' window) does not rerun when the buffer overflows: the
 /// buffer grows keeping what was stored and only the tets that did not fit search again, each
-/// resuming after the keys it had stored. Later frames read nothing here; an overflow shows in the
+/// resuming after the keys it had stored (they stopped searching when they did not fit). Later frames read nothing here; an overflow shows in the
 /// frame's counters and the frame reruns (grow_for). Returns the counters when it read them.
 template <class Exec>
 std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
     for (auto& points : resume_points_) points.resize_discard(tets_.size());
     std::size_t items = tets_.size();
+    std::size_t first_slot = 0; ///< where this run's keys start in the buffer
     const ResumePoint* resume_from = nullptr;
     for (int run = 0;; ++run) {
         FrameCounters* c = counters_.data();
         ResumePoint* stopped = resume_points_[run % 2].data();
         const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
         exec_.for_each(items, FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected,
-                                                   resume_from, stopped, &c->stopped_tets});
+                                                   resume_from, stopped, &c->stopped_tets, !pairs_sized_});
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
         if (!after.stopped_tets) return after;
-        // Every slot below the size holds a key or padding; the tets that stopped need at most the
-        // slots claimed past it, plus the padding of the one batch that straddled it. A quarter
-        // more leaves room for the next frames, whose overflow would rerun the whole frame.
+        // The tets that stopped quit searching when they did not fit, so their need is estimated from
+        // the keys per tet of the ones that finished in this run, with a quarter more (room for the
+        // next frames, whose overflow would rerun the whole frame); the buffer grows by half at
+        // least, so a poor estimate costs few rounds.
         const std::size_t kept = candidates_.size();
-        candidates_grown_.resize_discard(after.candidates + after.candidates / 4 + KeyBatch::size);
+        const double finished = static_cast<double>(items - after.stopped_tets);
+        const double stored_now = static_cast<double>(kept - std::min(kept, first_slot));
+        const double estimate = finished > 0.0 ? 1.25 * stored_now / finished * after.stopped_tets : 0.0;
+        const std::size_t more = std::max(static_cast<std::size_t>(estimate), kept / 2);
+        candidates_grown_.resize_discard(kept + more + KeyBatch::size);
         exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
         candidates_.swap(candidates_grown_);
         ++regrows_;
         after.candidates = kept;
+        first_slot = kept;
         items = after.stopped_tets;
         after.stopped_tets = 0;
         exec_.upload(counters_.data(), &after, 1);
