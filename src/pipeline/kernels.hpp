@@ -423,8 +423,9 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
 /// below the capacity, so every slot below the count is defined. (t, t) is never a pair.
 constexpr std::uint64_t no_pair_key = ~0ull;
 
-/// @brief Appends to a buffer of `capacity` keys; the counter keeps counting past it so the host
-/// learns the size it needs. A batch is stored whole or not at all.
+/// @brief Appends to a buffer of `capacity` keys; the counter keeps counting past it, so the host
+/// learns the size a rerun needs from the writers that go on appending. A batch is stored whole or
+/// not at all.
 struct KeyAppender {
     std::uint64_t* keys;
     std::uint64_t capacity;
@@ -456,7 +457,9 @@ struct ResumePoint {
 
 /// @brief One work item's keys, handed to a KeyAppender a batch at a time: one atomic per batch
 /// instead of one per key, which matters when many threads append at once. Once a batch has not
-/// fit, the item is `stopped`: later batches only count (every later slot is past the capacity).
+/// fit, the item is `stopped`: if it goes on (to count the room a rerun needs), later batches only
+/// count (every later slot is past the capacity); in a first frame it stops searching at once
+/// (FindCandidatesKernel::stop_when_full).
 struct KeyBatch {
     static constexpr std::uint32_t size = 16;
     const KeyAppender* out;
