@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <limits>
 
 namespace kdet {
 namespace {
@@ -94,19 +96,93 @@ TEST(DeviceApi, PositionsGivenInBackendMemoryDriveTheDetection) {
     EXPECT_EQ(got, expected);
 }
 
-TEST(DeviceApi, NonFinitePositionsInBackendMemoryAreRejectedAndNeverUsed) {
-    const TetMesh a = test::random_soup(300, 2.0, 1.0, 96);
+std::vector<IndexPair> pairs_of(const FrameResult& r, ObjectId a, ObjectId b) {
+    std::vector<IndexPair> got;
+    for (const TetPair& p : r.pairs)
+        if (p.object_a == a && p.object_b == b) got.emplace_back(p.tet_a, p.tet_b);
+    return got;
+}
+
+void expect_error_naming(const std::function<void()>& call, const std::string& naming) {
+    try {
+        call();
+        FAIL() << "expected kdet::Error naming " << naming;
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(naming), std::string::npos) << e.what();
+    }
+}
+
+TEST(DeviceApi, NonFinitePositionsInBackendMemoryAreRejectedByTheNextFrameAndNeverUsed) {
+    const TetMesh a = test::random_soup(300, 2.0, 1.0, 96), b = test::random_soup(300, 2.0, 1.0, 97);
     Detector detector;
-    const ObjectId id = detector.add_object(a);
+    detector.add_object(a);
+    const ObjectId id = detector.add_object(b);
     detector.set_self_collision(id, true);
     const std::vector<TetPair> before = detector.detect().pairs;
     ASSERT_FALSE(before.empty());
-    std::vector<float> xyz = as_float(a);
-    xyz[7] = std::numeric_limits<float>::infinity();
-    EXPECT_THROW(detector.set_positions_on_device(id, xyz.data(), a.num_vertices()), Error);
-    EXPECT_THROW(detector.set_positions_on_device(id, xyz.data(), a.num_vertices() - 1), Error);
+    std::vector<float> xyz = as_float(test::moved(b, 5.0, 0.0, 0.0, 0.0));
+    xyz[3 * 7 + 1] = std::numeric_limits<float>::infinity();
+    EXPECT_THROW(detector.set_positions_on_device(id, xyz.data(), b.num_vertices() - 1), Error);
+    // Handing them over waits for nothing; the frame that checks them says which vertex is bad.
+    detector.set_positions_on_device(id, xyz.data(), b.num_vertices());
+    expect_error_naming([&] { detector.detect(); }, "object 1: vertex 7 of the positions given on the device");
+    DeviceResults discarded = detector.device_results();
+    EXPECT_EQ(discarded.pair_count, 0u);
+    for (std::size_t t = 0; t < discarded.tet_count; ++t) ASSERT_EQ(discarded.colliding[t], 0u) << t;
     // The rejected positions never became current: the detector still sees the last good ones.
     EXPECT_EQ(detector.detect().pairs, before);
+
+    detector.set_positions_on_device(id, xyz.data(), b.num_vertices());
+    detector.detect_async();
+    EXPECT_THROW(detector.finish(), Error);
+    EXPECT_EQ(detector.detect().pairs, before);
+}
+
+TEST(DeviceApi, TheLaterOfHostAndDevicePositionsWins) {
+    const TetMesh a = test::random_soup(400, 2.0, 1.0, 98), b = test::random_soup(400, 2.0, 1.0, 99);
+    const TetMesh near = test::moved(b, 0.4, 0.3, 0.0, 0.0), far = test::moved(b, 0.0, 50.0, 0.0, 0.0);
+    const auto expected_near = collide(a, near);
+    ASSERT_FALSE(expected_near.empty());
+    const std::vector<float> near_xyz = as_float(near), far_xyz = as_float(far);
+    Detector detector;
+    detector.add_object(a);
+    const ObjectId ib = detector.add_object(b);
+
+    detector.set_positions_on_device(ib, far_xyz.data(), b.num_vertices());
+    detector.set_positions(ib, near_xyz.data(), b.num_vertices());
+    EXPECT_EQ(pairs_of(detector.detect(), 0, ib), expected_near);
+
+    detector.set_positions(ib, far_xyz.data(), b.num_vertices());
+    detector.set_positions_on_device(ib, near_xyz.data(), b.num_vertices());
+    EXPECT_EQ(pairs_of(detector.detect(), 0, ib), expected_near);
+}
+
+TEST(DeviceApi, PositionsGivenOnTheDeviceBeforeAnObjectIsAddedAreKeptOrRejected) {
+    const TetMesh a = test::random_soup(400, 2.0, 1.0, 100), b = test::random_soup(400, 2.0, 1.0, 101);
+    const TetMesh near = test::moved(b, 0.4, 0.3, 0.0, 0.0);
+    const auto expected_near = collide(a, near);
+    const auto expected_rest = collide(a, b);
+    ASSERT_NE(expected_near, expected_rest);
+    std::vector<float> xyz = as_float(near);
+    Detector detector;
+    detector.add_object(a);
+    const ObjectId ib = detector.add_object(b);
+    detector.detect();
+
+    // Staged, then the topology changes before any frame adopts them: the new pipeline gets them.
+    detector.set_positions_on_device(ib, xyz.data(), b.num_vertices());
+    detector.add_object(test::random_soup(10, 100.0, 0.0, 102));
+    EXPECT_EQ(pairs_of(detector.detect(), 0, ib), expected_near);
+
+    // The same with a bad value: the rebuild reports it and keeps the previous positions.
+    const std::vector<float> good = xyz;
+    xyz[0] = std::nanf("");
+    detector.set_positions(ib, as_float(b).data(), b.num_vertices());
+    detector.detect();
+    detector.set_positions_on_device(ib, xyz.data(), b.num_vertices());
+    detector.add_object(test::random_soup(10, 100.0, 0.0, 103));
+    expect_error_naming([&] { detector.detect(); }, "object 1: vertex 0 of the positions given on the device");
+    EXPECT_EQ(pairs_of(detector.detect(), 0, ib), expected_rest);
 }
 
 } // namespace

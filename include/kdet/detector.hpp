@@ -48,8 +48,12 @@ public:
 
     /// @brief Replaces an object's positions from memory of the detector's backend (a CUDA device
     /// pointer for Backend::cuda, a host pointer for Backend::cpu), e.g. a simulation's own buffer;
-    /// nothing passes through the host. x y z float per vertex. Throws kdet::Error on a non-finite
-    /// coordinate.
+    /// nothing passes through the host and nothing waits. x y z float per vertex. The positions are
+    /// copied now (on Backend::cuda in the order of DetectorOptions::cuda_stream, after the kernels
+    /// enqueued on it so far) and checked by the next detection, on the backend: if one is not
+    /// finite, that detection uses none of the positions given this way, keeps the objects' previous
+    /// ones, and its detect() or finish() throws kdet::Error naming the object and vertex. Throws at
+    /// once on a wrong vertex count.
     void set_positions_on_device(ObjectId object, const float* positions, std::size_t vertex_count);
 
     /// @brief Switches self-collision of one object (off by default).

@@ -546,7 +546,8 @@ NB_MODULE(_kdet, m) {
              "object id.")
         .def("set_positions", &set_positions, "object"_a, "positions"_a,
              "Replaces an object's vertex positions: (n, 3) float32/float64, any strides; on the CUDA backend also a GPU "
-             "array (__dlpack__ or __cuda_array_interface__), which never passes through the host.")
+             "array (__dlpack__ or __cuda_array_interface__), which never passes through the host: it is checked by "
+             "the next detect(), which raises kdet.Error on a non-finite value and keeps the previous positions.")
         .def(
             "set_self_collision",
             [](PyDetector& self, std::int64_t object, bool enabled) {

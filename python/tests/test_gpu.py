@@ -142,8 +142,11 @@ def test_non_finite_gpu_positions_are_rejected(scene):
     detector, moving = gpu_detector(bunny)
     positions = other.vertices.astype(np.float32)
     positions[5, 1] = np.nan
-    with pytest.raises(kdet.Error, match="non-finite"):
-        detector.set_positions(moving, CudaArray(positions))
+    before = detector.detect().pairs
+    detector.set_positions(moving, CudaArray(positions))  # checked on the GPU by the next frame
+    with pytest.raises(kdet.Error, match="vertex 5 of the positions given on the device has a non-finite"):
+        detector.detect()
+    np.testing.assert_array_equal(detector.detect().pairs, before)
 
 
 def test_torch_and_cupy_arrays(scene):

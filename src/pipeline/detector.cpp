@@ -21,22 +21,50 @@ struct Detector::Impl {
     std::vector<std::uint8_t> positions_dirty; // per object: changed since the last upload
     // Per object: positions were last given on the device, so only the pipeline holds them.
     std::vector<std::uint8_t> positions_on_device;
+    // Per object: positions given on the device wait in the pipeline's staging buffer for the next frame.
+    std::vector<std::uint8_t> positions_staged;
     FrameResult result;
     bool frame_pending = false; // detect_async() ran, finish() not yet
 
     std::size_t objects() const { return object_vertex_begin.size() - 1; }
 
     /// Gives the pipeline the new topology; positions that only the pipeline holds are fetched first.
+    /// Staged positions are checked here, as a frame would: bad ones are dropped, and reported once
+    /// the rebuild is done.
     void rebuild_pipeline() {
+        std::string rejected;
         for (std::size_t o = 0; o < objects(); ++o) {
             if (!positions_on_device[o]) continue;
-            const std::uint32_t first = object_vertex_begin[o];
-            pipeline->get_positions(first, positions.data() + first, object_vertex_begin[o + 1] - first);
-            positions_on_device[o] = 0;
+            const std::uint32_t first = object_vertex_begin[o], count = object_vertex_begin[o + 1] - first;
+            vec3* held = positions.data() + first;
+            if (positions_staged[o]) {
+                pipeline->get_positions(first, held, count, true);
+                const std::uint32_t bad = first_non_finite(held, count);
+                if (bad != no_vertex) {
+                    rejected = non_finite_message(o, bad);
+                    pipeline->get_positions(first, held, count, false);
+                }
+            } else {
+                pipeline->get_positions(first, held, count, false);
+            }
+            positions_on_device[o] = positions_staged[o] = 0;
         }
         pipeline->set_topology(topology);
         std::fill(positions_dirty.begin(), positions_dirty.end(), 1); // the pipeline's buffers are new
         topology_changed = false;
+        if (!rejected.empty()) throw Error(rejected);
+    }
+
+    static std::uint32_t first_non_finite(const vec3* p, std::uint32_t count) {
+        for (std::uint32_t v = 0; v < count; ++v)
+            if (!std::isfinite(p[v].x) || !std::isfinite(p[v].y) || !std::isfinite(p[v].z)) return v;
+        return no_vertex;
+    }
+
+    static std::string non_finite_message(std::size_t object, std::uint32_t vertex) {
+        return "object " + std::to_string(object) + ": vertex " + std::to_string(vertex) +
+               " of the positions given on the device has a non-finite coordinate; they were not used (the "
+               "object keeps its previous positions)";
     }
 
     void check_object(ObjectId object) const {
@@ -71,7 +99,7 @@ struct Detector::Impl {
         const std::vector<vec3> converted = to_float_positions(object, xyz, vertex_count);
         std::copy(converted.begin(), converted.end(), positions.begin() + first);
         positions_dirty[object] = 1;
-        positions_on_device[object] = 0;
+        positions_on_device[object] = positions_staged[object] = 0;
     }
 
     /// Adds an object; on a bad index or coordinate it throws and leaves the detector as it was.
@@ -107,6 +135,7 @@ struct Detector::Impl {
         positions.insert(positions.end(), converted.begin(), converted.end());
         positions_dirty.push_back(1);
         positions_on_device.push_back(0);
+        positions_staged.push_back(0);
 
         const std::size_t n = objects();
         std::vector<std::uint8_t> enabled(n * n, 0);
@@ -164,10 +193,9 @@ void Detector::set_positions_on_device(ObjectId object, const float* positions, 
         throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
                     " vertices, expected " + std::to_string(expected));
     if (d.topology_changed) d.rebuild_pipeline();
-    d.pipeline->set_positions_on_device(first, reinterpret_cast<const vec3*>(positions),
-                                        static_cast<std::uint32_t>(vertex_count));
+    d.pipeline->stage_positions(first, reinterpret_cast<const vec3*>(positions), static_cast<std::uint32_t>(vertex_count));
     d.positions_dirty[object] = 0;
-    d.positions_on_device[object] = 1;
+    d.positions_on_device[object] = d.positions_staged[object] = 1;
 }
 
 void Detector::set_self_collision(ObjectId object, bool enabled) {
@@ -196,13 +224,15 @@ void Detector::detect_async() {
         return;
     }
     std::vector<PositionUpload> uploads;
-    for (std::size_t o = 0; o < d.objects(); ++o)
-        if (d.positions_dirty[o]) {
-            const std::uint32_t first = d.object_vertex_begin[o];
-            uploads.push_back({first, d.positions.data() + first, d.object_vertex_begin[o + 1] - first});
-        }
-    d.pipeline->start(uploads, d.pair_enabled);
+    std::vector<VertexRange> staged;
+    for (std::size_t o = 0; o < d.objects(); ++o) {
+        const std::uint32_t first = d.object_vertex_begin[o], count = d.object_vertex_begin[o + 1] - first;
+        if (d.positions_dirty[o]) uploads.push_back({first, d.positions.data() + first, count});
+        if (d.positions_staged[o]) staged.push_back({first, count});
+    }
+    d.pipeline->start(uploads, staged, d.pair_enabled);
     std::fill(d.positions_dirty.begin(), d.positions_dirty.end(), 0);
+    std::fill(d.positions_staged.begin(), d.positions_staged.end(), 0);
     d.frame_pending = true;
 }
 
@@ -210,7 +240,12 @@ const FrameResult& Detector::finish() {
     Impl& d = *impl_;
     if (!d.frame_pending) return d.result;
     d.frame_pending = false;
-    d.pipeline->finish(d.result);
+    const std::uint32_t bad = d.pipeline->finish(d.result);
+    if (bad != no_vertex) {
+        const auto& begin = d.object_vertex_begin;
+        const auto object = static_cast<std::size_t>(std::upper_bound(begin.begin(), begin.end(), bad) - begin.begin() - 1);
+        throw Error(Impl::non_finite_message(object, bad - begin[object]) + "; this frame's results were discarded");
+    }
     return d.result;
 }
 

@@ -716,14 +716,33 @@ struct UserFlagsKernel {
     KDET_HD void operator()(std::uint64_t i) const { user_colliding[i] = colliding[stored_id[i]]; }
 };
 
-/// @brief Flags a non-finite coordinate among positions handed over in the backend's memory.
+/// @brief No vertex: FrameCounters::first_non_finite_vertex while every staged position is finite.
+constexpr std::uint32_t no_vertex = 0xffffffffu;
+
+/// @brief Finds the lowest vertex with a non-finite coordinate among positions handed over in the
+/// backend's memory (staged from vertex `first` on); `found` is global and starts at no_vertex.
 struct FiniteCheckKernel {
-    const vec3* positions;
+    const vec3* staged; ///< indexed by global vertex
+    std::uint32_t first;
     std::uint32_t* found;
-    KDET_HD void operator()(std::uint64_t v) const {
-        const vec3 p = positions[v];
+    KDET_HD void operator()(std::uint64_t i) const {
+        const std::uint32_t v = first + static_cast<std::uint32_t>(i);
+        const vec3 p = staged[v];
         // x - x is 0 for finite x and NaN for NaN and infinities.
-        if (!(p.x - p.x == 0.0f && p.y - p.y == 0.0f && p.z - p.z == 0.0f)) atomic_store_relaxed(found, 1u);
+        if (!(p.x - p.x == 0.0f && p.y - p.y == 0.0f && p.z - p.z == 0.0f)) atomic_min(found, v);
+    }
+};
+
+/// @brief Makes staged positions current, once FiniteCheckKernel found none of them bad; otherwise
+/// the previous positions stay and the frame's end reports the bad vertex.
+struct AdoptPositionsKernel {
+    const vec3* staged; ///< indexed by global vertex
+    vec3* positions;
+    std::uint32_t first;
+    const std::uint32_t* non_finite_vertex;
+    KDET_HD void operator()(std::uint64_t i) const {
+        if (*non_finite_vertex != no_vertex) return;
+        positions[first + i] = staged[first + i];
     }
 };
 

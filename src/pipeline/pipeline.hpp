@@ -35,7 +35,7 @@ struct FrameCounters {
     std::uint32_t grid_failure;
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
-    std::uint32_t non_finite;
+    std::uint32_t first_non_finite_vertex; ///< lowest staged vertex found non-finite, or no_vertex
     std::uint32_t cells_claimed;
     std::uint32_t grid_entries; ///< entries of the compacted cells
     std::uint32_t object_runs; ///< runs of tets of one object, i.e. non-empty objects
@@ -51,6 +51,7 @@ struct FrameCounters {
         FrameCounters c{};
         c.min_size = float_to_ordered(std::numeric_limits<float>::infinity());
         c.max_size = float_to_ordered(0.0f);
+        c.first_non_finite_vertex = no_vertex;
         for (int a = 0; a < 3; ++a) {
             c.region.lo[a] = float_to_ordered(std::numeric_limits<float>::infinity());
             c.region.hi[a] = float_to_ordered(-std::numeric_limits<float>::infinity());
@@ -103,18 +104,14 @@ public:
         colliding_count_ = 0;
     }
 
-    void set_positions_on_device(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
-        // Checked where they are, before they replace anything: rejected positions never become current.
-        reset_counters();
-        exec_.for_each(count, FiniteCheckKernel{positions, &counters_.data()->non_finite});
-        FrameCounters c;
-        exec_.download(&c, counters_.data(), 1);
-        if (c.non_finite) throw Error("positions given on the device hold a non-finite coordinate");
-        exec_.copy(positions_.data() + first, positions, count);
+    void stage_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
+        // Allocated on first use: only simulations that hand positions over on the device need it.
+        if (staged_positions_.size() != positions_.size()) staged_positions_.resize_discard(positions_.size());
+        exec_.copy(staged_positions_.data() + first, positions, count);
     }
 
-    void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count) override {
-        exec_.download(positions, positions_.data() + first, count);
+    void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count, bool staged) override {
+        exec_.download(positions, (staged ? staged_positions_ : positions_).data() + first, count);
     }
 
     DeviceResults device_results() override {
@@ -124,7 +121,7 @@ public:
 
     std::size_t memory_bytes() const override {
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
-               user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() +
+               user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() + staged_positions_.capacity_bytes() +
                info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() +
@@ -136,8 +133,9 @@ public:
 
     std::string device_name() const override { return exec_.device_name(); }
 
-    void start(const std::vector<PositionUpload>& uploads, const std::vector<std::uint8_t>& pair_enabled) override;
-    void finish(FrameResult& result) override;
+    void start(const std::vector<PositionUpload>& uploads, const std::vector<VertexRange>& staged,
+               const std::vector<std::uint8_t>& pair_enabled) override;
+    std::uint32_t finish(FrameResult& result) override;
 
 private:
     SceneView scene_view() {
@@ -162,6 +160,7 @@ private:
     bool grid_method() const { return options_.method == Method::kdet || options_.method == Method::kdet_no_pairs; }
 
     void enqueue_frame();
+    void adopt_staged_positions();
     void bounds_and_culling();
     void grid_geometry();
     void size_grid(const FrameCounters& plan);
@@ -186,6 +185,7 @@ private:
     buffer<std::uint32_t> user_id_;   ///< stored tet -> caller's global id
     buffer<std::uint32_t> stored_id_; ///< caller's global id -> stored tet
     buffer<vec3> positions_;
+    buffer<vec3> staged_positions_; ///< handed over on the device, current once a frame found them finite
     buffer<TetInfo> info_;
     buffer<TetPlanes> planes_;
     buffer<std::uint32_t> colliding_;      ///< per stored tet
@@ -214,7 +214,8 @@ private:
     bool pairs_sized_ = false;       ///< the pairs' window has been sized from a count read back once
     std::size_t colliding_count_ = 0; ///< pairs in out_keys_ after the last detection
 
-    // The frame in flight: what it copies back at its end, read by finish().
+    // The frame in flight: the staged ranges it adopts, and what it copies back at its end, read by finish().
+    std::vector<VertexRange> staged_;
     FrameCounters last_{};
     std::vector<std::uint64_t> host_keys_;
     std::vector<std::uint32_t> host_flags_;
@@ -439,6 +440,7 @@ void Pipeline<Exec>::enqueue_frame() {
     FrameCounters* c = counters_.data();
     std::optional<FrameCounters> found; ///< the counters after the candidate stage, when read back
     reset_counters();
+    adopt_staged_positions();
     fill(colliding_, 0u);
     bounds_and_culling();
     if (grid_method()) grid_geometry();
@@ -497,6 +499,18 @@ void Pipeline<Exec>::enqueue_frame() {
     exec_.download_later(host_contacts_.data(), out_contacts_.data(), host_contacts_.size());
 }
 
+/// @brief Checks the positions staged on the device and makes them current if every one is finite,
+/// without a wait: the frame's counters carry the verdict to finish(). A rerun of the frame does it
+/// again, to the same effect.
+template <class Exec>
+void Pipeline<Exec>::adopt_staged_positions() {
+    std::uint32_t* verdict = &counters_.data()->first_non_finite_vertex;
+    for (const VertexRange& r : staged_)
+        exec_.for_each(r.count, FiniteCheckKernel{staged_positions_.data(), r.first, verdict});
+    for (const VertexRange& r : staged_)
+        exec_.for_each(r.count, AdoptPositionsKernel{staged_positions_.data(), positions_.data(), r.first, verdict});
+}
+
 /// @brief After a frame: grows what was too small for it and says whether it must run again.
 /// The grid also grows for its plan, so the next frame of a growing scene fits at once.
 template <class Exec>
@@ -526,7 +540,9 @@ bool Pipeline<Exec>::grow_for(const FrameCounters& c) {
 }
 
 template <class Exec>
-void Pipeline<Exec>::start(const std::vector<PositionUpload>& uploads, const std::vector<std::uint8_t>& pair_enabled) {
+void Pipeline<Exec>::start(const std::vector<PositionUpload>& uploads, const std::vector<VertexRange>& staged,
+                           const std::vector<std::uint8_t>& pair_enabled) {
+    staged_ = staged;
     waits_before_ = exec_.host_waits();
     regrows_ = 0;
     clock_.begin_frame();
@@ -537,7 +553,7 @@ void Pipeline<Exec>::start(const std::vector<PositionUpload>& uploads, const std
 }
 
 template <class Exec>
-void Pipeline<Exec>::finish(FrameResult& result) {
+std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
     for (;;) {
         exec_.finish_downloads(); // the frame's one wait
         if (!grow_for(last_)) break;
@@ -546,7 +562,14 @@ void Pipeline<Exec>::finish(FrameResult& result) {
     }
     clock_.mark(frame_end);
     clock_.wait(frame_end); // recorded after the frame's wait, on an idle stream: no wait more
+    staged_.clear();
     const FrameCounters& c = last_;
+    if (c.first_non_finite_vertex != no_vertex) {
+        // The frame ran on the previous positions: none of its results is handed out.
+        colliding_count_ = 0;
+        fill(user_colliding_, 0u);
+        return c.first_non_finite_vertex;
+    }
     const Method method = options_.method;
     colliding_count_ = method == Method::kdet_no_pairs ? 0 : c.colliding_pairs;
 
@@ -603,6 +626,7 @@ void Pipeline<Exec>::finish(FrameResult& result) {
     t.narrow_phase = clock_.between_ms(candidates_done, narrow_phase_done) + clock_.between_ms(sorted, results_done);
     t.total = clock_.between_ms(frame_start, frame_end);
     counts.host_waits = static_cast<std::uint32_t>(exec_.host_waits() - waits_before_);
+    return no_vertex;
 }
 
 } // namespace kdet

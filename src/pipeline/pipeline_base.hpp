@@ -30,22 +30,36 @@ struct PositionUpload {
     std::uint32_t count;
 };
 
+/// @brief `count` vertices from global vertex `first` on.
+struct VertexRange {
+    std::uint32_t first;
+    std::uint32_t count;
+};
+
 class PipelineBase {
 public:
     virtual ~PipelineBase() = default;
     /// @brief Replaces all geometry; positions must be set again afterwards.
     virtual void set_topology(const SceneTopology& topology) = 0;
-    /// @brief Copies `count` positions already in the backend's memory; throws Error on a non-finite value.
-    virtual void set_positions_on_device(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
-    /// @brief Copies `count` positions starting at global vertex `first` back to the host.
-    virtual void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count) = 0;
+    /// @brief Copies `count` positions already in the backend's memory (in stream order) into a
+    /// staging buffer, waiting for nothing; a frame adopts them (start()'s `staged`) once it has
+    /// checked that they are finite, so rejected positions never become current.
+    virtual void stage_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
+    /// @brief Copies `count` positions starting at global vertex `first` back to the host: the current
+    /// ones, or with `staged` those stage_positions() copied and no frame has adopted yet.
+    virtual void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count, bool staged) = 0;
     /// @brief Enqueues one detection, after copying in the positions that changed on the host (counted
-    /// in its total time); pair_enabled is [objects * objects], symmetric, diagonal = self-collision.
-    /// Waits for nothing, except on a first frame (it sizes the buffers from what it reads).
-    virtual void start(const std::vector<PositionUpload>& uploads, const std::vector<std::uint8_t>& pair_enabled) = 0;
+    /// in its total time) and adopting the `staged` ranges if all of them are finite; pair_enabled is
+    /// [objects * objects], symmetric, diagonal = self-collision. Waits for nothing, except on a first
+    /// frame (it sizes the buffers from what it reads).
+    virtual void start(const std::vector<PositionUpload>& uploads, const std::vector<VertexRange>& staged,
+                       const std::vector<std::uint8_t>& pair_enabled) = 0;
     /// @brief Completes the detection start() enqueued: reads its counters (and results when they go
     /// to the host) with one wait, and grows a buffer and reruns the frame if one was too small.
-    virtual void finish(FrameResult& result) = 0;
+    /// Returns no_vertex, or the lowest global vertex of the staged positions with a non-finite
+    /// coordinate: then none of them was adopted, `result` is left as it was, and the frame's device
+    /// results are empty.
+    virtual std::uint32_t finish(FrameResult& result) = 0;
     virtual DeviceResults device_results() = 0;
     virtual std::size_t memory_bytes() const = 0;
     virtual std::string device_name() const = 0;
