@@ -165,7 +165,7 @@ struct TestTable {
         const Compacted c = compacted(ids.size());
         EXPECT_EQ(c.failure, 0u);
         EveryEntry collect;
-        grid_for_each_in_cell(c.view, cell, collect);
+        grid_for_each_in_cell(c.view, cell, 0u, collect);
         return collect.found;
     }
 };
@@ -273,9 +273,32 @@ TEST(BucketTable, CompactionThatDoesNotFitSaysSoAndLeavesEmptyCells) {
     const auto short_of_room = table.compacted(25);
     EXPECT_EQ(short_of_room.failure, static_cast<std::uint32_t>(grid_entries_full));
     EveryEntry readable;
-    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, readable);
+    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, 0u, readable);
     EXPECT_EQ(readable.found.size(), 20u); // two cells of ten fit; the third reads as empty
     for (std::uint32_t id : readable.found) EXPECT_LT(id, 30u);
+}
+
+TEST(BucketTable, CompactedCellsListTheirIdsInOrderAndSkipTheSmallerOnes) {
+    // Ids inserted out of order across a chain of several buckets, as concurrent threads would.
+    TestTable table(64, 4, 64, 32, HashFunction::fnv1a);
+    std::vector<std::uint32_t> ids(37);
+    for (std::uint32_t i = 0; i < ids.size(); ++i) ids[i] = 3 * i + 1;
+    std::shuffle(ids.begin(), ids.end(), std::mt19937(11));
+    const CellCoord cell{2, 0, 5, 1};
+    for (std::uint32_t id : ids) ASSERT_TRUE(grid_insert(table.view, cell, id));
+    const auto c = table.compacted(ids.size());
+    ASSERT_EQ(c.failure, 0u);
+    struct InOrder {
+        std::vector<std::uint32_t> seen;
+        void operator()(const GridEntry& e) { seen.push_back(e.id); }
+    };
+    std::sort(ids.begin(), ids.end());
+    for (std::uint32_t first_id : {0u, 1u, 2u, 50u, 52u, 109u, 110u, 1000u}) {
+        InOrder visit;
+        grid_for_each_in_cell(c.view, cell, first_id, visit);
+        const std::vector<std::uint32_t> expected(std::lower_bound(ids.begin(), ids.end(), first_id), ids.end());
+        EXPECT_EQ(visit.seen, expected) << "first_id " << first_id;
+    }
 }
 
 TEST(CellKey, DistinguishesLayersAndCoordinates) {

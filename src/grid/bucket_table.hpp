@@ -2,8 +2,8 @@
 /// @file bucket_table.hpp
 /// @brief The hash table that stores the grid: fixed-capacity buckets, rehash probing on misses,
 /// overflow buckets chained per cell, and a frame stamp so the table never needs clearing. Once
-/// filled, each cell's chain is copied into one contiguous list of entries (compact_cell), which is
-/// what queries read.
+/// filled, each cell's chain is copied into one contiguous list of entries sorted by id
+/// (compact_cell), which is what queries read.
 ///
 /// A bucket's `state` is stamp*2 while a thread is writing its header and stamp*2+1 once it is ready;
 /// any other stamp means the bucket is empty this frame. Overflow buckets come from a pool after the
@@ -132,8 +132,9 @@ KDET_HD inline std::uint32_t grid_find(const GridView& g, CellCoord cell) {
 }
 
 /// @brief Copies the ids of the cell whose main bucket is `slot` (if it is occupied this frame) into
-/// one list of entries, entry_of(id) each, and points the main bucket at it. When the list does not
-/// fit, the cell reads as empty and grid_entries_full is set: the frame reruns with more room.
+/// one list of entries, entry_of(id) each, sorted by id, and points the main bucket at it. When the
+/// list does not fit, the cell reads as empty and grid_entries_full is set: the frame reruns with
+/// more room.
 template <class EntryOf>
 KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const EntryOf& entry_of) {
     BucketHeader& main = g.headers[slot];
@@ -154,18 +155,34 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
         const std::uint32_t* ids = g.ids + static_cast<std::uint64_t>(b) * g.bucket_capacity;
         for (std::uint32_t i = 0; i < n; ++i) g.entries[k++] = entry_of(ids[i]);
     }
+    // Insertion sort: threads populate in about id order, so few entries move.
+    for (std::uint32_t i = first + 1; i < first + total; ++i) {
+        const GridEntry e = g.entries[i];
+        std::uint32_t j = i;
+        for (; j > first && g.entries[j - 1].id > e.id; --j) g.entries[j] = g.entries[j - 1];
+        g.entries[j] = e;
+    }
     main.count = total;
     main.first_entry = first;
 }
 
-/// @brief Calls visit(entry) for every entry of `cell`, once the table is compacted.
+/// @brief Calls visit(entry) for every entry of `cell` whose id is at least `first_id`, once the table
+/// is compacted; the smaller ids are skipped by a binary search, never read.
 template <class Visitor>
-KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, Visitor& visit) {
+KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std::uint32_t first_id, Visitor& visit) {
     const std::uint32_t bucket = grid_find(g, cell);
     if (bucket == no_bucket) return;
     const GridEntry* entries = g.entries + g.headers[bucket].first_entry;
     const std::uint32_t n = g.headers[bucket].count;
-    for (std::uint32_t k = 0; k < n; ++k) visit(entries[k]);
+    std::uint32_t begin = 0;
+    for (std::uint32_t end = n; begin < end;) {
+        const std::uint32_t middle = begin + (end - begin) / 2;
+        if (entries[middle].id < first_id)
+            begin = middle + 1;
+        else
+            end = middle;
+    }
+    for (std::uint32_t k = begin; k < n; ++k) visit(entries[k]);
 }
 
 } // namespace kdet

@@ -368,11 +368,9 @@ struct LargerNeighbourFilter {
     /// the scene's fields for each (the visitor's stores keep the compiler from hoisting them).
     const std::uint8_t* checked_against;
     const GridParams* params;
-    std::uint32_t t;
     Aabb box;
     Visitor* visit;
     int layer;                 ///< layer being visited
-    bool same_layer;           ///< visiting t's own layer: every id there is on t's layer
     std::uint32_t first[3];    ///< t's first cell per axis on this layer
     std::uint32_t cell[3];     ///< cell being visited (not wrapped)
 
@@ -385,8 +383,6 @@ struct LargerNeighbourFilter {
     }
 
     KDET_HD void operator()(const GridEntry& e) const {
-        // A cell holds only tets of its own layer, so the tie-break needs no load of u's data.
-        if (same_layer && e.id <= t) return;
         if (!checked_against[e.object]) return;
         if (!boxes_overlap(box, e.box)) return;
         if (reports_from_this_cell(e.box)) (*visit)(e);
@@ -400,11 +396,13 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     if (self.layer < 0) return;
     const std::uint32_t object = scene.tet_object[t];
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
-    LargerNeighbourFilter<Visitor> filter{checked_against, &params, t, self.box, &visit, 0, true, {}, {}};
+    LargerNeighbourFilter<Visitor> filter{checked_against, &params, self.box, &visit, 0, {}, {}};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
         filter.layer = layer;
-        filter.same_layer = layer == self.layer;
+        // A cell holds only tets of its own layer: on t's, the larger tets are the higher ids, and the
+        // sorted list skips the others unread; on a higher layer every tet is larger.
+        const std::uint32_t first_id = layer == self.layer ? t + 1 : 0u;
         const CellRange r = cell_range(params, self.box, layer);
         for (int a = 0; a < 3; ++a) filter.first[a] = r.lo[a];
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
@@ -413,7 +411,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
                     filter.cell[0] = x;
                     filter.cell[1] = y;
                     filter.cell[2] = z;
-                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), filter);
+                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, filter);
                     if (visit.finished()) return;
                 }
     }
