@@ -21,10 +21,15 @@ namespace hash_detail {
 /// Odd multiplier that makes successive probes of the arithmetic hashes visit every slot.
 constexpr std::uint32_t probe_stride = 2654435761u;
 
-KDET_HD inline std::uint32_t djb2_word(std::uint32_t hash, std::uint32_t word) {
-    for (int byte = 0; byte < 4; ++byte) hash = hash * 33u + ((word >> (8 * byte)) & 0xffu);
-    return hash;
+/// DJB2 (h = h * 33 + byte) over the 4 bytes of a word, low byte first, from h = 0. Unrolled over all
+/// bytes, DJB2 is h0 * 33^n plus each byte times 33 to the number of bytes after it (mod 2^32), so
+/// the bytes need not wait on each other: the hash is on the path of every cell lookup.
+KDET_HD inline std::uint32_t djb2_word(std::uint32_t word) {
+    return (word & 0xffu) * 35937u + ((word >> 8) & 0xffu) * 1089u + ((word >> 16) & 0xffu) * 33u + (word >> 24);
 }
+
+/// 33^(4 * words): what DJB2 multiplies the hash so far by over `words` more words.
+constexpr std::uint32_t djb2_shift(int words) { return words == 0 ? 1u : 1185921u * djb2_shift(words - 1); }
 
 KDET_HD inline std::uint32_t fnv1a_word(std::uint32_t hash, std::uint32_t word) {
     for (int byte = 0; byte < 4; ++byte) hash = (hash ^ ((word >> (8 * byte)) & 0xffu)) * 16777619u;
@@ -45,12 +50,10 @@ KDET_HD inline std::uint32_t spread_bits_3(std::uint32_t v) {
 
 /// @brief DJB2 over the bytes of the cell key, then of the probe number.
 KDET_HD inline std::uint32_t hash_djb2(CellCoord c, std::uint32_t probe) {
-    std::uint32_t h = 5381u;
-    h = hash_detail::djb2_word(h, c.x);
-    h = hash_detail::djb2_word(h, c.y);
-    h = hash_detail::djb2_word(h, c.z);
-    h = hash_detail::djb2_word(h, c.layer);
-    return hash_detail::djb2_word(h, probe);
+    using namespace hash_detail;
+    constexpr std::uint32_t start = 5381u * djb2_shift(5);
+    return start + djb2_word(c.x) * djb2_shift(4) + djb2_word(c.y) * djb2_shift(3) + djb2_word(c.z) * djb2_shift(2) +
+           djb2_word(c.layer) * djb2_shift(1) + djb2_word(probe);
 }
 
 /// @brief FNV-1a (32-bit) over the bytes of the cell key, then of the probe number.
