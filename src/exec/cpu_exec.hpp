@@ -8,17 +8,60 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <memory>
+#include <new>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
 namespace kdet {
 
+namespace host_memory {
+
+/// Buffers this large are placed on 2 MiB boundaries and, on Linux, asked to be backed by huge
+/// pages: the grid's table and lists are read at random, and with 4 KiB pages a large table misses
+/// the TLB on nearly every lookup (where transparent huge pages are "always", this changes nothing).
+constexpr std::size_t huge_page = std::size_t{2} << 20;
+
+struct Free {
+    void operator()(void* p) const { std::free(p); }
+};
+
+/// Uninitialised memory for `count` objects of `size` bytes; throws std::bad_alloc when it cannot.
+inline void* allocate(std::size_t count, std::size_t size) {
+    if (count > std::numeric_limits<std::size_t>::max() / size) throw std::bad_alloc();
+    const std::size_t bytes = count * size;
+    void* p = nullptr;
+    if (bytes >= huge_page) {
+        const std::size_t rounded = (bytes + huge_page - 1) / huge_page * huge_page;
+        p = std::aligned_alloc(huge_page, rounded);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+        if (p) madvise(p, rounded, MADV_HUGEPAGE); // advice only: failing it is harmless
+#endif
+    } else {
+        p = std::malloc(bytes == 0 ? 1 : bytes);
+    }
+    if (!p) throw std::bad_alloc();
+    return p;
+}
+
+} // namespace host_memory
+
 /// @brief Growable array that keeps its memory between frames; contents are not preserved on growth.
+/// Elements are left uninitialised (every buffer of the pipeline is written before it is read).
 template <class T>
 class HostBuffer {
+    static_assert(std::is_trivially_default_constructible<T>::value && std::is_trivially_destructible<T>::value,
+                  "HostBuffer holds plain data: its memory is neither constructed nor destroyed");
+
 public:
     /// @brief Makes room for n elements; discards the old contents when it has to reallocate.
     /// A failed allocation (std::bad_alloc) leaves the buffer empty, never a size without memory.
@@ -26,7 +69,7 @@ public:
         if (n > capacity_) {
             data_.reset();
             size_ = capacity_ = 0;
-            data_.reset(new T[n]);
+            data_.reset(static_cast<T*>(host_memory::allocate(n, sizeof(T))));
             capacity_ = n;
         }
         size_ = n;
@@ -43,7 +86,7 @@ public:
     std::size_t capacity_bytes() const { return capacity_ * sizeof(T); }
 
 private:
-    std::unique_ptr<T[]> data_;
+    std::unique_ptr<T, host_memory::Free> data_;
     std::size_t size_ = 0;
     std::size_t capacity_ = 0;
 };
