@@ -33,8 +33,8 @@ TEST(DetectorOptions, InvalidSettingsAreRejectedByName) {
     o.block_size = 2048;
     expect_rejected(o, "block size");
     o = DetectorOptions{};
-    o.bucket_capacity = 0;
-    expect_rejected(o, "bucket capacity");
+    o.bucket_capacity = 4097;
+    expect_rejected(o, "bucket capacity 4097 out of range [0, 4096]");
     o = DetectorOptions{};
     int not_a_stream = 0;
     o.cuda_stream = &not_a_stream; // never used as a stream: the CPU backend rejects any

@@ -25,13 +25,14 @@ struct Outcome {
     std::vector<TetPair> pairs;
     std::vector<std::vector<std::uint8_t>> colliding;
     FrameCounts counts;
+    std::size_t grid_bytes;
 };
 
 Outcome run(const std::vector<TetMesh>& meshes, bool self, DetectorOptions options) {
     Detector detector(options);
     for (const TetMesh& m : meshes) detector.set_self_collision(detector.add_object(m), self);
     const FrameResult& r = detector.detect();
-    return Outcome{r.pairs, r.colliding, r.counts};
+    return Outcome{r.pairs, r.colliding, r.counts, r.grid_bytes};
 }
 
 DetectorOptions with_method(Method method) {
@@ -66,6 +67,9 @@ void expect_same_as_brute_force(const std::vector<TetMesh>& meshes, bool self, s
         // written twice would show up twice here.
         EXPECT_EQ(found.pairs, oracle.pairs) << "kdet with hash " << to_string(hash);
     }
+    DetectorOptions thesis_buckets = with_method(Method::kdet);
+    thesis_buckets.bucket_capacity = 32;
+    EXPECT_EQ(run(meshes, self, thesis_buckets).pairs, oracle.pairs) << "kdet with buckets of 32";
     const Outcome no_pairs = run(meshes, self, with_method(Method::kdet_no_pairs));
     EXPECT_TRUE(no_pairs.pairs.empty());
     EXPECT_EQ(no_pairs.colliding, flags_of(oracle.pairs, oracle.colliding));
@@ -201,6 +205,19 @@ TEST(Pipeline, OrdinaryInputGrowsNoBuffer) {
         EXPECT_GT(outcome.counts.unique_candidates, 0u);
         EXPECT_EQ(outcome.counts.buffer_regrows, 0u) << meshes.size() << " objects, self " << self;
     }
+}
+
+TEST(Pipeline, SparseScenesGetSmallBucketsAndTheSameAnswer) {
+    // Tets whose sizes span three decades, few to a cell: the automatic bucket capacity (4 here)
+    // shrinks the table's id storage, and the answer is the one of any fixed capacity.
+    const TetMesh a = random_soup(20000, 40.0, 3.0, 51), b = random_soup(20000, 40.0, 3.0, 52);
+    DetectorOptions automatic = with_method(Method::kdet), fixed = automatic;
+    fixed.bucket_capacity = 32;
+    const Outcome small = run({a, b}, true, automatic), large = run({a, b}, true, fixed);
+    ASSERT_GT(small.pairs.size(), 100u);
+    EXPECT_EQ(small.pairs, large.pairs);
+    EXPECT_EQ(small.counts.buffer_regrows, 0u);
+    EXPECT_LT(2 * small.grid_bytes, large.grid_bytes);
 }
 
 TEST(Pipeline, ThreadCountDoesNotChangeTheAnswer) {

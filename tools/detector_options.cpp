@@ -14,7 +14,7 @@ void add_detector_options(ArgParser& parser, DetectorOptions& options) {
     parser.option("--threads", "N",
                   [&](const std::string& v) { options.threads = static_cast<int>(parse_integer("--threads", v, 1, 1024)); });
     parser.option("--bucket-capacity", "N", [&](const std::string& v) {
-        options.bucket_capacity = static_cast<std::uint32_t>(parse_integer("--bucket-capacity", v, 1, 4096));
+        options.bucket_capacity = static_cast<std::uint32_t>(parse_integer("--bucket-capacity", v, 0, max_bucket_capacity));
     });
     parser.option("--block-size", "N", [&](const std::string& v) {
         options.block_size = static_cast<int>(parse_integer("--block-size", v, 1, 1024));
@@ -30,7 +30,8 @@ std::string detector_options_help() {
            R"(
   --threads N          CPU threads (default: all)
   --block-size N       CUDA threads per block (default 128)
-  --bucket-capacity N  tet ids per grid bucket before an overflow bucket is chained (default 32)
+  --bucket-capacity N  tet ids per grid bucket before an overflow bucket is chained, 1-4096
+                       (default 0: chosen from the scene, 4-32)
 )";
 }
 

@@ -98,7 +98,10 @@ DetectorOptions make_options(const std::string& backend, const std::string& meth
     options.threads = threads ? static_cast<int>(std::min<std::uint32_t>(positive_u32("threads", *threads), 1u << 20)) : 0;
     options.contacts = contacts;
     options.block_size = static_cast<int>(std::min<std::uint32_t>(positive_u32("block_size", block_size), 1u << 20));
-    options.bucket_capacity = positive_u32("bucket_capacity", bucket_capacity);
+    if (bucket_capacity < 0 || bucket_capacity > 0xffffffffll)
+        throw Error("bucket_capacity: expected 0 (chosen from the scene) or a positive number, got " +
+                    std::to_string(bucket_capacity));
+    options.bucket_capacity = static_cast<std::uint32_t>(bucket_capacity);
     if (initial_candidate_capacity < 0)
         throw Error("initial_candidate_capacity: expected 0 (sized from the tets) or a positive number, got " +
                     std::to_string(initial_candidate_capacity));

@@ -19,6 +19,16 @@ namespace kdet {
 
 constexpr std::uint32_t no_bucket = 0xffffffffu;
 
+/// @brief The automatic bucket capacity: the mean ids per occupied cell, from a plan's count of
+/// entries and its bound on the occupied cells (so never above the true mean), rounded up to a power
+/// of two and kept within [4, 32]. A bucket as large as a typical cell chains rarely; a larger one
+/// only makes every slot of a sparse table carry unused room.
+inline std::uint32_t automatic_bucket_capacity(double entries, double occupied_cells) {
+    std::uint32_t capacity = 4;
+    while (capacity < 32 && capacity * occupied_cells < entries) capacity *= 2;
+    return capacity;
+}
+
 /// @brief Bits of GridView::failure.
 enum GridFailure : std::uint32_t { grid_table_full = 1u, grid_overflow_pool_full = 2u, grid_entries_full = 4u };
 

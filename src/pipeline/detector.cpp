@@ -152,7 +152,9 @@ Detector::Detector(const DetectorOptions& options) : impl_(std::make_unique<Impl
     impl_->options = options;
     if (options.block_size < 1 || options.block_size > 1024)
         throw Error("block size " + std::to_string(options.block_size) + " out of range [1, 1024]");
-    if (options.bucket_capacity < 1) throw Error("bucket capacity must be at least 1");
+    if (options.bucket_capacity > max_bucket_capacity)
+        throw Error("bucket capacity " + std::to_string(options.bucket_capacity) + " out of range [0, " +
+                    std::to_string(max_bucket_capacity) + "] (0 chooses it from the scene)");
     if (options.cuda_stream && options.backend != Backend::cuda)
         throw Error("option cuda_stream is set, but the backend is '" + std::string(to_string(options.backend)) +
                     "': a CUDA stream needs backend 'cuda'");

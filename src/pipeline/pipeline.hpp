@@ -99,8 +99,9 @@ public:
         pair_enabled_.resize_discard(objects * objects);
         pair_active_.resize_discard(objects * objects);
         counters_.resize_discard(1);
-        // New geometry: the first frame plans the grid and sizes the pairs from what it finds.
+        // New geometry: the first frame plans the grid (and its bucket size) and sizes the pairs from what it finds.
         grid_planned_ = pairs_sized_ = false;
+        bucket_capacity_ = 0;
         colliding_count_ = 0;
     }
 
@@ -209,6 +210,7 @@ private:
     std::uint32_t slot_count_ = 0;
     std::uint32_t overflow_capacity_ = 0;
     std::uint32_t entry_capacity_ = 0;
+    std::uint32_t bucket_capacity_ = 0; ///< ids per bucket, chosen with the first plan of a topology
     std::size_t pairs_window_ = 0;   ///< room for colliding pairs this frame
     bool grid_planned_ = false;      ///< the grid has been sized from a plan read back once
     bool pairs_sized_ = false;       ///< the pairs' window has been sized from a count read back once
@@ -278,7 +280,9 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
         cells += std::min(occupied, region);
         entries += n;
     }
-    const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
+    if (bucket_capacity_ == 0)
+        bucket_capacity_ = options_.bucket_capacity ? options_.bucket_capacity : automatic_bucket_capacity(entries, cells);
+    const std::uint32_t capacity = bucket_capacity_;
     std::uint32_t wanted_slots = 1024;
     while (wanted_slots < 1.25 * cells && wanted_slots < (1u << 30)) wanted_slots *= 2;
     const double wanted_pool = std::min(std::ceil(entries / capacity) + 1.0, static_cast<double>(1u << 30));
@@ -295,9 +299,9 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
 /// frame reruns with more room (grow_for).
 template <class Exec>
 GridView Pipeline<Exec>::populate() {
-    const std::uint32_t capacity = std::max<std::uint32_t>(1, options_.bucket_capacity);
+    const std::uint32_t capacity = bucket_capacity_;
     const std::size_t buckets = static_cast<std::size_t>(slot_count_) + overflow_capacity_;
-    if (headers_.size() != buckets) {
+    if (headers_.size() != buckets || ids_.size() != buckets * capacity) {
         headers_.resize_discard(buckets);
         ids_.resize_discard(buckets * capacity);
         fill(headers_, BucketHeader{}); // stamp 0 is never current, so this empties the table
