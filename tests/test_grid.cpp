@@ -315,14 +315,14 @@ TEST(BucketTable, CompactedCellsListTheirIdsInOrderAndSkipTheSmallerOnes) {
     }
 }
 
-TEST(BucketCapacity, AutomaticIsTheMeanIdsPerCellRoundedUpToAPowerOfTwoFrom4To32) {
+TEST(BucketCapacity, AutomaticIsFourTimesTheMeanIdsPerCellRoundedUpToAPowerOfTwoFrom4To32) {
     EXPECT_EQ(automatic_bucket_capacity(0.0, 0.0), 4u);
-    EXPECT_EQ(automatic_bucket_capacity(1300.0, 1000.0), 4u); // a sparse soup: 1.3 ids per cell
-    EXPECT_EQ(automatic_bucket_capacity(4000.0, 1000.0), 4u);
-    EXPECT_EQ(automatic_bucket_capacity(4001.0, 1000.0), 8u);
-    EXPECT_EQ(automatic_bucket_capacity(12000.0, 1000.0), 16u);
-    EXPECT_EQ(automatic_bucket_capacity(17000.0, 1000.0), 32u);
-    EXPECT_EQ(automatic_bucket_capacity(500000.0, 1000.0), 32u); // dense meshes keep the thesis's size
+    EXPECT_EQ(automatic_bucket_capacity(1000.0, 1000.0), 4u);
+    EXPECT_EQ(automatic_bucket_capacity(1001.0, 1000.0), 8u);
+    EXPECT_EQ(automatic_bucket_capacity(1300.0, 1000.0), 8u);   // a sparse soup: 1.3 ids per cell
+    EXPECT_EQ(automatic_bucket_capacity(3500.0, 1000.0), 16u);  // armadillo at resolution 4: 3.5
+    EXPECT_EQ(automatic_bucket_capacity(4001.0, 1000.0), 32u);
+    EXPECT_EQ(automatic_bucket_capacity(500000.0, 1000.0), 32u); // dense cells keep the thesis's size
 }
 
 TEST(CellKey, DistinguishesLayersAndCoordinates) {

@@ -208,8 +208,8 @@ TEST(Pipeline, OrdinaryInputGrowsNoBuffer) {
 }
 
 TEST(Pipeline, SparseScenesGetSmallBucketsAndTheSameAnswer) {
-    // Tets whose sizes span three decades, few to a cell: the automatic bucket capacity (4 here)
-    // shrinks the table's id storage, and the answer is the one of any fixed capacity.
+    // Tets whose sizes span three decades, few to a cell: the automatic bucket capacity (8 here)
+    // shrinks the table's id storage (the grid by about half), and the answer is the one of any fixed capacity.
     const TetMesh a = random_soup(20000, 40.0, 3.0, 51), b = random_soup(20000, 40.0, 3.0, 52);
     DetectorOptions automatic = with_method(Method::kdet), fixed = automatic;
     fixed.bucket_capacity = 32;
@@ -217,7 +217,7 @@ TEST(Pipeline, SparseScenesGetSmallBucketsAndTheSameAnswer) {
     ASSERT_GT(small.pairs.size(), 100u);
     EXPECT_EQ(small.pairs, large.pairs);
     EXPECT_EQ(small.counts.buffer_regrows, 0u);
-    EXPECT_LT(2 * small.grid_bytes, large.grid_bytes);
+    EXPECT_LT(5 * small.grid_bytes, 3 * large.grid_bytes); // at least 40 % less
 }
 
 TEST(Pipeline, ThreadCountDoesNotChangeTheAnswer) {

@@ -19,13 +19,14 @@ namespace kdet {
 
 constexpr std::uint32_t no_bucket = 0xffffffffu;
 
-/// @brief The automatic bucket capacity: the mean ids per occupied cell, from a plan's count of
-/// entries and its bound on the occupied cells (so never above the true mean), rounded up to a power
-/// of two and kept within [4, 32]. A bucket as large as a typical cell chains rarely; a larger one
-/// only makes every slot of a sparse table carry unused room.
+/// @brief The automatic bucket capacity: four times the mean ids per occupied cell, from a plan's count
+/// of entries and its bound on the occupied cells (so never above the true mean), rounded up to a power
+/// of two and kept within [4, 32]. Most cells then fit in their main bucket: each further bucket of a
+/// chain costs every later insert into the cell one more atomic add. A larger bucket only makes every
+/// slot of a sparse table carry unused room.
 inline std::uint32_t automatic_bucket_capacity(double entries, double occupied_cells) {
     std::uint32_t capacity = 4;
-    while (capacity < 32 && capacity * occupied_cells < entries) capacity *= 2;
+    while (capacity < 32 && capacity * occupied_cells < 4.0 * entries) capacity *= 2;
     return capacity;
 }
 
