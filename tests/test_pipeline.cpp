@@ -379,6 +379,30 @@ TEST(Detector, ALaterFrameThatNeedsMoreRoomRunsAgainAndLosesNothing) {
     }
 }
 
+TEST(Detector, BucketsGrowWhenObjectsThatStartedApartMeet) {
+    // Apart, nothing is gridded and the automatic bucket capacity starts at its smallest; once the
+    // objects overlap, the buckets grow to what a detector that saw the overlap first chose, so both
+    // end with the same grid (a later frame keeping buckets of 4 chained most of its cells).
+    const TetMesh a = random_soup(3000, 3.0, 1.0, 61);
+    const TetMesh apart = moved(a, 0.0, 10.0, 0.0, 0.0), deep = moved(a, 0.3, 0.1, 0.0, 0.0);
+    Detector late(with_method(Method::kdet)), early(with_method(Method::kdet));
+    late.add_object(a);
+    const ObjectId b = late.add_object(apart);
+    ASSERT_EQ(late.detect().counts.colliding_pairs, 0u);
+    late.set_positions(b, deep.positions.data(), deep.num_vertices());
+    late.detect();
+    early.add_object(a);
+    early.add_object(deep);
+    early.detect();
+    const FrameResult& seen_late = late.detect();
+    const std::size_t late_grid_bytes = seen_late.grid_bytes;
+    const std::vector<TetPair> late_pairs = seen_late.pairs;
+    const FrameResult& seen_early = early.detect();
+    EXPECT_EQ(late_grid_bytes, seen_early.grid_bytes);
+    EXPECT_EQ(late_pairs, seen_early.pairs);
+    EXPECT_GT(late_pairs.size(), 100u);
+}
+
 TEST(Detector, FlagsClearWhenObjectsSeparateAfterColliding) {
     const TetMesh a = random_soup(500, 1.0, 1.0, 53);
     const TetMesh near = moved(a, 0.3, 0.05, 0.0, 0.0), far = moved(a, 0.3, 5.0, 0.0, 0.0);

@@ -210,7 +210,7 @@ private:
     std::uint32_t slot_count_ = 0;
     std::uint32_t overflow_capacity_ = 0;
     std::uint32_t entry_capacity_ = 0;
-    std::uint32_t bucket_capacity_ = 0; ///< ids per bucket, chosen with the first plan of a topology
+    std::uint32_t bucket_capacity_ = 0; ///< ids per bucket: the option, or the largest automatic choice of a topology's plans
     std::size_t pairs_window_ = 0;   ///< room for colliding pairs this frame
     bool grid_planned_ = false;      ///< the grid has been sized from a plan read back once
     bool pairs_sized_ = false;       ///< the pairs' window has been sized from a count read back once
@@ -280,8 +280,10 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
         cells += std::min(occupied, region);
         entries += n;
     }
-    if (bucket_capacity_ == 0)
-        bucket_capacity_ = options_.bucket_capacity ? options_.bucket_capacity : automatic_bucket_capacity(entries, cells);
+    // Chosen anew from each plan but never smaller: a scene whose objects first meet in a later frame
+    // has few or no gridded tets in its first plans.
+    bucket_capacity_ = options_.bucket_capacity ? options_.bucket_capacity
+                                                : std::max(bucket_capacity_, automatic_bucket_capacity(entries, cells));
     const std::uint32_t capacity = bucket_capacity_;
     std::uint32_t wanted_slots = 1024;
     while (wanted_slots < 1.25 * cells && wanted_slots < (1u << 30)) wanted_slots *= 2;
