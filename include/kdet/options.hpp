@@ -79,9 +79,10 @@ struct DetectorOptions {
     int threads = 0;
     /// CUDA block size (threads per block), 1-1024; capped per kernel at what the kernel can launch with.
     int block_size = 128;
-    /// Tet ids per grid bucket before an overflow bucket is chained, 1-4096; 0 chooses it from the
-    /// first frame after objects were added: the mean ids per occupied cell rounded up to a power of
-    /// two, from 4 to 32 (sparse scenes get small buckets, and a much smaller table).
+    /// Tet ids per grid bucket before an overflow bucket is chained, 1-4096; 0 chooses it from each
+    /// frame's grid plan, never smaller than before for the same objects: four times the mean ids per
+    /// occupied cell rounded up to a power of two, from 4 to 32 (sparse scenes get small buckets, and
+    /// a much smaller table).
     std::uint32_t bucket_capacity = 0;
     /// Initial capacity of the candidate buffer in pairs; 0 sizes it from the tet count.
     /// It grows (and the stage reruns) whenever a frame needs more, so any value is safe.
