@@ -75,8 +75,9 @@ KDET_HD inline std::uint32_t claim_bucket(const GridView& g, CellCoord cell) {
     const std::uint64_t key = cell_key(cell);
     const std::uint32_t writing = g.stamp * 2u;
     const std::uint32_t ready = writing + 1u;
+    const CellHash hash = hash_cell_part(g.hash, cell);
     for (std::uint32_t probe = 0; probe < g.max_probes; ++probe) {
-        const std::uint32_t slot = table_slot(hash_cell(g.hash, cell, probe), g.slot_bits);
+        const std::uint32_t slot = table_slot(hash_probe(hash, probe), g.slot_bits);
         BucketHeader& h = g.headers[slot];
         std::uint32_t state = atomic_load_acquire(&h.state);
         if ((state >> 1) != g.stamp && atomic_compare_exchange(&h.state, state, writing)) {
@@ -133,8 +134,9 @@ KDET_HD inline bool grid_insert(const GridView& g, CellCoord cell, std::uint32_t
 /// @brief Main bucket of `cell` after populating, or no_bucket when the cell is empty.
 KDET_HD inline std::uint32_t grid_find(const GridView& g, CellCoord cell) {
     const std::uint64_t key = cell_key(cell);
+    const CellHash hash = hash_cell_part(g.hash, cell);
     for (std::uint32_t probe = 0; probe < g.max_probes; ++probe) {
-        const std::uint32_t slot = table_slot(hash_cell(g.hash, cell, probe), g.slot_bits);
+        const std::uint32_t slot = table_slot(hash_probe(hash, probe), g.slot_bits);
         const BucketHeader& h = g.headers[slot];
         if ((h.state >> 1) != g.stamp) return no_bucket;
         if (h.key == key) return slot;

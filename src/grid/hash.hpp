@@ -48,48 +48,85 @@ KDET_HD inline std::uint32_t spread_bits_3(std::uint32_t v) {
 
 } // namespace hash_detail
 
-/// @brief DJB2 over the bytes of the cell key, then of the probe number.
-KDET_HD inline std::uint32_t hash_djb2(CellCoord c, std::uint32_t probe) {
+/// @brief A cell's hash before its probe number is mixed in. Each hash here is a function of the cell's
+/// part and the probe number, so a lookup computes the cell's part once, however many slots it
+/// probes (and the dispatch on the function runs outside the probe loop: inside it, the compiler
+/// hoisted the cell's part of all four functions and computed them all on every lookup).
+struct CellHash {
+    HashFunction function;
+    std::uint32_t cell_part;
+};
+
+/// @brief DJB2 over the bytes of the cell key (x, y, z, layer); the probe number's bytes follow.
+KDET_HD inline std::uint32_t djb2_cell_part(CellCoord c) {
     using namespace hash_detail;
     constexpr std::uint32_t start = 5381u * djb2_shift(5);
     return start + djb2_word(c.x) * djb2_shift(4) + djb2_word(c.y) * djb2_shift(3) + djb2_word(c.z) * djb2_shift(2) +
-           djb2_word(c.layer) * djb2_shift(1) + djb2_word(probe);
+           djb2_word(c.layer) * djb2_shift(1);
 }
 
-/// @brief FNV-1a (32-bit) over the bytes of the cell key, then of the probe number.
-KDET_HD inline std::uint32_t hash_fnv1a(CellCoord c, std::uint32_t probe) {
+/// @brief FNV-1a (32-bit) over the bytes of the cell key; the probe number's bytes follow.
+KDET_HD inline std::uint32_t fnv1a_cell_part(CellCoord c) {
     std::uint32_t h = 2166136261u;
     h = hash_detail::fnv1a_word(h, c.x);
     h = hash_detail::fnv1a_word(h, c.y);
     h = hash_detail::fnv1a_word(h, c.z);
-    h = hash_detail::fnv1a_word(h, c.layer);
-    return hash_detail::fnv1a_word(h, probe);
+    return hash_detail::fnv1a_word(h, c.layer);
 }
 
 /// @brief Teschner et al.'s three-prime hash, with the layer term of Eitz and Lixu.
-KDET_HD inline std::uint32_t hash_simple(CellCoord c, std::uint32_t probe) {
-    const std::uint32_t h = (c.x * 73856093u) ^ (c.y * 19349663u) ^ (c.z * 83492791u) ^ (c.layer * 67867979u);
-    return h + probe * hash_detail::probe_stride;
+KDET_HD inline std::uint32_t simple_cell_part(CellCoord c) {
+    return (c.x * 73856093u) ^ (c.y * 19349663u) ^ (c.z * 83492791u) ^ (c.layer * 67867979u);
 }
 
 /// @brief Morton code of the low 10 bits of each coordinate, mixed with the layer.
-KDET_HD inline std::uint32_t hash_morton(CellCoord c, std::uint32_t probe) {
+KDET_HD inline std::uint32_t morton_cell_part(CellCoord c) {
     const std::uint32_t code = hash_detail::spread_bits_3(c.x) | (hash_detail::spread_bits_3(c.y) << 1) |
                                (hash_detail::spread_bits_3(c.z) << 2);
     // The high coordinate bits that the 30-bit code drops still reach the hash through the xor.
     const std::uint32_t high = ((c.x >> 10) * 73856093u) ^ ((c.y >> 10) * 19349663u) ^ ((c.z >> 10) * 83492791u);
-    return (code ^ high ^ (c.layer * 67867979u)) + probe * hash_detail::probe_stride;
+    return code ^ high ^ (c.layer * 67867979u);
 }
 
-/// @brief Dispatches to the selected hash function.
-KDET_HD inline std::uint32_t hash_cell(HashFunction function, CellCoord c, std::uint32_t probe) {
+/// @brief The cell's part of the selected hash function.
+KDET_HD inline CellHash hash_cell_part(HashFunction function, CellCoord c) {
     switch (function) {
-    case HashFunction::fnv1a: return hash_fnv1a(c, probe);
-    case HashFunction::simple: return hash_simple(c, probe);
-    case HashFunction::morton: return hash_morton(c, probe);
+    case HashFunction::fnv1a: return CellHash{function, fnv1a_cell_part(c)};
+    case HashFunction::simple: return CellHash{function, simple_cell_part(c)};
+    case HashFunction::morton: return CellHash{function, morton_cell_part(c)};
     case HashFunction::djb2:
-    default: return hash_djb2(c, probe);
+    default: return CellHash{HashFunction::djb2, djb2_cell_part(c)};
     }
+}
+
+/// @brief The hash of probe number `probe` of a cell: DJB2 and FNV-1a go on over the probe number's
+/// bytes; the arithmetic hashes add it times an odd stride.
+KDET_HD inline std::uint32_t hash_probe(const CellHash& h, std::uint32_t probe) {
+    switch (h.function) {
+    case HashFunction::fnv1a: return hash_detail::fnv1a_word(h.cell_part, probe);
+    case HashFunction::simple:
+    case HashFunction::morton: return h.cell_part + probe * hash_detail::probe_stride;
+    case HashFunction::djb2:
+    default: return h.cell_part + hash_detail::djb2_word(probe);
+    }
+}
+
+KDET_HD inline std::uint32_t hash_djb2(CellCoord c, std::uint32_t probe) {
+    return hash_probe(CellHash{HashFunction::djb2, djb2_cell_part(c)}, probe);
+}
+KDET_HD inline std::uint32_t hash_fnv1a(CellCoord c, std::uint32_t probe) {
+    return hash_probe(CellHash{HashFunction::fnv1a, fnv1a_cell_part(c)}, probe);
+}
+KDET_HD inline std::uint32_t hash_simple(CellCoord c, std::uint32_t probe) {
+    return hash_probe(CellHash{HashFunction::simple, simple_cell_part(c)}, probe);
+}
+KDET_HD inline std::uint32_t hash_morton(CellCoord c, std::uint32_t probe) {
+    return hash_probe(CellHash{HashFunction::morton, morton_cell_part(c)}, probe);
+}
+
+/// @brief The selected hash function of a cell and probe number.
+KDET_HD inline std::uint32_t hash_cell(HashFunction function, CellCoord c, std::uint32_t probe) {
+    return hash_probe(hash_cell_part(function, c), probe);
 }
 
 /// @brief Slot of a hash in a table of 2^slot_bits slots. Fibonacci hashing keeps the product's high
