@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
 #include <tuple>
@@ -130,6 +131,9 @@ TEST(CellRange, ClampsNonFiniteAndFarCoordinates) {
     EXPECT_EQ(cell_index(g, 2.5f, 0.0f, 1), 1250u);
 }
 
+/// A query box that overlaps every entry's.
+const Aabb everywhere{{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
+
 /// A table on the CPU execution layer with the given geometry.
 /// Visits every entry of a cell.
 struct EveryEntry {
@@ -149,7 +153,7 @@ struct TestTable {
         : headers(slots + pool, BucketHeader{}), ids(static_cast<std::size_t>(slots + pool) * capacity) {
         std::uint32_t bits = 0;
         while ((1u << bits) < slots) ++bits;
-        view = GridView{headers.data(), ids.data(), nullptr, nullptr, 0, &overflow_used, &failure, &claimed,
+        view = GridView{headers.data(), ids.data(), nullptr, nullptr, nullptr, 0, &overflow_used, &failure, &claimed,
                         slots, bits, capacity, pool, 1, probes, hash};
     }
     /// A compacted copy of the table (the table itself stays open for inserts), with room for
@@ -157,18 +161,25 @@ struct TestTable {
     struct Compacted {
         std::vector<BucketHeader> headers;
         std::vector<GridEntry> entries;
+        std::vector<Aabb> block_bounds;
         std::uint32_t used = 0, failure = 0;
         GridView view;
     };
     Compacted compacted(std::size_t room) const {
-        Compacted c{headers, std::vector<GridEntry>(room), 0, 0, view};
+        return compacted(room, [](std::uint32_t id) { return GridEntry{Aabb{}, id, id}; });
+    }
+    template <class EntryOf>
+    Compacted compacted(std::size_t room, const EntryOf& entry_of) const {
+        Compacted c{headers, std::vector<GridEntry>(room), std::vector<Aabb>(room / entry_block + 1), 0, 0, view};
         c.view.headers = c.headers.data();
         c.view.entries = c.entries.data();
+        c.view.block_bounds = c.block_bounds.data();
         c.view.entries_used = &c.used;
         c.view.entry_capacity = static_cast<std::uint32_t>(room);
         c.view.failure = &c.failure;
         for (std::uint32_t slot = 0; slot < view.slot_count; ++slot)
-            compact_cell(c.view, slot, [](std::uint32_t id) { return GridEntry{Aabb{}, id, id}; });
+            compact_cell(c.view, slot, entry_of);
+        for (std::uint32_t block = 0; block < c.block_bounds.size(); ++block) bound_entry_block(c.view, block, c.used);
         return c;
     }
     void next_frame() {
@@ -179,7 +190,7 @@ struct TestTable {
         const Compacted c = compacted(ids.size());
         EXPECT_EQ(c.failure, 0u);
         EveryEntry collect;
-        grid_for_each_in_cell(c.view, cell, 0u, collect);
+        grid_for_each_in_cell(c.view, cell, 0u, everywhere, collect);
         return collect.found;
     }
 };
@@ -287,7 +298,7 @@ TEST(BucketTable, CompactionThatDoesNotFitSaysSoAndLeavesEmptyCells) {
     const auto short_of_room = table.compacted(25);
     EXPECT_EQ(short_of_room.failure, static_cast<std::uint32_t>(grid_entries_full));
     EveryEntry readable;
-    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, 0u, readable);
+    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, 0u, everywhere, readable);
     EXPECT_EQ(readable.found.size(), 20u); // two cells of ten fit; the third reads as empty
     for (std::uint32_t id : readable.found) EXPECT_LT(id, 30u);
 }
@@ -309,10 +320,40 @@ TEST(BucketTable, CompactedCellsListTheirIdsInOrderAndSkipTheSmallerOnes) {
     std::sort(ids.begin(), ids.end());
     for (std::uint32_t first_id : {0u, 1u, 2u, 50u, 52u, 109u, 110u, 1000u}) {
         InOrder visit;
-        grid_for_each_in_cell(c.view, cell, first_id, visit);
+        grid_for_each_in_cell(c.view, cell, first_id, everywhere, visit);
         const std::vector<std::uint32_t> expected(std::lower_bound(ids.begin(), ids.end(), first_id), ids.end());
         EXPECT_EQ(visit.seen, expected) << "first_id " << first_id;
     }
+}
+
+TEST(BucketTable, QueriesSkipTheBlocksOfEntriesWhoseBoundMissesTheirBox) {
+    // Two cells whose lists interleave in memory with blocks; entry i's box spans x in [i, i + 0.5].
+    TestTable table(64, 4, 64, 32, HashFunction::djb2);
+    const CellCoord row{1, 1, 1, 0}, other{9, 9, 9, 0};
+    for (std::uint32_t i = 0; i < 60; ++i) ASSERT_TRUE(grid_insert(table.view, row, i));
+    for (std::uint32_t i = 100; i < 105; ++i) ASSERT_TRUE(grid_insert(table.view, other, i));
+    const auto c = table.compacted(65, [](std::uint32_t id) {
+        const float x = static_cast<float>(id);
+        return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
+    });
+    ASSERT_EQ(c.failure, 0u);
+    struct Seen {
+        std::set<std::uint32_t> ids;
+        void operator()(const GridEntry& e) { ids.insert(e.id); }
+    };
+    for (std::uint32_t first_id : {0u, 11u, 30u}) {
+        const Aabb query{{10.2f, 0.5f, 0.5f}, {21.7f, 0.6f, 0.6f}};
+        Seen seen;
+        grid_for_each_in_cell(c.view, row, first_id, query, seen);
+        for (std::uint32_t i = std::max(first_id, 10u); i <= 21; ++i) EXPECT_TRUE(seen.ids.count(i)) << i;
+        for (std::uint32_t id : seen.ids) EXPECT_GE(id, first_id);
+        // Blocks are 8 entries: at most the blocks that hold 10 to 21 are read, whatever the alignment.
+        EXPECT_LE(seen.ids.size(), 12u + 2 * (entry_block - 1)) << first_id;
+        EXPECT_FALSE(seen.ids.count(40)) << first_id;
+    }
+    Seen everything;
+    grid_for_each_in_cell(c.view, row, 0u, everywhere, everything);
+    EXPECT_EQ(everything.ids.size(), 60u);
 }
 
 TEST(BucketCapacity, AutomaticIsFourTimesTheMeanIdsPerCellRoundedUpToAPowerOfTwoFrom4To32) {

@@ -51,11 +51,17 @@ struct GridEntry {
     std::uint32_t object;
 };
 
+/// @brief Entries of the compacted lists per block: block b bounds the boxes of entries
+/// [b * entry_block, (b + 1) * entry_block), whatever lists they belong to, so that a query skips the
+/// entries of a block whose bound misses its box without reading them.
+constexpr std::uint32_t entry_block = 8;
+
 /// @brief A plain view of the table's buffers, passed by value into per-element code.
 struct GridView {
     BucketHeader* headers;          ///< slot_count main buckets, then overflow_capacity pool buckets
     std::uint32_t* ids;             ///< bucket_capacity ids per bucket
     GridEntry* entries;             ///< the compacted cells' lists
+    Aabb* block_bounds;             ///< [entry_capacity / entry_block rounded up] the bound of each block of entries
     std::uint32_t* entries_used;
     std::uint32_t entry_capacity;
     std::uint32_t* overflow_used;   ///< pool buckets handed out this frame
@@ -179,13 +185,33 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
     main.first_entry = first;
 }
 
-/// @brief Calls visit(entry) for every entry of `cell` whose id is at least `first_id`, once the table
-/// is compacted; the smaller ids are skipped by a binary search, never read.
+/// @brief The bound of block `block` of the compacted entries (see entry_block), once every list is
+/// written (`used` entries claimed in all, which may exceed the room when a list did not fit);
+/// blocks past them are left alone.
+KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, std::uint32_t used) {
+    if (used > g.entry_capacity) used = g.entry_capacity;
+    const std::uint32_t begin = block * entry_block;
+    if (begin >= used) return;
+    const std::uint32_t end = used - begin < entry_block ? used : begin + entry_block;
+    Aabb bound = g.entries[begin].box;
+    for (std::uint32_t k = begin + 1; k < end; ++k) {
+        bound.lo = min_v(bound.lo, g.entries[k].box.lo);
+        bound.hi = max_v(bound.hi, g.entries[k].box.hi);
+    }
+    g.block_bounds[block] = bound;
+}
+
+/// @brief Calls visit(entry) for every entry of `cell` whose id is at least `first_id` and whose box
+/// may overlap `box`, once the table is compacted: the smaller ids are skipped by a binary search,
+/// and the entries of a block whose bound misses `box` without being read (the visitor still tests
+/// each box it gets).
 template <class Visitor>
-KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std::uint32_t first_id, Visitor& visit) {
+KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std::uint32_t first_id, const Aabb& box,
+                                          Visitor& visit) {
     const std::uint32_t bucket = grid_find(g, cell);
     if (bucket == no_bucket) return;
-    const GridEntry* entries = g.entries + g.headers[bucket].first_entry;
+    const std::uint32_t first = g.headers[bucket].first_entry;
+    const GridEntry* entries = g.entries + first;
     const std::uint32_t n = g.headers[bucket].count;
     std::uint32_t begin = 0;
     for (std::uint32_t end = n; begin < end;) {
@@ -195,7 +221,16 @@ KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std
         else
             end = middle;
     }
-    for (std::uint32_t k = begin; k < n; ++k) visit(entries[k]);
+    for (std::uint32_t k = begin; k < n;) {
+        const std::uint32_t block = (first + k) / entry_block;
+        const std::uint32_t block_end = (block + 1) * entry_block - first;
+        const std::uint32_t end = block_end < n ? block_end : n;
+        if (!boxes_overlap(box, g.block_bounds[block])) {
+            k = end;
+            continue;
+        }
+        for (; k < end; ++k) visit(entries[k]);
+    }
 }
 
 } // namespace kdet

@@ -353,6 +353,14 @@ struct CompactCellsKernel {
     }
 };
 
+/// @brief Stage 2, after compacting: the bound of each block of entries (bound_entry_block).
+struct BoundEntryBlocksKernel {
+    GridView grid;
+    KDET_HD void operator()(std::uint64_t block) const {
+        bound_entry_block(grid, static_cast<std::uint32_t>(block), *grid.entries_used);
+    }
+};
+
 /// @brief Calls visit(entry) once for every tet u (entry.id) that tet t must test, with what the
 /// cell's list holds about u (box, object): u is stored in a cell that t's
 /// box overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
@@ -413,7 +421,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
                     filter.cell[0] = x;
                     filter.cell[1] = y;
                     filter.cell[2] = z;
-                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, filter);
+                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, self.box, filter);
                     if (visit.finished()) return;
                 }
     }
