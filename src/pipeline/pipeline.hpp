@@ -261,7 +261,8 @@ void Pipeline<Exec>::grid_geometry() {
 /// @brief Sizes the table for a plan: per layer the occupied cells are at most the plan's bound
 /// (GridPlanKernel) and at most the region's cells; the table gets a quarter more slots than that
 /// bound (probing stays short), and the overflow pool one bucket
-/// per bucket_capacity entries, which holds every chain whatever the cells' fill; the compacted lists
+/// per bucket_capacity entries, which holds every chain whatever the cells' fill, plus room for the
+/// buckets that racing threads waste; the compacted lists
 /// get room for the entries, which the plan counts exactly. All only grow, so a scene that keeps its
 /// size sizes them once.
 template <class Exec>
@@ -289,7 +290,9 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     const std::uint32_t capacity = bucket_capacity_;
     std::uint32_t wanted_slots = 1024;
     while (wanted_slots < 1.25 * cells && wanted_slots < (1u << 30)) wanted_slots *= 2;
-    const double wanted_pool = std::min(std::ceil(entries / capacity) + 1.0, static_cast<double>(1u << 30));
+    // A thread that loses the race to chain a full bucket leaves the bucket it took unused for the
+    // frame: an eighth more (and 64) keeps such losses from failing the pass and running it again.
+    const double wanted_pool = std::min(std::ceil(1.125 * entries / capacity) + 64.0, static_cast<double>(1u << 30));
     slot_count_ = std::max(slot_count_, wanted_slots);
     overflow_capacity_ = std::max(overflow_capacity_, static_cast<std::uint32_t>(wanted_pool));
     // An eighth more than the plan's count: a deforming scene's cells gain entries from frame to frame,
