@@ -217,6 +217,8 @@ TEST(Pipeline, SparseScenesGetSmallBucketsAndTheSameAnswer) {
     ASSERT_GT(small.pairs.size(), 100u);
     EXPECT_EQ(small.pairs, large.pairs);
     EXPECT_EQ(small.counts.buffer_regrows, 0u);
+    EXPECT_EQ(small.counts.grid_bucket_capacity, 8u);
+    EXPECT_EQ(large.counts.grid_bucket_capacity, 32u);
     EXPECT_LT(5 * small.grid_bytes, 3 * large.grid_bytes); // at least 40 % less
 }
 
@@ -396,8 +398,11 @@ TEST(Detector, BucketsGrowWhenObjectsThatStartedApartMeet) {
     early.detect();
     const FrameResult& seen_late = late.detect();
     const std::size_t late_grid_bytes = seen_late.grid_bytes;
+    const std::uint32_t late_capacity = seen_late.counts.grid_bucket_capacity;
     const std::vector<TetPair> late_pairs = seen_late.pairs;
     const FrameResult& seen_early = early.detect();
+    EXPECT_GT(late_capacity, 4u);
+    EXPECT_EQ(late_capacity, seen_early.counts.grid_bucket_capacity);
     EXPECT_EQ(late_grid_bytes, seen_early.grid_bytes);
     EXPECT_EQ(late_pairs, seen_early.pairs);
     EXPECT_GT(late_pairs.size(), 100u);

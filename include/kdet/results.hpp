@@ -61,6 +61,8 @@ struct FrameCounts {
     std::uint64_t grid_cells = 0;        ///< occupied grid cells (main buckets claimed)
     std::uint64_t grid_slots = 0;        ///< main buckets of the hash table
     std::uint64_t grid_overflow_buckets = 0; ///< overflow buckets chained this frame
+    /// Ids per grid bucket: DetectorOptions::bucket_capacity, or the automatic choice from the plans so far.
+    std::uint32_t grid_bucket_capacity = 0;
     /// Times the host waited for the backend (reads of counters and results); on the GPU each is a
     /// stream synchronisation. Counted identically on the CPU backend.
     std::uint32_t host_waits = 0;

@@ -38,6 +38,7 @@ constexpr auto fields_of<FrameCounts>() {
                            Field{"buffer_regrows", &C::buffer_regrows}, Field{"grid_cells", &C::grid_cells},
                            Field{"grid_slots", &C::grid_slots},
                            Field{"grid_overflow_buckets", &C::grid_overflow_buckets},
+                           Field{"grid_bucket_capacity", &C::grid_bucket_capacity},
                            Field{"host_waits", &C::host_waits});
 }
 

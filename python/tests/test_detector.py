@@ -157,6 +157,19 @@ def test_detectors_in_threads_agree(octopus):
         np.testing.assert_array_equal(pairs, expected)
 
 
+def test_bucket_capacity_is_chosen_or_kept(octopus):
+    # 0 (the default) lets each frame's grid plan choose the ids per bucket; a number is kept.
+    counts = {}
+    for capacity in (0, 32):
+        detector = kdet.Detector(bucket_capacity=capacity)
+        detector.add_object(octopus)
+        detector.add_object(moved(octopus, 0.3, (0.1 * extent(octopus), 0.0, 0.0)))
+        counts[capacity] = detector.detect().counts
+    assert counts[0].grid_bucket_capacity in (4, 8, 16, 32)
+    assert counts[32].grid_bucket_capacity == 32
+    assert counts[0].colliding_pairs == counts[32].colliding_pairs > 0
+
+
 def test_reprs_and_options():
     detector = kdet.Detector(method="GPU", test="sat-mtv", threads=2)
     assert detector.options["method"] == "brute_force_loop" and detector.options["test"] == "sat_mtv"

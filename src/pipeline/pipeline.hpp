@@ -606,6 +606,7 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
         counts.grid_cells = c.cells_claimed;
         counts.grid_slots = slot_count_;
         counts.grid_overflow_buckets = c.overflow_used;
+        counts.grid_bucket_capacity = bucket_capacity_;
     }
 
     const std::size_t objects = object_boxes_.size();
