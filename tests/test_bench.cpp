@@ -40,21 +40,21 @@ std::string settings(const BenchConfig& c) {
     out << c.scene << " r" << c.request.resolution << " " << bench_method_name(c.options.method) << " "
         << to_string(c.options.narrow_phase) << " g" << c.options.block_size << " n" << c.runs << " self "
         << c.self << " " << to_string(c.options.hash) << " " << c.output_dir << " " << to_string(c.options.backend)
-        << " threads " << c.options.threads << " frames " << c.first_frame << ":" << c.last_frame << " quiet "
+        << " threads " << c.options.threads << " buckets " << c.options.bucket_capacity << " frames " << c.first_frame << ":" << c.last_frame << " quiet "
         << c.quiet << " help " << c.help << " procedural flag '" << c.procedural_flag << "'";
     return out.str();
 }
 
 TEST(BenchArgs, DefaultsAreTheThesiss) {
     EXPECT_EQ(settings(parse_words({})), "procedural r1 kdet sat g128 n10 self 0 djb2 exports/benchmark_data cpu "
-                                         "threads 0 frames 0:-1 quiet 0 help 0 procedural flag ''");
+                                         "threads 0 buckets 0 frames 0:-1 quiet 0 help 0 procedural flag ''");
 }
 
 TEST(BenchArgs, EveryFlagInAnyOrder) {
     const BenchConfig c = parse_words({"-r", "3", "-c", "gpu_no_loop", "-o", "sat_mtv", "-g", "64", "armadillos", "-n",
                                        "20", "-s", "y", "-h", "fnv-1a", "-d", "out/x", "--backend", "cuda", "--threads",
-                                       "4", "--frames", "5:9", "--quiet", "--help"});
-    EXPECT_EQ(settings(c), "armadillos r3 gpu_no_loop sat_mtv g64 n20 self 1 fnv-1a out/x cuda threads 4 frames 5:9 "
+                                       "4", "--frames", "5:9", "--quiet", "--help", "--bucket-capacity", "32"});
+    EXPECT_EQ(settings(c), "armadillos r3 gpu_no_loop sat_mtv g64 n20 self 1 fnv-1a out/x cuda threads 4 buckets 32 frames 5:9 "
                            "quiet 1 help 1 procedural flag ''");
 }
 
@@ -96,7 +96,7 @@ TEST(BenchArgs, TheThesissExampleCommandRunsUnchanged) {
     const BenchConfig c = parse_words({"buddha_and_armadillo", "-r", "2", "-n", "5", "-c", "gpu_no_loop", "-o", "sat-mtv",
                                        "-d", "./../../exports/benchmark_data"});
     EXPECT_EQ(settings(c), "buddha_and_armadillo r2 gpu_no_loop sat_mtv g128 n5 self 0 djb2 ./../../exports/benchmark_data "
-                           "cpu threads 0 frames 0:-1 quiet 0 help 0 procedural flag ''");
+                           "cpu threads 0 buckets 0 frames 0:-1 quiet 0 help 0 procedural flag ''");
     EXPECT_EQ(parse_words({"-c", "Brute-Force-Pairs", "-h", "FNV_1A", "--backend", "CPU"}).options.method,
               Method::brute_force_pairs);
 }
@@ -314,7 +314,7 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
                                                   "overlap test",      "self collisions", "hashing algorithm",
                                                   "#frames",           "first frame", "total runs", "#tetsA",
                                                   "#tetsB",            "#verticesA", "#verticesB"};
-    const std::vector<std::string> more_keys = {"backend", "threads", "device", "compiler", "compiler flags",
+    const std::vector<std::string> more_keys = {"backend", "threads", "bucket capacity", "device", "compiler", "compiler flags",
                                                 "kdet version", "peak memory bytes", "time unit"};
     std::vector<std::string> keys;
     std::map<std::string, std::string> header;
@@ -327,6 +327,7 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     expected.insert(expected.end(), more_keys.begin(), more_keys.end());
     EXPECT_EQ(keys, expected);
     EXPECT_EQ(header["scene name"], "procedural");
+    EXPECT_EQ(header["bucket capacity"], config.options.bucket_capacity ? std::to_string(config.options.bucket_capacity) : "automatic");
     EXPECT_EQ(header["algorithm"], "kdet");
     EXPECT_EQ(header["self collisions"], "yes");
     EXPECT_EQ(header["#frames"], "3");

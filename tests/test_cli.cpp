@@ -182,6 +182,7 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
         {"bench -h", 2, "option '-h' needs a value"},
         {"bench --backend gpu", 2, "invalid value 'gpu' for --backend"},
         {"bench --threads 0", 2, "invalid value '0' for --threads"},
+        {"bench --bucket-capacity 5000", 2, "invalid value '5000' for --bucket-capacity"},
         {"bench --frames 5:2", 2, "invalid value '5:2' for --frames"},
         {"bench --tets 300 --scene-frames 9 --frames 3:9", 2, "for --frames: scene 'procedural' has frames 0 to 8"},
         {"bench --tets 5", 2, "--tets"},

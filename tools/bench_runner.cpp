@@ -72,6 +72,7 @@ std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene
             {"#verticesB", std::to_string(vertices_of(scene, 1))},
             {"backend", to_string(o.backend)},
             {"threads", std::to_string(threads)},
+            {"bucket capacity", o.bucket_capacity ? std::to_string(o.bucket_capacity) : "automatic"},
             {"device", detector.device_name()},
             {"compiler", compiler()},
             {"compiler flags", KDET_BENCH_CXX_FLAGS},
