@@ -39,7 +39,7 @@ TEST(Hash, MatchesIndependentReferenceValues) {
 }
 
 TEST(Hash, Djb2EqualsItsDefinitionByteAfterByte) {
-    // hash_djb2 adds each byte times its power of 33; the definition runs h = h * 33 + byte.
+    // DJB2 adds each byte times its power of 33; the definition runs h = h * 33 + byte.
     std::mt19937 rng(5);
     for (int i = 0; i < 10000; ++i) {
         const std::uint32_t words[5] = {static_cast<std::uint32_t>(rng()), static_cast<std::uint32_t>(rng()),
@@ -48,7 +48,7 @@ TEST(Hash, Djb2EqualsItsDefinitionByteAfterByte) {
         std::uint32_t h = 5381u;
         for (std::uint32_t w : words)
             for (int byte = 0; byte < 4; ++byte) h = h * 33u + ((w >> (8 * byte)) & 0xffu);
-        ASSERT_EQ(hash_djb2(CellCoord{words[0], words[1], words[2], words[3]}, words[4]), h) << i;
+        ASSERT_EQ(hash_cell(HashFunction::djb2, CellCoord{words[0], words[1], words[2], words[3]}, words[4]), h) << i;
     }
 }
 

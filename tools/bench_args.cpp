@@ -1,5 +1,7 @@
 #include "bench_args.hpp"
 
+#include "commands.hpp"
+
 #include <string>
 #include <vector>
 
@@ -40,8 +42,7 @@ thesis options (any order):
 more options:
   --backend B          where detection runs: )" + option_help(defaults.backend) + R"(; cuda needs a GPU
   --threads N          CPU threads (default: all)
-  --bucket-capacity N  tet ids per grid bucket, 1-4096 (default 0: chosen from the scene, 4-32)
-  --frames A:B         run frames A to B only (0-based, inclusive)
+)" + bucket_capacity_help + R"(  --frames A:B         run frames A to B only (0-based, inclusive)
   --quiet              no per-frame table and no progress bar; only the summary
   --help               this text
 
@@ -101,9 +102,7 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     parser.option("--threads", "N", [&](const std::string& v) {
         config.options.threads = static_cast<int>(parse_integer("--threads", v, 1, 1024));
     });
-    parser.option("--bucket-capacity", "N", [&](const std::string& v) {
-        config.options.bucket_capacity = static_cast<std::uint32_t>(parse_integer("--bucket-capacity", v, 0, max_bucket_capacity));
-    });
+    add_bucket_capacity_option(parser, config.options);
     const auto scene_length = [&](const std::string& flag, const std::string& v) {
         config.request.procedural.frames = static_cast<int>(parse_integer(flag, v, 1, 100000));
         if (config.procedural_flag.empty()) config.procedural_flag = flag;

@@ -111,19 +111,6 @@ KDET_HD inline std::uint32_t hash_probe(const CellHash& h, std::uint32_t probe) 
     }
 }
 
-KDET_HD inline std::uint32_t hash_djb2(CellCoord c, std::uint32_t probe) {
-    return hash_probe(CellHash{HashFunction::djb2, djb2_cell_part(c)}, probe);
-}
-KDET_HD inline std::uint32_t hash_fnv1a(CellCoord c, std::uint32_t probe) {
-    return hash_probe(CellHash{HashFunction::fnv1a, fnv1a_cell_part(c)}, probe);
-}
-KDET_HD inline std::uint32_t hash_simple(CellCoord c, std::uint32_t probe) {
-    return hash_probe(CellHash{HashFunction::simple, simple_cell_part(c)}, probe);
-}
-KDET_HD inline std::uint32_t hash_morton(CellCoord c, std::uint32_t probe) {
-    return hash_probe(CellHash{HashFunction::morton, morton_cell_part(c)}, probe);
-}
-
 /// @brief The selected hash function of a cell and probe number.
 KDET_HD inline std::uint32_t hash_cell(HashFunction function, CellCoord c, std::uint32_t probe) {
     return hash_probe(hash_cell_part(function, c), probe);

@@ -99,7 +99,8 @@ public:
         pair_enabled_.resize_discard(objects * objects);
         pair_active_.resize_discard(objects * objects);
         counters_.resize_discard(1);
-        // New geometry: the first frame plans the grid (and its bucket size) and sizes the pairs from what it finds.
+        // New geometry: the first frame plans the grid and sizes the pairs from what it finds; the bucket
+        // size is chosen again from that plan (and only grows with later ones).
         grid_planned_ = pairs_sized_ = false;
         bucket_capacity_ = 0;
         colliding_count_ = 0;
