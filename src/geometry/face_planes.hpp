@@ -2,8 +2,8 @@
 /// @file face_planes.hpp
 /// @brief A pre-test for tet pairs from each tet's four face planes, computed once per tet and frame.
 /// It proves a pair separated (one tet lies beyond a face plane of the other) or intersecting (a vertex
-/// of one tet lies inside the other), each only by a margin far above every rounding involved, and
-/// leaves all other pairs to the narrow-phase test. So it never changes what a test reports.
+/// or an edge point of one tet lies inside the other), each only by a margin far above every rounding
+/// involved, and leaves all other pairs to the narrow-phase test. So it never changes what a test reports.
 ///
 /// Bounds, with u = 2^-24, L the pair's longest edge, l the plane owner's shortest edge, s = 1/64 the
 /// smallest sine between the two edges a used face normal is built from, and pairs whose boxes overlap
@@ -24,11 +24,13 @@
 /// A face's margin is k_plane_margin L^2 / l, k_plane_margin = 2^-9 (1.95e-3), more than 2.5 times
 /// what the first, third and fourth add up to (7.3e-4 L^2 / l at most, as l <= L), so a pair the
 /// pre-test separates shows a gap above 1.2e-3 L^2 / l
-/// along a face axis that sat, sat_no_edges and sat_mtv compute and report as separating. A vertex
-/// found inside all four planes of a tet whose opposite vertices lie below their faces by the margin
-/// (`solid`) lies inside the true tet by more than 1.7e-3 L^2 / l, so the tets overlap by that much
-/// along every axis. Both decisions are therefore true for the exact float input (the `exact` test
-/// agrees) and lie far inside the clear band (beyond 1e-5 L) where gjk and fast agree with CGAL
+/// along a face axis that sat, sat_no_edges and sat_mtv compute and report as separating. A point of
+/// the other tet found inside all four planes of a tet whose opposite vertices lie below their faces
+/// by the margin (`solid`) lies inside the true tet by more than 1.7e-3 L^2 / l, so the tets overlap
+/// by that much along every axis; the point is a vertex, or a point of an edge whose distances are
+/// interpolated from those of its ends (under 30u L more rounding, within the margin's room). Both
+/// decisions are therefore true for the exact float input (the `exact` test agrees) and lie far
+/// inside the clear band (beyond 1e-5 L) where gjk and fast agree with CGAL
 /// (tests/cgal/test_narrow_phase_cgal.cpp), and no test misses an intersecting pair.
 ///
 /// The bounds need every intermediate value normal: a tet is used only when its coordinates relative
@@ -37,6 +39,7 @@
 /// from the edges scaled by a power of two (exact), so no square underflows or overflows. An unused
 /// tet gets an infinite margin scale: every margin involving it is infinite or NaN, and decides nothing.
 
+#include "geometry/tet_pair.hpp"
 #include "geometry/vec3.hpp"
 
 #include <cstdint>
@@ -130,6 +133,12 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     return p;
 }
 
+/// @brief Signed distance of point w beyond each face plane k of p.
+KDET_HD inline void plane_distances(const TetPlanes& p, vec3 w, float distance[4]) {
+    const vec3 r = w - p.origin;
+    for (int k = 0; k < 4; ++k) distance[k] = p.nx[k] * r.x + p.ny[k] * r.y + p.nz[k] * r.z - p.offset[k];
+}
+
 /// @brief What the four face planes of p show about the four vertices w, with a margin: whether all
 /// of w lies beyond one face plane (`separated`), and whether some vertex lies inside all four
 /// (`inside`). The four faces are evaluated side by side (vector instructions on the CPU).
@@ -142,9 +151,8 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
     float nearest[4] = {3.4e38f, 3.4e38f, 3.4e38f, 3.4e38f};
     int inside = 0;
     for (int j = 0; j < 4; ++j) {
-        const vec3 r = w[j] - p.origin;
         float distance[4];
-        for (int k = 0; k < 4; ++k) distance[k] = p.nx[k] * r.x + p.ny[k] * r.y + p.nz[k] * r.z - p.offset[k];
+        plane_distances(p, w[j], distance);
         for (int k = 0; k < 4; ++k) nearest[k] = min_f(nearest[k], distance[k]);
         const float farthest = max_f(max_f(distance[0], distance[1]), max_f(distance[2], distance[3]));
         inside |= farthest < -margin ? 1 : 0;
@@ -152,6 +160,50 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
     int separated = 0;
     for (int k = 0; k < 4; ++k) separated |= nearest[k] > margin ? 1 : 0;
     return PlaneSides{separated != 0, inside != 0 && p.solid != 0};
+}
+
+/// @brief A distance beyond any that a used tet's planes give along the other tet's edges.
+constexpr float k_plane_far = 3.0e38f;
+
+/// @brief Whether a point of some edge of tet w lies inside all four face planes of a solid tet p by
+/// more than `margin`: where no vertex lies inside the other tet, two intersecting tets still have an
+/// edge of one passing through the other. The distances vary linearly along an edge, so the part of
+/// it inside every plane is clipped from those at its ends (each face keeps the parameters between
+/// where its distance reaches -margin and where it would reach -k_plane_far, with min and max
+/// only: a branch per edge and face would be a coin flip). The middle of that part, clamped onto
+/// the edge whatever the rounding, is then checked as a vertex is, from the interpolated distances.
+KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float margin) {
+    if (!p.solid) return false;
+    float distance[4][4];
+    for (int j = 0; j < 4; ++j) plane_distances(p, w[j], distance[j]);
+    // Edge e and face k at [4 e + k], in flat arrays so that each step runs on all 24 at once.
+    float from[24], slope[24], enter[24], leave[24], at_s[24], s[6];
+    for (int e = 0; e < 6; ++e)
+        for (int k = 0; k < 4; ++k) {
+            from[4 * e + k] = distance[narrow::edge_first(e)][k];
+            slope[4 * e + k] = distance[narrow::edge_second(e)][k] - distance[narrow::edge_first(e)][k];
+        }
+    for (int i = 0; i < 24; ++i) {
+        const float inverse_slope = 1.0f / slope[i];
+        const float at_margin = -(from[i] + margin) * inverse_slope;
+        const float at_far = -(from[i] + k_plane_far) * inverse_slope;
+        enter[i] = min_f(at_margin, at_far);
+        leave[i] = max_f(at_margin, at_far);
+    }
+    for (int e = 0; e < 6; ++e) {
+        const float* en = enter + 4 * e;
+        const float* le = leave + 4 * e;
+        const float first = max_f(max_f(max_f(en[0], en[1]), max_f(en[2], en[3])), 0.0f);
+        const float last = min_f(min_f(min_f(le[0], le[1]), min_f(le[2], le[3])), 1.0f);
+        s[e] = min_f(max_f(0.5f * (first + last), 0.0f), 1.0f);
+    }
+    for (int i = 0; i < 24; ++i) at_s[i] = from[i] + s[i / 4] * slope[i];
+    int found = 0;
+    for (int e = 0; e < 6; ++e) {
+        const float* d = at_s + 4 * e;
+        found |= max_f(max_f(d[0], d[1]), max_f(d[2], d[3])) < -margin ? 1 : 0;
+    }
+    return found != 0;
 }
 
 /// @brief What the face planes prove about two tets whose boxes overlap.
@@ -162,11 +214,14 @@ enum class PlaneVerdict { unsure, separated, intersecting };
 KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
                                                const vec3 b[4], bool separation_only) {
     const float longest = max_f(pa.longest, pb.longest);
-    const PlaneSides b_by_a = plane_sides(pa, b, pa.margin_scale * longest * longest);
+    const float margin_a = pa.margin_scale * longest * longest, margin_b = pb.margin_scale * longest * longest;
+    const PlaneSides b_by_a = plane_sides(pa, b, margin_a);
     if (b_by_a.separated) return PlaneVerdict::separated;
-    const PlaneSides a_by_b = plane_sides(pb, a, pb.margin_scale * longest * longest);
+    const PlaneSides a_by_b = plane_sides(pb, a, margin_b);
     if (a_by_b.separated) return PlaneVerdict::separated;
-    if (!separation_only && (b_by_a.inside || a_by_b.inside)) return PlaneVerdict::intersecting;
+    if (separation_only) return PlaneVerdict::unsure;
+    if (b_by_a.inside || a_by_b.inside || edges_pass_inside(pa, b, margin_a) || edges_pass_inside(pb, a, margin_b))
+        return PlaneVerdict::intersecting;
     return PlaneVerdict::unsure;
 }
 
