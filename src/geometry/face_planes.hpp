@@ -24,11 +24,13 @@
 /// A face's margin is k_plane_margin L^2 / l, k_plane_margin = 2^-9 (1.95e-3), more than 2.5 times
 /// what the first, third and fourth add up to (7.3e-4 L^2 / l at most, as l <= L), so a pair the
 /// pre-test separates shows a gap above 1.2e-3 L^2 / l
-/// along a face axis that sat, sat_no_edges and sat_mtv compute and report as separating. A point of
-/// the other tet found inside all four planes of a tet whose opposite vertices lie below their faces
-/// by the margin (`solid`) lies inside the true tet by more than 1.7e-3 L^2 / l, so the tets overlap
-/// by that much along every axis; the point is a vertex, or a point of an edge whose distances are
-/// interpolated from those of its ends (under 30u L more rounding, within the margin's room). Both
+/// along a face axis that sat, sat_no_edges and sat_mtv compute and report as separating.
+/// An intersection needs no agreement with the float tests' axes, only a point truly inside: a point
+/// of the other tet found inside all four planes, by k_plane_inside_margin L^2 / l = 2^-11 L^2 / l
+/// (4.9e-4), of a tet whose opposite vertices lie below their faces by the face margin (`solid`) lies
+/// inside the true tet by more than 3e-4 L^2 / l (the first two bounds add up to 1.8e-4 L^2 / l at
+/// most), so the tets overlap by that much along every axis; the point is a vertex, or a point of an
+/// edge whose distances are interpolated from those of its ends (under 30u L more rounding). Both
 /// decisions are therefore true for the exact float input (the `exact` test agrees) and lie far
 /// inside the clear band (beyond 1e-5 L) where gjk and fast agree with CGAL
 /// (tests/cgal/test_narrow_phase_cgal.cpp), and no test misses an intersecting pair.
@@ -48,6 +50,10 @@ namespace kdet {
 
 /// @brief Margin of the pre-test in units of L^2 / l_min (see the file comment).
 constexpr float k_plane_margin = 1.0f / 512.0f;
+
+/// @brief How far inside the other tet's planes a point must lie to prove an intersection, in the
+/// same units: smaller, since it need not agree with the float tests' own axes (file comment).
+constexpr float k_plane_inside_margin = 1.0f / 2048.0f;
 
 /// @brief Faces whose two normal-building edges meet at an angle with a smaller sine are not used.
 constexpr float k_plane_min_sine = 1.0f / 64.0f;
@@ -139,15 +145,16 @@ KDET_HD inline void plane_distances(const TetPlanes& p, vec3 w, float distance[4
     for (int k = 0; k < 4; ++k) distance[k] = p.nx[k] * r.x + p.ny[k] * r.y + p.nz[k] * r.z - p.offset[k];
 }
 
-/// @brief What the four face planes of p show about the four vertices w, with a margin: whether all
-/// of w lies beyond one face plane (`separated`), and whether some vertex lies inside all four
-/// (`inside`). The four faces are evaluated side by side (vector instructions on the CPU).
+/// @brief What the four face planes of p show about the four vertices w: whether all of w lies beyond
+/// one face plane by more than `margin` (`separated`), and whether some vertex lies inside all four by
+/// more than `inside_margin` (`inside`). The four faces are evaluated side by side (vector
+/// instructions on the CPU).
 struct PlaneSides {
     bool separated;
     bool inside;
 };
 
-KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float margin) {
+KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float margin, float inside_margin) {
     float nearest[4] = {3.4e38f, 3.4e38f, 3.4e38f, 3.4e38f};
     int inside = 0;
     for (int j = 0; j < 4; ++j) {
@@ -155,7 +162,7 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
         plane_distances(p, w[j], distance);
         for (int k = 0; k < 4; ++k) nearest[k] = min_f(nearest[k], distance[k]);
         const float farthest = max_f(max_f(distance[0], distance[1]), max_f(distance[2], distance[3]));
-        inside |= farthest < -margin ? 1 : 0;
+        inside |= farthest < -inside_margin ? 1 : 0;
     }
     int separated = 0;
     for (int k = 0; k < 4; ++k) separated |= nearest[k] > margin ? 1 : 0;
@@ -215,12 +222,14 @@ KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a
                                                const vec3 b[4], bool separation_only) {
     const float longest = max_f(pa.longest, pb.longest);
     const float margin_a = pa.margin_scale * longest * longest, margin_b = pb.margin_scale * longest * longest;
-    const PlaneSides b_by_a = plane_sides(pa, b, margin_a);
+    constexpr float inside_share = k_plane_inside_margin / k_plane_margin;
+    const float inside_a = inside_share * margin_a, inside_b = inside_share * margin_b;
+    const PlaneSides b_by_a = plane_sides(pa, b, margin_a, inside_a);
     if (b_by_a.separated) return PlaneVerdict::separated;
-    const PlaneSides a_by_b = plane_sides(pb, a, margin_b);
+    const PlaneSides a_by_b = plane_sides(pb, a, margin_b, inside_b);
     if (a_by_b.separated) return PlaneVerdict::separated;
     if (separation_only) return PlaneVerdict::unsure;
-    if (b_by_a.inside || a_by_b.inside || edges_pass_inside(pa, b, margin_a) || edges_pass_inside(pb, a, margin_b))
+    if (b_by_a.inside || a_by_b.inside || edges_pass_inside(pa, b, inside_a) || edges_pass_inside(pb, a, inside_b))
         return PlaneVerdict::intersecting;
     return PlaneVerdict::unsure;
 }
