@@ -360,33 +360,45 @@ KDET_NOINLINE KDET_HD inline bool decide_exactly(const vec3 a[4], const vec3 b[4
 }
 
 /// @brief The exact test; `exact_stage` is set when the float level could not decide the pair.
-KDET_HD inline bool exact_intersect(const vec3 a[4], const vec3 b[4], bool& exact_stage) {
+/// `edges_first` runs the float level's 36 edge axes before its 8 face axes (for pairs the face-plane
+/// pre-test left undecided, which a face axis seldom separates): a separation ends the test in either
+/// order, and otherwise every axis runs, so the answer is the same.
+KDET_HD inline bool exact_intersect(const vec3 a[4], const vec3 b[4], bool& exact_stage, bool edges_first = false) {
     FilterPair f;
     std::uint64_t open = 0;
     bool solid = false;
     if (make_filter_pair(a, b, f)) {
         FilterProjections s;
-        for (int t = 0; t < 2; ++t)
-            for (int k = 0; k < 4; ++k) {
-                const vec3* edges = t ? f.edge_b : f.edge_a;
-                const float* norms = t ? f.norm_b : f.norm_a;
-                const int e0 = face_edge(k, 0), e1 = face_edge(k, 1);
-                filter_project(f, cross(edges[e0], edges[e1]), s);
-                const float bound = norms[e0] * norms[e1] * f.relative + f.absolute;
-                const AxisVerdict verdict = filter_verdict(s, bound);
-                if (verdict == AxisVerdict::separates) return false;
-                if (verdict == AxisVerdict::uncertain) open |= std::uint64_t{1} << (4 * t + k);
-                // Face 0 against vertex 0 of its own tet: six times the tet's volume.
-                const float* own = t ? s.b : s.a;
-                if (k == 0 && fabsf(own[0] - own[1]) > bound) solid = true;
-            }
-        for (int i = 0; i < 6; ++i)
-            for (int j = 0; j < 6; ++j) {
-                filter_project(f, cross(f.edge_a[i], f.edge_b[j]), s);
-                const AxisVerdict verdict = filter_verdict(s, f.norm_a[i] * f.norm_b[j] * f.relative + f.absolute);
-                if (verdict == AxisVerdict::separates) return false;
-                if (verdict == AxisVerdict::uncertain) open |= std::uint64_t{1} << (8 + 6 * i + j);
-            }
+        // Each returns true when one of its axes separates the pair, marking the undecided ones open.
+        const auto face_axes_separate = [&]() {
+            for (int t = 0; t < 2; ++t)
+                for (int k = 0; k < 4; ++k) {
+                    const vec3* edges = t ? f.edge_b : f.edge_a;
+                    const float* norms = t ? f.norm_b : f.norm_a;
+                    const int e0 = face_edge(k, 0), e1 = face_edge(k, 1);
+                    filter_project(f, cross(edges[e0], edges[e1]), s);
+                    const float bound = norms[e0] * norms[e1] * f.relative + f.absolute;
+                    const AxisVerdict verdict = filter_verdict(s, bound);
+                    if (verdict == AxisVerdict::separates) return true;
+                    if (verdict == AxisVerdict::uncertain) open |= std::uint64_t{1} << (4 * t + k);
+                    // Face 0 against vertex 0 of its own tet: six times the tet's volume.
+                    const float* own = t ? s.b : s.a;
+                    if (k == 0 && fabsf(own[0] - own[1]) > bound) solid = true;
+                }
+            return false;
+        };
+        const auto edge_axes_separate = [&]() {
+            for (int i = 0; i < 6; ++i)
+                for (int j = 0; j < 6; ++j) {
+                    filter_project(f, cross(f.edge_a[i], f.edge_b[j]), s);
+                    const AxisVerdict verdict = filter_verdict(s, f.norm_a[i] * f.norm_b[j] * f.relative + f.absolute);
+                    if (verdict == AxisVerdict::separates) return true;
+                    if (verdict == AxisVerdict::uncertain) open |= std::uint64_t{1} << (8 + 6 * i + j);
+                }
+            return false;
+        };
+        if (edges_first ? edge_axes_separate() || face_axes_separate() : face_axes_separate() || edge_axes_separate())
+            return false;
         if (open == 0 && solid) return true;
     } else {
         open = (std::uint64_t{1} << 44) - 1;

@@ -56,26 +56,34 @@ KDET_HD inline bool edge_axes_separate(const LocalPair& p, int i, MtvState& best
 /// @brief Runs the face axes (and, with edges, the 36 edge axes); true as soon as one separates.
 /// Face axes go first: they are cheaper and separate most pairs. Edge axes must beat a face axis by
 /// more than the tolerance to become the MTV axis, so near-ties keep the more stable face normal.
+/// `edges_first` (without track, for pairs the face-plane pre-test left undecided, which a face axis
+/// seldom separates) runs the edge axes first; the order changes only when a separation is found,
+/// never the answer.
 template <bool track>
-KDET_HD inline bool sat_separates(const LocalPair& p, bool edges, MtvState& best) {
+KDET_HD inline bool sat_separates(const LocalPair& p, bool edges, MtvState& best, bool edges_first = false) {
     vec3 axis;
     float length2;
+    const bool edges_now = edges && edges_first && !track;
+    if (edges_now)
+        for (int i = 0; i < 6; ++i)
+            if (edge_axes_separate<track>(p, i, best)) return true;
     for (int k = 0; k < 4; ++k)
         if (face_axis(p.a, k, axis, length2) && axis_separates<track>(p, axis, length2, 0.0f, best)) return true;
     for (int k = 0; k < 4; ++k)
         if (face_axis(p.b, k, axis, length2) && axis_separates<track>(p, axis, length2, 0.0f, best)) return true;
-    if (!edges) return false;
+    if (!edges || edges_now) return false;
     for (int i = 0; i < 6; ++i)
         if (edge_axes_separate<track>(p, i, best)) return true;
     return false;
 }
 
-/// @brief 44-axis SAT (edges true) or face normals only (edges false) on input coordinates.
-KDET_HD inline bool sat_intersect(const vec3 a[4], const vec3 b[4], bool edges) {
+/// @brief 44-axis SAT (edges true) or face normals only (edges false) on input coordinates;
+/// `edges_first` as for sat_separates.
+KDET_HD inline bool sat_intersect(const vec3 a[4], const vec3 b[4], bool edges, bool edges_first = false) {
     LocalPair p;
     if (!make_local_pair(a, b, p)) return points_coincide(a[0], b[0]);
     MtvState unused{k_huge, vec3{0.0f, 0.0f, 0.0f}};
-    return !sat_separates<false>(p, edges, unused);
+    return !sat_separates<false>(p, edges, unused, edges_first);
 }
 
 /// @brief 44-axis SAT with the minimum translation vector; see tets_intersect_sat_mtv.

@@ -25,8 +25,9 @@ namespace kdet {
 
 /// @brief Separating axis test over the 44 axes (4 + 4 face normals, 36 edge cross products).
 /// Edge pairs within sqrt(eps) of parallel are skipped (they add no usable axis).
-KDET_HD inline bool tets_intersect_sat(const vec3 a[4], const vec3 b[4]) {
-    return narrow::sat_intersect(a, b, true);
+/// `edges_first`: see narrow::sat_separates (the same answer, sooner after the face-plane pre-test).
+KDET_HD inline bool tets_intersect_sat(const vec3 a[4], const vec3 b[4], bool edges_first = false) {
+    return narrow::sat_intersect(a, b, true, edges_first);
 }
 
 /// @brief Face normals only (8 axes). Conservative: never misses an intersecting pair, but may report
@@ -64,8 +65,9 @@ KDET_HD inline bool tets_intersect_fast(const vec3 a[4], const vec3 b[4]) { retu
 /// do_intersect with exact predicates gives the same answer), zero-volume tets included. A float
 /// separating-axis test with proven error bounds decides almost every pair; the rest go to an exact
 /// stage (exact_test.hpp), and then `exact_stage` is set to true (it is never cleared). The default test.
-KDET_HD inline bool tets_intersect_exact(const vec3 a[4], const vec3 b[4], bool& exact_stage) {
-    return narrow::exact_intersect(a, b, exact_stage);
+/// `edges_first`: see narrow::exact_intersect (the same answer, sooner after the face-plane pre-test).
+KDET_HD inline bool tets_intersect_exact(const vec3 a[4], const vec3 b[4], bool& exact_stage, bool edges_first = false) {
+    return narrow::exact_intersect(a, b, exact_stage, edges_first);
 }
 KDET_HD inline bool tets_intersect_exact(const vec3 a[4], const vec3 b[4]) {
     bool exact_stage = false;
@@ -74,11 +76,12 @@ KDET_HD inline bool tets_intersect_exact(const vec3 a[4], const vec3 b[4]) {
 
 /// @brief The test `Test`, chosen at compile time, so that a kernel instantiated for one test holds
 /// only that test's code (registers and stack are those of the test in use); `exact_stage` as for
-/// tets_intersect_exact (only that test has an exact stage).
+/// tets_intersect_exact (only that test has an exact stage). `after_pretest`: the pair is one the
+/// face-plane pre-test left undecided, so the tests that can take it run their edge axes first.
 template <NarrowPhase Test>
-KDET_HD inline bool tets_intersect_as(const vec3 a[4], const vec3 b[4], bool& exact_stage) {
+KDET_HD inline bool tets_intersect_as(const vec3 a[4], const vec3 b[4], bool& exact_stage, bool after_pretest = false) {
     if constexpr (Test == NarrowPhase::exact) {
-        return tets_intersect_exact(a, b, exact_stage);
+        return tets_intersect_exact(a, b, exact_stage, after_pretest);
     } else if constexpr (Test == NarrowPhase::sat_no_edges) {
         return tets_intersect_sat_no_edges(a, b);
     } else if constexpr (Test == NarrowPhase::sat_mtv) {
@@ -91,7 +94,7 @@ KDET_HD inline bool tets_intersect_as(const vec3 a[4], const vec3 b[4], bool& ex
         return tets_intersect_fast(a, b);
     } else {
         static_assert(Test == NarrowPhase::sat, "every NarrowPhase has its test");
-        return tets_intersect_sat(a, b);
+        return tets_intersect_sat(a, b, after_pretest);
     }
 }
 

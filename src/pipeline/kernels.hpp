@@ -82,13 +82,14 @@ KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<
 
 /// @brief The narrow-phase test alone on stored tets first < second: the lower stored id goes first, so
 /// every method sees the same floating-point computation. `exact_stage` is set when the pair reached
-/// the exact stage of NarrowPhase::exact.
+/// the exact stage of NarrowPhase::exact. `after_pretest`: see tets_intersect_as.
 template <NarrowPhase Test>
-KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint32_t second, bool& exact_stage) {
+KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint32_t second, bool& exact_stage,
+                              bool after_pretest = false) {
     vec3 a[4], b[4];
     load_tet(s, first, a);
     load_tet(s, second, b);
-    return tets_intersect_as<Test>(a, b, exact_stage);
+    return tets_intersect_as<Test>(a, b, exact_stage, after_pretest);
 }
 
 /// @brief The decision for a pair whose boxes overlap and that is not adjacent (first < second): the
@@ -101,7 +102,7 @@ KDET_HD inline bool candidate_collides(const SceneView& s, std::uint32_t first, 
     load_tet(s, second, b);
     const PlaneVerdict verdict = face_plane_pretest(s.planes[first], a, s.planes[second], b, false);
     if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
-    return tets_intersect_as<Test>(a, b, exact_stage);
+    return tets_intersect_as<Test>(a, b, exact_stage, true);
 }
 
 /// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, and
@@ -690,7 +691,9 @@ struct NarrowPhaseKernel {
         const std::uint32_t a = key_first(keys[k]), b = key_second(keys[k]);
         const std::uint32_t t = a < b ? a : b, u = a < b ? b : a;
         bool reached_exact = false;
-        const bool collides = a > b || test_pair<Test>(scene, t, u, reached_exact);
+        // Edge axes first: the pre-test left this pair undecided, or brute force found it colliding
+        // (every axis runs then anyway).
+        const bool collides = a > b || test_pair<Test>(scene, t, u, reached_exact, true);
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
         if (!collides) return;
         atomic_store_relaxed(&colliding[t], 1u);

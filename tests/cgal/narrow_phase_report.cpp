@@ -74,7 +74,7 @@ double time_per_pair(NarrowPhase test, const std::vector<const Case*>& pairs) {
         return time_per_pair([](const vec3 a[4], const vec3 b[4]) { return kdet::tets_intersect_exact(a, b); }, pairs);
     case NarrowPhase::sat: break;
     }
-    return time_per_pair(kdet::tets_intersect_sat, pairs);
+    return time_per_pair([](const vec3 a[4], const vec3 b[4]) { return kdet::tets_intersect_sat(a, b); }, pairs);
 }
 
 /// @brief exact in both argument orders against CGAL, per kind, with the pairs that reached its exact
