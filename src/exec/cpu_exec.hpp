@@ -133,11 +133,18 @@ public:
         for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
     }
 
-    /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`): a stage
-    /// whose size an earlier stage counted is launched without the host reading the count.
+    /// @brief Consecutive keys per work item of a stage that appends what it finds: many, so that a
+    /// thread appends them a batch at a time (threads contend for the one counter).
+    static constexpr std::uint32_t keys_per_appending_item = 64;
+
+    /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`),
+    /// divided by `per_item` (rounded up) when each item takes that many: a stage whose size an earlier
+    /// stage counted is launched without the host reading the count.
     template <class F>
-    void for_each_counted(const unsigned long long* count, std::uint64_t capacity, const F& f) const {
-        for_each(std::min<std::uint64_t>(*count, capacity), f);
+    void for_each_counted(const unsigned long long* count, std::uint64_t capacity, const F& f,
+                          std::uint32_t per_item = 1) const {
+        const std::uint64_t n = std::min<std::uint64_t>(*count, capacity);
+        for_each(n / per_item + (n % per_item != 0), f);
     }
 
     /// @brief Sorts the first min(*count, capacity) keys ascending (the count in the backend's memory);

@@ -139,10 +139,12 @@ __global__ void for_each_kernel(std::uint64_t n, F f) {
     for (std::uint64_t i = static_cast<std::uint64_t>(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) f(i);
 }
 
-/// @brief for_each_kernel over a count that an earlier kernel left in device memory, at most `capacity`.
+/// @brief for_each_kernel over a count that an earlier kernel left in device memory, at most `capacity`,
+/// divided by `per_item` (rounded up).
 template <class F>
-__global__ void for_each_counted_kernel(const unsigned long long* count, std::uint64_t capacity, F f) {
-    const std::uint64_t n = *count < capacity ? *count : capacity;
+__global__ void for_each_counted_kernel(const unsigned long long* count, std::uint64_t capacity, std::uint32_t per_item, F f) {
+    const std::uint64_t keys = *count < capacity ? *count : capacity;
+    const std::uint64_t n = keys / per_item + (keys % per_item != 0);
     const std::uint64_t stride = static_cast<std::uint64_t>(gridDim.x) * blockDim.x;
     for (std::uint64_t i = static_cast<std::uint64_t>(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) f(i);
 }
@@ -163,6 +165,9 @@ public:
     using buffer = DeviceBuffer<T>;
     using stage_clock = CudaStageClock;
 
+    /// @brief Consecutive keys per work item of a stage that appends what it finds: one, a thread each.
+    static constexpr std::uint32_t keys_per_appending_item = 1;
+
     explicit CudaExec(const DetectorOptions& options)
         : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
         int devices = 0;
@@ -180,15 +185,17 @@ public:
         cuda_check(cudaGetLastError(), "kernel launch");
     }
 
-    /// @brief Runs f(i) for every i below the count in device memory (at most `capacity`): a stage whose
-    /// size an earlier stage counted is launched without the host reading the count. The grid covers
-    /// at most counted_blocks blocks; their threads stride over the rest.
+    /// @brief Runs f(i) for every i below the count in device memory (at most `capacity`), divided by
+    /// `per_item` (rounded up) when each item takes that many: a stage whose size an earlier stage
+    /// counted is launched without the host reading the count. The grid covers at most counted_blocks
+    /// blocks; their threads stride over the rest.
     template <class F>
-    void for_each_counted(const unsigned long long* count, std::uint64_t capacity, const F& f) const {
+    void for_each_counted(const unsigned long long* count, std::uint64_t capacity, const F& f,
+                          std::uint32_t per_item = 1) const {
         if (capacity == 0) return;
         const int block = launchable_block_size(for_each_counted_kernel<F>);
-        const unsigned blocks = std::min(blocks_for(capacity, block), counted_blocks);
-        for_each_counted_kernel<<<blocks, block, 0, stream_>>>(count, capacity, f);
+        const unsigned blocks = std::min(blocks_for(capacity / per_item + 1, block), counted_blocks);
+        for_each_counted_kernel<<<blocks, block, 0, stream_>>>(count, capacity, per_item, f);
         cuda_check(cudaGetLastError(), "kernel launch");
     }
 

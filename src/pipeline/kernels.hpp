@@ -676,18 +676,23 @@ struct BruteForcePairsKernel {
 /// appends each colliding pair under the caller's tet ids (lower id first; sorted afterwards, so
 /// the order of appends does not matter). A proven_pair_key collides (the candidate search's pre-test
 /// proved it); every other pair, which the pre-test left undecided or never saw (brute force), gets
-/// the test.
-template <NarrowPhase Test>
+/// the test. Work item i decides keys [i KeysPerItem, (i + 1) KeysPerItem) of the first
+/// min(*key_count, key_capacity): with more than one, its pairs are appended a batch at a time (one
+/// atomic per batch where every pair would take one, all on the same counter).
+template <NarrowPhase Test, std::uint32_t KeysPerItem>
 struct NarrowPhaseKernel {
     SceneView scene;
     const std::uint64_t* keys;
+    const unsigned long long* key_count;
+    std::uint64_t key_capacity;
     std::uint32_t* colliding;
     const std::uint32_t* user_id; ///< [tets] stored id -> caller's global id
     KeyAppender out;
     unsigned long long* exact_stage_pairs;
 
-    KDET_HD void operator()(std::uint64_t k) const {
-        if (keys[k] == no_pair_key) return;
+    /// @brief Decides key k; true, with the pair under the caller's ids, when it collides.
+    KDET_HD bool decide(std::uint64_t k, std::uint64_t& pair) const {
+        if (keys[k] == no_pair_key) return false;
         const std::uint32_t a = key_first(keys[k]), b = key_second(keys[k]);
         const std::uint32_t t = a < b ? a : b, u = a < b ? b : a;
         bool reached_exact = false;
@@ -695,10 +700,26 @@ struct NarrowPhaseKernel {
         // (every axis runs then anyway).
         const bool collides = a > b || test_pair<Test>(scene, t, u, reached_exact, true);
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
-        if (!collides) return;
+        if (!collides) return false;
         atomic_store_relaxed(&colliding[t], 1u);
         atomic_store_relaxed(&colliding[u], 1u);
-        out.push(pair_key(user_id[t], user_id[u]));
+        pair = pair_key(user_id[t], user_id[u]);
+        return true;
+    }
+
+    KDET_HD void operator()(std::uint64_t item) const {
+        std::uint64_t pair = 0;
+        if constexpr (KeysPerItem == 1) {
+            if (decide(item, pair)) out.push(pair);
+        } else {
+            const std::uint64_t count = *key_count < key_capacity ? *key_count : key_capacity;
+            const std::uint64_t begin = item * KeysPerItem;
+            const std::uint64_t end = count - begin < KeysPerItem ? count : begin + KeysPerItem;
+            KeyBatch batch(&out);
+            for (std::uint64_t k = begin; k < end; ++k)
+                if (decide(k, pair)) batch.push(pair);
+            batch.flush();
+        }
     }
 };
 

@@ -429,10 +429,12 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     out_keys_.resize_discard(pairs_window_);
     const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
     with_narrow_phase(options_.narrow_phase, [&](auto test) {
+        constexpr std::uint32_t per_item = Exec::keys_per_appending_item;
         exec_.for_each_counted(&c->candidates, candidates_.size(),
-                               NarrowPhaseKernel<decltype(test)::value>{scene_view(), candidates_.data(),
-                                                             colliding_.data(), user_id_.data(), out,
-                                                             &c->exact_stage_pairs});
+                               NarrowPhaseKernel<decltype(test)::value, per_item>{
+                                   scene_view(), candidates_.data(), &c->candidates, candidates_.size(),
+                                   colliding_.data(), user_id_.data(), out, &c->exact_stage_pairs},
+                               per_item);
     });
     clock_.mark(narrow_phase_done);
     // The keys hold the caller's ids, which are below the tet count.
