@@ -38,7 +38,7 @@ for line in run.stderr.splitlines():
     m = re.search(r"Compiling entry function '(\S+)'", line)
     if m:
         plain = subprocess.run(["c++filt", m.group(1)], capture_output=True, text=True).stdout.strip()
-        k = re.search(r"for_each(?:_counted)?_kernel<kdet::(\w+)(?:<\(kdet::NarrowPhase\)(\d+)>)?", plain)
+        k = re.search(r"for_each(?:_counted)?_kernel<kdet::(\w+)(?:<\(kdet::NarrowPhase\)(\d+)(?:, \w+)?>)?", plain)
         tests = ["sat", "sat_no_edges", "sat_mtv", "gjk", "fast", "exact"]  # kdet::NarrowPhase's order
         # CUB's own kernels are left out; a kernel per narrow-phase test is named with its test.
         name = (k.group(1) + (f"<{tests[int(k.group(2))]}>" if k.group(2) else "")) if k else None
