@@ -17,20 +17,6 @@
 
 #include "geometry/vec3.hpp"
 
-/// @brief Keeps a rarely taken function out of its callers (KDET_NOINLINE), with its loops rolled on
-/// the GPU (KDET_NO_UNROLL): a kernel holds as many registers per thread as the hungriest function it
-/// calls, so the exact stage must need no more than the float filter (see docs/narrow-phase.md).
-#if defined(__CUDACC__)
-#define KDET_NOINLINE __noinline__
-#else
-#define KDET_NOINLINE __attribute__((noinline))
-#endif
-#if defined(__CUDA_ARCH__)
-#define KDET_NO_UNROLL _Pragma("unroll 1")
-#else
-#define KDET_NO_UNROLL
-#endif
-
 namespace kdet::exact {
 
 /// @brief A float as sign, integer significand and exponent: value = (negative ? -1 : 1) * m * 2^e.

@@ -183,13 +183,16 @@ KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float
     if (!p.solid) return false;
     float distance[4][4];
     for (int j = 0; j < 4; ++j) plane_distances(p, w[j], distance[j]);
-    // Edge e and face k at [4 e + k], in flat arrays so that each step runs on all 24 at once.
+    // Edge e and face k at [4 e + k], in flat arrays so that each step runs on all 24 at once (vector
+    // instructions on the CPU; rolled loops on the GPU, where 24 of each would be live in registers).
     float from[24], slope[24], enter[24], leave[24], at_s[24], s[6];
+    KDET_NO_UNROLL
     for (int e = 0; e < 6; ++e)
         for (int k = 0; k < 4; ++k) {
             from[4 * e + k] = distance[narrow::edge_first(e)][k];
             slope[4 * e + k] = distance[narrow::edge_second(e)][k] - distance[narrow::edge_first(e)][k];
         }
+    KDET_NO_UNROLL
     for (int i = 0; i < 24; ++i) {
         const float inverse_slope = 1.0f / slope[i];
         const float at_margin = -(from[i] + margin) * inverse_slope;
@@ -197,6 +200,7 @@ KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float
         enter[i] = min_f(at_margin, at_far);
         leave[i] = max_f(at_margin, at_far);
     }
+    KDET_NO_UNROLL
     for (int e = 0; e < 6; ++e) {
         const float* en = enter + 4 * e;
         const float* le = leave + 4 * e;
@@ -204,8 +208,10 @@ KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float
         const float last = min_f(min_f(min_f(le[0], le[1]), min_f(le[2], le[3])), 1.0f);
         s[e] = min_f(max_f(0.5f * (first + last), 0.0f), 1.0f);
     }
+    KDET_NO_UNROLL
     for (int i = 0; i < 24; ++i) at_s[i] = from[i] + s[i / 4] * slope[i];
     int found = 0;
+    KDET_NO_UNROLL
     for (int e = 0; e < 6; ++e) {
         const float* d = at_s + 4 * e;
         found |= max_f(max_f(d[0], d[1]), max_f(d[2], d[3])) < -margin ? 1 : 0;

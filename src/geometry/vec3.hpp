@@ -6,6 +6,20 @@
 
 #include <cmath>
 
+/// @brief Keeps a rarely taken function out of its callers (KDET_NOINLINE), with its loops rolled on
+/// the GPU (KDET_NO_UNROLL): a kernel holds as many registers per thread as the hungriest function it
+/// calls, so a rarely taken or wide step must need no more than the rest (see docs/narrow-phase.md).
+#if defined(__CUDACC__)
+#define KDET_NOINLINE __noinline__
+#else
+#define KDET_NOINLINE __attribute__((noinline))
+#endif
+#if defined(__CUDA_ARCH__)
+#define KDET_NO_UNROLL _Pragma("unroll 1")
+#else
+#define KDET_NO_UNROLL
+#endif
+
 namespace kdet {
 
 struct vec3 {
