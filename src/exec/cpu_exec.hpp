@@ -133,9 +133,11 @@ public:
         for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
     }
 
-    /// @brief Consecutive keys per work item of a stage that appends what it finds: many, so that a
-    /// thread appends them a batch at a time (threads contend for the one counter).
-    static constexpr std::uint32_t keys_per_appending_item = 64;
+    /// @brief Consecutive keys per work item of a stage that appends what it finds: a batch's worth, so
+    /// that a thread appends them with one atomic (threads contend for the one counter). More would
+    /// leave small stages too few items to share (64 ran a resolution-4 scene's narrow phase on one
+    /// thread: for_each below runs 512 items or fewer serially).
+    static constexpr std::uint32_t keys_per_appending_item = 16;
 
     /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`),
     /// divided by `per_item` (rounded up) when each item takes that many: a stage whose size an earlier
