@@ -30,7 +30,7 @@
 /// (4.9e-4), of a tet whose opposite vertices lie below their faces by the face margin (`solid`) lies
 /// inside the true tet by more than 3e-4 L^2 / l (the first two bounds add up to 1.8e-4 L^2 / l at
 /// most), so the tets overlap by that much along every axis; the point is a vertex, or a point of an
-/// edge whose distances are interpolated from those of its ends (under 30u L more rounding). Both
+/// edge whose distances are interpolated from those of its ends (under 40u L more rounding). Both
 /// decisions are therefore true for the exact float input (the `exact` test agrees) and lie far
 /// inside the clear band (beyond 1e-5 L) where gjk and fast agree with CGAL
 /// (tests/cgal/test_narrow_phase_cgal.cpp), and no test misses an intersecting pair.
