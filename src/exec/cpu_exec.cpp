@@ -4,7 +4,7 @@
 
 #include <algorithm>
 #include <fstream>
-#include <parallel/algorithm>
+#include <utility>
 #include <vector>
 
 namespace kdet {
@@ -12,12 +12,31 @@ namespace kdet {
 CpuExec::CpuExec(const DetectorOptions& options)
     : threads_(options.threads > 0 ? options.threads : omp_get_max_threads()) {}
 
-void CpuExec::sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int) const {
+void CpuExec::sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
     const std::size_t n = std::min<std::size_t>(capacity, *count);
-    if (n > 1 << 14 && threads_ > 1)
-        __gnu_parallel::sort(keys, keys + n, __gnu_parallel::multiway_mergesort_tag(static_cast<__gnu_parallel::_ThreadIndex>(threads_)));
-    else
+    if (n <= 1 << 14) {
         std::sort(keys, keys + n);
+        return;
+    }
+    // Least significant digit first, 11 bits a pass, only over the bits the keys use, skipping digits
+    // that every key shares (a pair key of a 100k-tet mesh: 4 passes where a comparison sort makes
+    // log2(n) of them).
+    constexpr int digit_bits = 11;
+    constexpr std::size_t digits = std::size_t{1} << digit_bits;
+    std::vector<std::uint64_t> scratch(n);
+    std::vector<std::size_t> start(digits);
+    std::uint64_t* from = keys;
+    std::uint64_t* to = scratch.data();
+    for (int shift = 0; shift < bits; shift += digit_bits) {
+        std::fill(start.begin(), start.end(), std::size_t{0});
+        for (std::size_t i = 0; i < n; ++i) ++start[(from[i] >> shift) & (digits - 1)];
+        if (std::find(start.begin(), start.end(), n) != start.end()) continue; // one digit: nothing moves
+        std::size_t sum = 0;
+        for (std::size_t& s : start) sum += std::exchange(s, sum);
+        for (std::size_t i = 0; i < n; ++i) to[start[(from[i] >> shift) & (digits - 1)]++] = from[i];
+        std::swap(from, to);
+    }
+    if (from != keys) std::copy(from, from + n, keys);
 }
 
 void CpuExec::sum(const std::uint32_t* in, std::size_t n, unsigned long long* total) const {
