@@ -23,10 +23,10 @@ void CpuExec::sort(std::uint64_t* keys, std::size_t capacity, const unsigned lon
     // log2(n) of them).
     constexpr int digit_bits = 11;
     constexpr std::size_t digits = std::size_t{1} << digit_bits;
-    std::vector<std::uint64_t> scratch(n);
+    if (sort_scratch_.size() < n) sort_scratch_.resize_discard(n);
     std::vector<std::size_t> start(digits);
     std::uint64_t* from = keys;
-    std::uint64_t* to = scratch.data();
+    std::uint64_t* to = sort_scratch_.data();
     for (int shift = 0; shift < bits; shift += digit_bits) {
         std::fill(start.begin(), start.end(), std::size_t{0});
         for (std::size_t i = 0; i < n; ++i) ++start[(from[i] >> shift) & (digits - 1)];

@@ -226,8 +226,8 @@ public:
     /// finish_downloads().
     std::uint64_t host_waits() const { return host_waits_; }
 
-    /// @brief Bytes of scratch memory the layer keeps (none on the CPU).
-    std::size_t scratch_bytes() const { return 0; }
+    /// @brief Bytes of scratch memory the layer keeps (the sort's second buffer of keys).
+    std::size_t scratch_bytes() const { return sort_scratch_.capacity_bytes(); }
 
     int threads() const { return threads_; }
     std::string device_name() const;
@@ -241,6 +241,8 @@ private:
     int threads_;
     mutable std::uint64_t host_waits_ = 0;
     mutable std::vector<PendingDownload> pending_;
+    /// The radix sort's other buffer, kept between frames so that a frame allocates nothing.
+    mutable HostBuffer<std::uint64_t> sort_scratch_;
 };
 
 } // namespace kdet

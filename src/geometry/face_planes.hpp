@@ -181,6 +181,8 @@ constexpr float k_plane_far = 3.0e38f;
 /// the edge whatever the rounding, is then checked as a vertex is, from the interpolated distances.
 KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float margin) {
     if (!p.solid) return false;
+    // plane_sides computed these distances too; they are computed again so that plane_sides, which
+    // every candidate runs, keeps nothing for the few pairs that get this far.
     float distance[4][4];
     for (int j = 0; j < 4; ++j) plane_distances(p, w[j], distance[j]);
     // Edge e and face k at [4 e + k], in flat arrays so that each step runs on all 24 at once (vector

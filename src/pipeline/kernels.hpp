@@ -440,7 +440,8 @@ struct KeyAppender {
     std::uint64_t capacity;
     unsigned long long* count;
     /// Slots filled with no_pair_key by a batch that straddled the capacity; null where every batch
-    /// is a single key, which fits or not.
+    /// is a single key, which fits or not, or where a buffer that overflows is never read (the
+    /// narrow phase's pairs: the frame runs again).
     unsigned long long* padding;
     KDET_HD bool push(std::uint64_t key) const { return write(&key, 1); }
     KDET_HD bool write(const std::uint64_t* batch, std::uint32_t n) const {
