@@ -92,7 +92,9 @@ TEST(FacePlanesCgal, NearItsMarginItDecidesOnlyWhatEveryTestDecides) {
                 check.separated, check.intersecting);
     EXPECT_EQ(check.wrong, 0);
     EXPECT_GT(check.separated, check.pairs / 8);
-    EXPECT_GT(check.intersecting, check.pairs / 20);
+    // A point inside by the inside margin (a quarter of the face margin) proves 22 % of them
+    // intersecting; with the face margin it proved 15 %.
+    EXPECT_GT(check.intersecting, check.pairs / 5);
 }
 
 /// A pair whose only contact is an edge of one tet passing through the other (no vertex of either lies
