@@ -139,7 +139,7 @@ const Aabb everywhere{{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, IN
 struct EveryEntry {
     std::multiset<std::uint32_t> found;
     void operator()(const GridEntry& e) {
-        EXPECT_EQ(e.object, e.id);
+        EXPECT_EQ(e.object(), e.id);
         found.insert(e.id);
     }
 };
@@ -166,7 +166,7 @@ struct TestTable {
         GridView view;
     };
     Compacted compacted(std::size_t room) const {
-        return compacted(room, [](std::uint32_t id) { return GridEntry{Aabb{}, id, id}; });
+        return compacted(room, [](std::uint32_t id, CellCoord) { return GridEntry{Aabb{}, id, id}; });
     }
     template <class EntryOf>
     Compacted compacted(std::size_t room, const EntryOf& entry_of) const {
@@ -332,7 +332,7 @@ TEST(BucketTable, QueriesSkipTheBlocksOfEntriesWhoseBoundMissesTheirBox) {
     const CellCoord row{1, 1, 1, 0}, other{9, 9, 9, 0};
     for (std::uint32_t i = 0; i < 60; ++i) ASSERT_TRUE(grid_insert(table.view, row, i));
     for (std::uint32_t i = 100; i < 105; ++i) ASSERT_TRUE(grid_insert(table.view, other, i));
-    const auto c = table.compacted(65, [](std::uint32_t id) {
+    const auto c = table.compacted(65, [](std::uint32_t id, CellCoord) {
         const float x = static_cast<float>(id);
         return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
     });
@@ -374,6 +374,35 @@ TEST(CellKey, DistinguishesLayersAndCoordinates) {
                 for (std::uint32_t z = 0; z < 4; ++z) keys.insert(cell_key(make_cell(x, y, z, layer)));
     EXPECT_EQ(keys.size(), 3u * 64u);
     EXPECT_EQ(keys.count(0), 0u);
+}
+
+TEST(CellKey, GivesBackItsCell) {
+    const std::uint32_t top = (1u << cell_coordinate_bits) - 1u;
+    for (const CellCoord c : {make_cell(0, 0, 0, 0), make_cell(top, 1, top, max_grid_layers - 1), make_cell(5, top, 7, 3)}) {
+        const CellCoord back = cell_of_key(cell_key(c));
+        EXPECT_EQ(back.x, c.x);
+        EXPECT_EQ(back.y, c.y);
+        EXPECT_EQ(back.z, c.z);
+        EXPECT_EQ(back.layer, c.layer);
+    }
+}
+
+TEST(GridEntry, SaysAlongWhichAxesTheBoxStartsInItsCell) {
+    const GridParams g{{0, 0, 0}, 1.0f, 1.0f, 4};
+    const Aabb box{{2.5f, 3.0f, 0.9f}, {3.2f, 3.5f, 1.4f}}; // cells x 2-3, y 3, z 0-1 on layer 0
+    EXPECT_EQ(grid_entry(g, make_cell(2, 3, 0, 0), box, 7, 5).starts(), 7u);
+    EXPECT_EQ(grid_entry(g, make_cell(3, 3, 0, 0), box, 7, 5).starts(), 6u);
+    EXPECT_EQ(grid_entry(g, make_cell(2, 3, 1, 0), box, 7, 5).starts(), 3u);
+    EXPECT_EQ(grid_entry(g, make_cell(3, 3, 1, 0), box, 7, 5).starts(), 2u);
+    EXPECT_EQ(grid_entry(g, make_cell(1, 1, 0, 1), box, 7, 5).starts(), 7u); // layer 1: cells of size 2
+    const GridEntry e = grid_entry(g, make_cell(3, 3, 1, 0), box, 7, (1u << grid_entry_object_bits) - 1u);
+    EXPECT_EQ(e.id, 7u);
+    EXPECT_EQ(e.object(), (1u << grid_entry_object_bits) - 1u);
+    // Coordinates beyond the wrap compare as the cell's wrapped ones.
+    const float far = static_cast<float>(1u << cell_coordinate_bits);
+    const Aabb wrapped{{far + 2.5f, 3.0f, 0.5f}, {far + 3.5f, 3.5f, 0.7f}};
+    EXPECT_EQ(grid_entry(g, make_cell(2, 3, 0, 0), wrapped, 7, 5).starts(), 7u);
+    EXPECT_EQ(grid_entry(g, make_cell(3, 3, 0, 0), wrapped, 7, 5).starts(), 6u);
 }
 
 } // namespace

@@ -1,3 +1,4 @@
+#include "grid/bucket_table.hpp"
 #include "pipeline/pipeline_base.hpp"
 #include "pipeline/spatial_order.hpp"
 
@@ -109,6 +110,8 @@ struct Detector::Impl {
         const std::uint64_t total_vertices = std::uint64_t{object_vertex_begin.back()} + vertex_count;
         if (total_tets >= 0xffffffffull || total_vertices >= 0xffffffffull)
             throw Error("too many tetrahedra or vertices for 32-bit ids");
+        if (objects() >= (std::size_t{1} << grid_entry_object_bits))
+            throw Error("too many objects (at most " + std::to_string(std::size_t{1} << grid_entry_object_bits) + ")");
         const ObjectId id = static_cast<ObjectId>(objects());
         for (std::size_t t = 0; t < tet_count; ++t)
             for (int k = 0; k < 4; ++k)

@@ -339,18 +339,23 @@ struct PopulateKernel {
 };
 
 /// @brief Stage 2, after populating: one work item per main slot of the table; copies each occupied
-/// cell's ids, with their boxes and objects, into one contiguous list (compact_cell).
+/// cell's ids, with their boxes, objects and where their boxes start, into one contiguous list
+/// (compact_cell).
 struct CompactCellsKernel {
     SceneView scene;
     GridView grid;
+    const GridParams* params; ///< GridParamsKernel's
 
     struct EntryOf {
         const SceneView* scene;
-        KDET_HD GridEntry operator()(std::uint32_t u) const { return GridEntry{scene->info[u].box, u, scene->tet_object[u]}; }
+        GridParams params;
+        KDET_HD GridEntry operator()(std::uint32_t u, CellCoord cell) const {
+            return grid_entry(params, cell, scene->info[u].box, u, scene->tet_object[u]);
+        }
     };
 
     KDET_HD void operator()(std::uint64_t slot) const {
-        compact_cell(grid, static_cast<std::uint32_t>(slot), EntryOf{&scene});
+        compact_cell(grid, static_cast<std::uint32_t>(slot), EntryOf{&scene, *params});
     }
 };
 
@@ -372,31 +377,23 @@ struct BoundEntryBlocksKernel {
 /// A pair shares every cell that both boxes overlap; it is reported from one of them only, the cell
 /// holding the lower corner of the boxes' intersection. That corner is max(t.lo, u.lo) per axis, and
 /// cell indices are monotone, so its cell is max(t's first cell, u's first cell): inside both ranges,
-/// hence always visited. No duplicates are written, so the candidate buffer holds unique pairs.
+/// hence always visited. No duplicates are written, so the candidate buffer holds unique pairs. Along
+/// an axis where the cell is not t's first, it must be u's: the entry says so (GridEntry::starts).
 template <class Visitor>
 struct LargerNeighbourFilter {
     /// t's object's row of the active pairs: one load per entry, where pair_is_active would reload
     /// the scene's fields for each (the visitor's stores keep the compiler from hoisting them).
     const std::uint8_t* checked_against;
-    const GridParams* params;
     Aabb box;
     Visitor* visit;
-    int layer;                 ///< layer being visited
-    std::uint32_t first[3];    ///< t's first cell per axis on this layer
-    std::uint32_t cell[3];     ///< cell being visited (not wrapped)
-
-    KDET_HD bool reports_from_this_cell(const Aabb& other) const {
-        for (int a = 0; a < 3; ++a)
-            if (cell[a] != first[a] &&
-                cell_index(*params, component(other.lo, a), component(params->origin, a), layer) != cell[a])
-                return false;
-        return true;
-    }
+    /// Bit a set when the cell being visited is not t's first along axis a: there the pair is
+    /// reported only if u's box starts in the cell.
+    std::uint32_t required_starts;
 
     KDET_HD void operator()(const GridEntry& e) const {
-        if (!checked_against[e.object]) return;
-        if (!boxes_overlap(box, e.box)) return;
-        if (reports_from_this_cell(e.box)) (*visit)(e);
+        if ((e.starts() & required_starts) != required_starts) return;
+        if (!checked_against[e.object()]) return;
+        if (boxes_overlap(box, e.box)) (*visit)(e);
     }
 };
 
@@ -407,21 +404,17 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     if (self.layer < 0) return;
     const std::uint32_t object = scene.tet_object[t];
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
-    LargerNeighbourFilter<Visitor> filter{checked_against, &params, self.box, &visit, 0, {}, {}};
+    LargerNeighbourFilter<Visitor> filter{checked_against, self.box, &visit, 0};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
-        filter.layer = layer;
         // A cell holds only tets of its own layer: on t's, the larger tets are the higher ids, and the
         // sorted list skips the others unread; on a higher layer every tet is larger.
         const std::uint32_t first_id = layer == self.layer ? t + 1 : 0u;
         const CellRange r = cell_range(params, self.box, layer);
-        for (int a = 0; a < 3; ++a) filter.first[a] = r.lo[a];
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    filter.cell[0] = x;
-                    filter.cell[1] = y;
-                    filter.cell[2] = z;
+                    filter.required_starts = (x != r.lo[0] ? 1u : 0u) | (y != r.lo[1] ? 2u : 0u) | (z != r.lo[2] ? 4u : 0u);
                     grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, self.box, filter);
                     if (visit.finished()) return;
                 }
@@ -532,7 +525,7 @@ struct FindCandidatesKernel {
         KDET_HD void operator()(const GridEntry& e) {
             const std::uint32_t u = e.id;
             const TetIndices other = scene->tets[u];
-            if (e.object == object && share_vertex(tet, other)) return;
+            if (e.object() == object && share_vertex(tet, other)) return;
             vec3 w[4];
             for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
             const PlaneVerdict verdict = face_plane_pretest(planes, vertices, scene->planes[u], w, false);
