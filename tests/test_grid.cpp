@@ -139,8 +139,8 @@ const Aabb everywhere{{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, IN
 struct EveryEntry {
     std::multiset<std::uint32_t> found;
     void operator()(const GridEntry& e) {
-        EXPECT_EQ(e.object(), e.id);
-        found.insert(e.id);
+        EXPECT_EQ(e.object, e.id());
+        found.insert(e.id());
     }
 };
 
@@ -166,7 +166,7 @@ struct TestTable {
         GridView view;
     };
     Compacted compacted(std::size_t room) const {
-        return compacted(room, [](std::uint32_t id, CellCoord) { return GridEntry{Aabb{}, id, id}; });
+        return compacted(room, [](std::uint32_t id) { return GridEntry{Aabb{}, id, id}; });
     }
     template <class EntryOf>
     Compacted compacted(std::size_t room, const EntryOf& entry_of) const {
@@ -256,7 +256,7 @@ TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
     const CpuExec exec(two_threads);
     const std::uint32_t ids = 5000, cells = 7;
     exec.for_each(ids, [&](std::uint64_t i) {
-        grid_insert(table.view, CellCoord{static_cast<std::uint32_t>(i % cells), 1, 2, 0}, static_cast<std::uint32_t>(i));
+        grid_insert(table.view, CellCoord{static_cast<std::uint32_t>(i % cells), 1, 2, 0}, static_cast<std::uint32_t>(i), 0u);
     });
     ASSERT_EQ(table.failure, 0u);
     EXPECT_EQ(table.claimed, cells);
@@ -271,27 +271,27 @@ TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
 
 TEST(BucketTable, ReportsAFullTableAndAnExhaustedPool) {
     TestTable full(4, 8, 16, 4, HashFunction::djb2);
-    for (std::uint32_t c = 0; c < 16; ++c) grid_insert(full.view, CellCoord{c, 0, 0, 0}, c);
+    for (std::uint32_t c = 0; c < 16; ++c) grid_insert(full.view, CellCoord{c, 0, 0, 0}, c, 0u);
     EXPECT_TRUE(full.failure & grid_table_full);
 
     TestTable pool(16, 2, 1, 8, HashFunction::djb2);
-    for (std::uint32_t i = 0; i < 10; ++i) grid_insert(pool.view, CellCoord{3, 3, 3, 0}, i);
+    for (std::uint32_t i = 0; i < 10; ++i) grid_insert(pool.view, CellCoord{3, 3, 3, 0}, i, 0u);
     EXPECT_TRUE(pool.failure & grid_overflow_pool_full);
 }
 
 TEST(BucketTable, ANewStampEmptiesTheTableWithoutClearing) {
     TestTable table(32, 4, 8, 8, HashFunction::morton);
-    grid_insert(table.view, CellCoord{1, 2, 3, 0}, 42);
+    grid_insert(table.view, CellCoord{1, 2, 3, 0}, 42, 0u);
     EXPECT_EQ(table.contents(CellCoord{1, 2, 3, 0}).count(42), 1u);
     table.next_frame();
     EXPECT_TRUE(table.contents(CellCoord{1, 2, 3, 0}).empty());
-    grid_insert(table.view, CellCoord{1, 2, 3, 0}, 7);
+    grid_insert(table.view, CellCoord{1, 2, 3, 0}, 7, 0u);
     EXPECT_EQ(table.contents(CellCoord{1, 2, 3, 0}), std::multiset<std::uint32_t>{7});
 }
 
 TEST(BucketTable, CompactionThatDoesNotFitSaysSoAndLeavesEmptyCells) {
     TestTable table(64, 4, 64, 32, HashFunction::djb2);
-    for (std::uint32_t i = 0; i < 30; ++i) grid_insert(table.view, CellCoord{i % 3, 0, 0, 0}, i);
+    for (std::uint32_t i = 0; i < 30; ++i) grid_insert(table.view, CellCoord{i % 3, 0, 0, 0}, i, 0u);
     const auto exact = table.compacted(30);
     EXPECT_EQ(exact.failure, 0u);
     EXPECT_EQ(exact.used, 30u);
@@ -310,12 +310,12 @@ TEST(BucketTable, CompactedCellsListTheirIdsInOrderAndSkipTheSmallerOnes) {
     for (std::uint32_t i = 0; i < ids.size(); ++i) ids[i] = 3 * i + 1;
     std::shuffle(ids.begin(), ids.end(), std::mt19937(11));
     const CellCoord cell{2, 0, 5, 1};
-    for (std::uint32_t id : ids) ASSERT_TRUE(grid_insert(table.view, cell, id));
+    for (std::uint32_t id : ids) ASSERT_TRUE(grid_insert(table.view, cell, id, 0u));
     const auto c = table.compacted(ids.size());
     ASSERT_EQ(c.failure, 0u);
     struct InOrder {
         std::vector<std::uint32_t> seen;
-        void operator()(const GridEntry& e) { seen.push_back(e.id); }
+        void operator()(const GridEntry& e) { seen.push_back(e.id()); }
     };
     std::sort(ids.begin(), ids.end());
     for (std::uint32_t first_id : {0u, 1u, 2u, 50u, 52u, 109u, 110u, 1000u}) {
@@ -330,16 +330,16 @@ TEST(BucketTable, QueriesSkipTheBlocksOfEntriesWhoseBoundMissesTheirBox) {
     // Two cells whose lists interleave in memory with blocks; entry i's box spans x in [i, i + 0.5].
     TestTable table(64, 4, 64, 32, HashFunction::djb2);
     const CellCoord row{1, 1, 1, 0}, other{9, 9, 9, 0};
-    for (std::uint32_t i = 0; i < 60; ++i) ASSERT_TRUE(grid_insert(table.view, row, i));
-    for (std::uint32_t i = 100; i < 105; ++i) ASSERT_TRUE(grid_insert(table.view, other, i));
-    const auto c = table.compacted(65, [](std::uint32_t id, CellCoord) {
+    for (std::uint32_t i = 0; i < 60; ++i) ASSERT_TRUE(grid_insert(table.view, row, i, 0u));
+    for (std::uint32_t i = 100; i < 105; ++i) ASSERT_TRUE(grid_insert(table.view, other, i, 0u));
+    const auto c = table.compacted(65, [](std::uint32_t id) {
         const float x = static_cast<float>(id);
         return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
     });
     ASSERT_EQ(c.failure, 0u);
     struct Seen {
         std::set<std::uint32_t> ids;
-        void operator()(const GridEntry& e) { ids.insert(e.id); }
+        void operator()(const GridEntry& e) { ids.insert(e.id()); }
     };
     for (std::uint32_t first_id : {0u, 11u, 30u}) {
         const Aabb query{{10.2f, 0.5f, 0.5f}, {21.7f, 0.6f, 0.6f}};
@@ -354,6 +354,29 @@ TEST(BucketTable, QueriesSkipTheBlocksOfEntriesWhoseBoundMissesTheirBox) {
     Seen everything;
     grid_for_each_in_cell(c.view, row, 0u, everywhere, everything);
     EXPECT_EQ(everything.ids.size(), 60u);
+}
+
+TEST(BucketTable, CompactedEntriesKeepTheirStartBitsAndSortByIdAlone) {
+    TestTable table(64, 4, 64, 32, HashFunction::djb2);
+    const CellCoord cell{4, 5, 6, 2};
+    std::vector<std::uint32_t> ids(40);
+    for (std::uint32_t i = 0; i < ids.size(); ++i) ids[i] = grid_id_mask - 2 * i; // the largest ids there are
+    std::shuffle(ids.begin(), ids.end(), std::mt19937(3));
+    for (std::uint32_t id : ids) ASSERT_TRUE(grid_insert(table.view, cell, id, id % 8u));
+    const auto c = table.compacted(ids.size());
+    ASSERT_EQ(c.failure, 0u);
+    struct InOrder {
+        std::vector<std::uint32_t> seen;
+        void operator()(const GridEntry& e) {
+            EXPECT_EQ(e.starts(), e.id() % 8u) << e.id();
+            EXPECT_EQ(e.object, e.id());
+            seen.push_back(e.id());
+        }
+    };
+    InOrder visit;
+    grid_for_each_in_cell(c.view, cell, grid_id_mask - 20, everywhere, visit);
+    std::sort(ids.begin(), ids.end());
+    EXPECT_EQ(visit.seen, std::vector<std::uint32_t>(std::lower_bound(ids.begin(), ids.end(), grid_id_mask - 20), ids.end()));
 }
 
 TEST(BucketCapacity, AutomaticIsFourTimesTheMeanIdsPerCellRoundedUpToAPowerOfTwoFrom4To32) {
@@ -374,35 +397,6 @@ TEST(CellKey, DistinguishesLayersAndCoordinates) {
                 for (std::uint32_t z = 0; z < 4; ++z) keys.insert(cell_key(make_cell(x, y, z, layer)));
     EXPECT_EQ(keys.size(), 3u * 64u);
     EXPECT_EQ(keys.count(0), 0u);
-}
-
-TEST(CellKey, GivesBackItsCell) {
-    const std::uint32_t top = (1u << cell_coordinate_bits) - 1u;
-    for (const CellCoord c : {make_cell(0, 0, 0, 0), make_cell(top, 1, top, max_grid_layers - 1), make_cell(5, top, 7, 3)}) {
-        const CellCoord back = cell_of_key(cell_key(c));
-        EXPECT_EQ(back.x, c.x);
-        EXPECT_EQ(back.y, c.y);
-        EXPECT_EQ(back.z, c.z);
-        EXPECT_EQ(back.layer, c.layer);
-    }
-}
-
-TEST(GridEntry, SaysAlongWhichAxesTheBoxStartsInItsCell) {
-    const GridParams g{{0, 0, 0}, 1.0f, 1.0f, 4};
-    const Aabb box{{2.5f, 3.0f, 0.9f}, {3.2f, 3.5f, 1.4f}}; // cells x 2-3, y 3, z 0-1 on layer 0
-    EXPECT_EQ(grid_entry(g, make_cell(2, 3, 0, 0), box, 7, 5).starts(), 7u);
-    EXPECT_EQ(grid_entry(g, make_cell(3, 3, 0, 0), box, 7, 5).starts(), 6u);
-    EXPECT_EQ(grid_entry(g, make_cell(2, 3, 1, 0), box, 7, 5).starts(), 3u);
-    EXPECT_EQ(grid_entry(g, make_cell(3, 3, 1, 0), box, 7, 5).starts(), 2u);
-    EXPECT_EQ(grid_entry(g, make_cell(1, 1, 0, 1), box, 7, 5).starts(), 7u); // layer 1: cells of size 2
-    const GridEntry e = grid_entry(g, make_cell(3, 3, 1, 0), box, 7, (1u << grid_entry_object_bits) - 1u);
-    EXPECT_EQ(e.id, 7u);
-    EXPECT_EQ(e.object(), (1u << grid_entry_object_bits) - 1u);
-    // Coordinates beyond the wrap compare as the cell's wrapped ones.
-    const float far = static_cast<float>(1u << cell_coordinate_bits);
-    const Aabb wrapped{{far + 2.5f, 3.0f, 0.5f}, {far + 3.5f, 3.5f, 0.7f}};
-    EXPECT_EQ(grid_entry(g, make_cell(2, 3, 0, 0), wrapped, 7, 5).starts(), 7u);
-    EXPECT_EQ(grid_entry(g, make_cell(3, 3, 0, 0), wrapped, 7, 5).starts(), 6u);
 }
 
 } // namespace

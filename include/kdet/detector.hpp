@@ -33,7 +33,8 @@ public:
     Detector& operator=(const Detector&) = delete;
 
     /// @brief Adds an object; tets are 4 vertex indices (0-based) each. Throws kdet::Error on an
-    /// out-of-range index or a non-finite coordinate, and then leaves the detector unchanged.
+    /// out-of-range index, a non-finite coordinate or more than 2^29 - 1 tets in all objects, and
+    /// then leaves the detector unchanged.
     /// Internally the tets are stored in the spatial order of these positions (neighbours close in
     /// memory), so pass the object's real rest shape; results always use the tet order given here.
     ObjectId add_object(const float* positions, std::size_t vertex_count, const std::uint32_t* tets,

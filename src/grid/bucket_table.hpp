@@ -43,35 +43,24 @@ struct BucketHeader {
     std::uint64_t key;
 };
 
-/// @brief Bits of an entry's object_starts above the object.
-constexpr int grid_entry_object_bits = 29;
+/// @brief Bits of an id as the buckets and lists store it; above them, the axes along which the id's
+/// box starts in the cell (bit a: its first cell along axis a is this one), which decides the cell
+/// a pair is reported from. Tet ids stay below 2^grid_id_bits (Detector checks).
+constexpr int grid_id_bits = 29;
+constexpr std::uint32_t grid_id_mask = (1u << grid_id_bits) - 1u;
+
+/// @brief An id with its start bits, as a bucket stores it.
+KDET_HD inline std::uint32_t tag_starts(std::uint32_t id, std::uint32_t starts) { return id | starts << grid_id_bits; }
 
 /// @brief One id of a compacted cell with what a query filters on, so that scanning a cell reads
 /// one contiguous list instead of each id's data wherever it lies.
 struct GridEntry {
     Aabb box;
-    std::uint32_t id;
-    /// The id's object in the low grid_entry_object_bits; above them bit a set when the box's first
-    /// cell along axis a is this one (the box starts here), which decides the cell a pair is reported from.
-    std::uint32_t object_starts;
-    KDET_HD std::uint32_t object() const { return object_starts & ((1u << grid_entry_object_bits) - 1u); }
-    KDET_HD std::uint32_t starts() const { return object_starts >> grid_entry_object_bits; }
+    std::uint32_t id_and_starts; ///< tag_starts(id, starts)
+    std::uint32_t object;
+    KDET_HD std::uint32_t id() const { return id_and_starts & grid_id_mask; }
+    KDET_HD std::uint32_t starts() const { return id_and_starts >> grid_id_bits; }
 };
-
-/// @brief The entry of `id` (of `object`, box `box`) in `cell`: whether the box starts in the cell,
-/// per axis, compared on the wrapped coordinates the cell has. A box spans at most a few cells of
-/// its layer, so its first cell differs from the cell by far less than the wrap and the comparison
-/// is that of the true coordinates.
-KDET_HD inline GridEntry grid_entry(const GridParams& params, CellCoord cell, const Aabb& box, std::uint32_t id,
-                                    std::uint32_t object) {
-    const CellCoord first = make_cell(cell_index(params, box.lo.x, params.origin.x, static_cast<int>(cell.layer)),
-                                      cell_index(params, box.lo.y, params.origin.y, static_cast<int>(cell.layer)),
-                                      cell_index(params, box.lo.z, params.origin.z, static_cast<int>(cell.layer)),
-                                      static_cast<int>(cell.layer));
-    const std::uint32_t starts =
-        (first.x == cell.x ? 1u : 0u) | (first.y == cell.y ? 2u : 0u) | (first.z == cell.z ? 4u : 0u);
-    return GridEntry{box, id, object | starts << grid_entry_object_bits};
-}
 
 /// @brief Entries of the compacted lists per block: block b bounds the boxes of entries
 /// [b * entry_block, (b + 1) * entry_block), whatever lists they belong to, so that a query skips the
@@ -153,10 +142,11 @@ KDET_HD inline bool append_to_chain(const GridView& g, std::uint32_t bucket, std
     }
 }
 
-/// @brief Inserts `id` into `cell`; false (with a failure bit set) when the table must grow.
-KDET_HD inline bool grid_insert(const GridView& g, CellCoord cell, std::uint32_t id) {
+/// @brief Inserts `id` into `cell`, with the axes along which its box starts there (`starts`, bit a
+/// for axis a); false (with a failure bit set) when the table must grow.
+KDET_HD inline bool grid_insert(const GridView& g, CellCoord cell, std::uint32_t id, std::uint32_t starts) {
     const std::uint32_t bucket = claim_bucket(g, cell);
-    return bucket != no_bucket && append_to_chain(g, bucket, id);
+    return bucket != no_bucket && append_to_chain(g, bucket, tag_starts(id, starts));
 }
 
 /// @brief Main bucket of `cell` after populating, or no_bucket when the cell is empty.
@@ -173,7 +163,7 @@ KDET_HD inline std::uint32_t grid_find(const GridView& g, CellCoord cell) {
 }
 
 /// @brief Copies the ids of the cell whose main bucket is `slot` (if it is occupied this frame) into
-/// one list of entries, entry_of(id, cell) each, sorted by id, and points the main bucket at it. When the
+/// one list of entries, entry_of(id) each with the id's start bits, sorted by id, and points the main bucket at it. When the
 /// list does not fit, the cell reads as empty and grid_entries_full is set: the frame reruns with
 /// more room.
 template <class EntryOf>
@@ -190,18 +180,21 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
         main.first_entry = 0;
         return;
     }
-    const CellCoord cell = cell_of_key(main.key);
     std::uint32_t k = first;
     for (std::uint32_t b = slot; b != no_bucket; b = g.headers[b].next) {
         const std::uint32_t n = g.headers[b].count < g.bucket_capacity ? g.headers[b].count : g.bucket_capacity;
         const std::uint32_t* ids = g.ids + static_cast<std::uint64_t>(b) * g.bucket_capacity;
-        for (std::uint32_t i = 0; i < n; ++i) g.entries[k++] = entry_of(ids[i], cell);
+        for (std::uint32_t i = 0; i < n; ++i) {
+            GridEntry e = entry_of(ids[i] & grid_id_mask);
+            e.id_and_starts = ids[i];
+            g.entries[k++] = e;
+        }
     }
     // Insertion sort: threads populate in about id order, so few entries move.
     for (std::uint32_t i = first + 1; i < first + total; ++i) {
         const GridEntry e = g.entries[i];
         std::uint32_t j = i;
-        for (; j > first && g.entries[j - 1].id > e.id; --j) g.entries[j] = g.entries[j - 1];
+        for (; j > first && g.entries[j - 1].id() > e.id(); --j) g.entries[j] = g.entries[j - 1];
         g.entries[j] = e;
     }
     main.count = total;
@@ -239,7 +232,7 @@ KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std
     std::uint32_t begin = 0;
     for (std::uint32_t end = n; begin < end;) {
         const std::uint32_t middle = begin + (end - begin) / 2;
-        if (entries[middle].id < first_id)
+        if (entries[middle].id() < first_id)
             begin = middle + 1;
         else
             end = middle;

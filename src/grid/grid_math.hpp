@@ -89,13 +89,4 @@ KDET_HD inline std::uint64_t cell_key(CellCoord c) {
            (static_cast<std::uint64_t>(c.y) << cell_coordinate_bits) | static_cast<std::uint64_t>(c.z);
 }
 
-/// @brief The cell a key identifies (inverse of cell_key).
-KDET_HD inline CellCoord cell_of_key(std::uint64_t key) {
-    const std::uint64_t mask = (1u << cell_coordinate_bits) - 1u;
-    return CellCoord{static_cast<std::uint32_t>((key >> (2 * cell_coordinate_bits)) & mask),
-                     static_cast<std::uint32_t>((key >> cell_coordinate_bits) & mask),
-                     static_cast<std::uint32_t>(key & mask),
-                     static_cast<std::uint32_t>((key >> (3 * cell_coordinate_bits)) - 1u)};
-}
-
 } // namespace kdet

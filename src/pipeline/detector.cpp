@@ -108,10 +108,10 @@ struct Detector::Impl {
     ObjectId add(const Scalar* xyz, std::size_t vertex_count, const std::uint32_t* tets, std::size_t tet_count) {
         const std::uint64_t total_tets = topology.tets.size() + tet_count;
         const std::uint64_t total_vertices = std::uint64_t{object_vertex_begin.back()} + vertex_count;
-        if (total_tets >= 0xffffffffull || total_vertices >= 0xffffffffull)
-            throw Error("too many tetrahedra or vertices for 32-bit ids");
-        if (objects() >= (std::size_t{1} << grid_entry_object_bits))
-            throw Error("too many objects (at most " + std::to_string(std::size_t{1} << grid_entry_object_bits) + ")");
+        if (total_tets > grid_id_mask)
+            throw Error("too many tetrahedra: " + std::to_string(total_tets) + " in all, at most " +
+                        std::to_string(grid_id_mask));
+        if (total_vertices >= 0xffffffffull) throw Error("too many vertices for 32-bit ids");
         const ObjectId id = static_cast<ObjectId>(objects());
         for (std::size_t t = 0; t < tet_count; ++t)
             for (int k = 0; k < 4; ++k)

@@ -333,29 +333,26 @@ struct PopulateKernel {
         const CellRange r = cell_range(*params, info.box, info.layer);
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
-                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
-                    if (!grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t))) return;
+                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
+                    const std::uint32_t starts = (x == r.lo[0] ? 1u : 0u) | (y == r.lo[1] ? 2u : 0u) | (z == r.lo[2] ? 4u : 0u);
+                    if (!grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t), starts)) return;
+                }
     }
 };
 
 /// @brief Stage 2, after populating: one work item per main slot of the table; copies each occupied
-/// cell's ids, with their boxes, objects and where their boxes start, into one contiguous list
-/// (compact_cell).
+/// cell's ids, with their boxes and objects, into one contiguous list (compact_cell).
 struct CompactCellsKernel {
     SceneView scene;
     GridView grid;
-    const GridParams* params; ///< GridParamsKernel's
 
     struct EntryOf {
         const SceneView* scene;
-        GridParams params;
-        KDET_HD GridEntry operator()(std::uint32_t u, CellCoord cell) const {
-            return grid_entry(params, cell, scene->info[u].box, u, scene->tet_object[u]);
-        }
+        KDET_HD GridEntry operator()(std::uint32_t u) const { return GridEntry{scene->info[u].box, u, scene->tet_object[u]}; }
     };
 
     KDET_HD void operator()(std::uint64_t slot) const {
-        compact_cell(grid, static_cast<std::uint32_t>(slot), EntryOf{&scene, *params});
+        compact_cell(grid, static_cast<std::uint32_t>(slot), EntryOf{&scene});
     }
 };
 
@@ -391,8 +388,8 @@ struct LargerNeighbourFilter {
     std::uint32_t required_starts;
 
     KDET_HD void operator()(const GridEntry& e) const {
+        if (!checked_against[e.object]) return;
         if ((e.starts() & required_starts) != required_starts) return;
-        if (!checked_against[e.object()]) return;
         if (boxes_overlap(box, e.box)) (*visit)(e);
     }
 };
@@ -523,9 +520,9 @@ struct FindCandidatesKernel {
         TetPlanes planes;
         unsigned long long rejected;
         KDET_HD void operator()(const GridEntry& e) {
-            const std::uint32_t u = e.id;
+            const std::uint32_t u = e.id();
             const TetIndices other = scene->tets[u];
-            if (e.object() == object && share_vertex(tet, other)) return;
+            if (e.object == object && share_vertex(tet, other)) return;
             vec3 w[4];
             for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
             const PlaneVerdict verdict = face_plane_pretest(planes, vertices, scene->planes[u], w, false);
@@ -573,7 +570,7 @@ struct NoPairsKernel {
         unsigned long long tests;
         unsigned long long exact_stage;
         KDET_HD void operator()(const GridEntry& e) {
-            const std::uint32_t u = e.id;
+            const std::uint32_t u = e.id();
             std::uint32_t* flags = kernel->colliding;
             if (atomic_load_acquire(&flags[t]) && atomic_load_acquire(&flags[u])) return;
             ++tests;

@@ -330,7 +330,7 @@ GridView Pipeline<Exec>::populate() {
                         &c->overflow_used, &c->grid_failure, &c->cells_claimed, slot_count_, slot_bits, capacity,
                         overflow_capacity_, stamp_, 64u, options_.hash};
     exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, &c->params});
-    exec_.for_each(slot_count_, CompactCellsKernel{scene_view(), grid, &c->params});
+    exec_.for_each(slot_count_, CompactCellsKernel{scene_view(), grid});
     exec_.for_each(block_bounds_.size(), BoundEntryBlocksKernel{grid});
     return grid;
 }
