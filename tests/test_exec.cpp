@@ -12,6 +12,27 @@
 namespace kdet {
 namespace {
 
+TEST(ShareVertex, IsTrueExactlyWhenSomeIndexOfOneTetIsAnIndexOfTheOther) {
+    std::mt19937 rng(17);
+    std::uniform_int_distribution<std::uint32_t> index(0, 9); // few values: about half the pairs share one
+    int shared = 0;
+    for (int round = 0; round < 20000; ++round) {
+        TetIndices a, b;
+        for (int k = 0; k < 4; ++k) {
+            a.v[k] = index(rng);
+            b.v[k] = index(rng) | (round % 3 == 0 ? 0x80000000u : 0u); // high bits matter too
+        }
+        bool expected = false;
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j) expected = expected || a.v[i] == b.v[j];
+        ASSERT_EQ(share_vertex(a, b), expected) << round;
+        ASSERT_EQ(share_vertex(b, a), expected) << round;
+        shared += expected;
+    }
+    EXPECT_GT(shared, 5000);
+    EXPECT_LT(shared, 15000);
+}
+
 TEST(PairKeyBits, EveryKeyOfTheTetsFitsAndNoBitIsSpare) {
     for (std::uint32_t tets : {2u, 3u, 4u, 5u, 1000u, 1u << 20, (1u << 20) + 2, 0xfffffff0u}) {
         const int bits = pair_key_bits(tets);
