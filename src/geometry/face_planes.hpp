@@ -142,6 +142,7 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
 /// @brief Signed distance of point w beyond each face plane k of p.
 KDET_HD inline void plane_distances(const TetPlanes& p, vec3 w, float distance[4]) {
     const vec3 r = w - p.origin;
+    KDET_VECTOR_LOOP
     for (int k = 0; k < 4; ++k) distance[k] = p.nx[k] * r.x + p.ny[k] * r.y + p.nz[k] * r.z - p.offset[k];
 }
 
@@ -160,6 +161,7 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
     for (int j = 0; j < 4; ++j) {
         float distance[4];
         plane_distances(p, w[j], distance);
+        KDET_VECTOR_LOOP
         for (int k = 0; k < 4; ++k) nearest[k] = min_f(nearest[k], distance[k]);
         const float farthest = max_f(max_f(distance[0], distance[1]), max_f(distance[2], distance[3]));
         inside |= farthest < -inside_margin ? 1 : 0;
