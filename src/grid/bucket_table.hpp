@@ -163,9 +163,9 @@ KDET_HD inline std::uint32_t grid_find(const GridView& g, CellCoord cell) {
 }
 
 /// @brief Copies the ids of the cell whose main bucket is `slot` (if it is occupied this frame) into
-/// one list of entries, entry_of(id) each with the id's start bits, sorted by id, and points the main bucket at it. When the
-/// list does not fit, the cell reads as empty and grid_entries_full is set: the frame reruns with
-/// more room.
+/// one list of entries, entry_of(id) each with the id's start bits, sorted by id, and points the main
+/// bucket at it. When the list does not fit, the cell reads as empty and grid_entries_full is set:
+/// the frame reruns with more room.
 template <class EntryOf>
 KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const EntryOf& entry_of) {
     BucketHeader& main = g.headers[slot];
