@@ -21,8 +21,9 @@
 #endif
 /// @brief A loop over four lanes (the faces of a tet, say) that GCC should turn into vector
 /// instructions: kept a loop on the host, since GCC unrolls a loop of four before its vectoriser sees
-/// it and then rarely packs the copies again. Device code unrolls it as usual.
-#if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDA_ARCH__)
+/// it and then rarely packs the copies again. Left to the compiler under nvcc (whose front end does not
+/// know the pragma; the CPU backend is compiled by the host compiler) and in device code.
+#if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__)
 #define KDET_VECTOR_LOOP _Pragma("GCC unroll 1")
 #else
 #define KDET_VECTOR_LOOP
