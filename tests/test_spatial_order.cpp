@@ -139,5 +139,22 @@ TEST(Detector, AFailedAddLeavesTheDetectorAsItWas) {
     EXPECT_NO_THROW(detector.detect());
 }
 
+TEST(Detector, MoreTetsThanTheGridsIdsHoldAreRejectedBeforeAnyIsRead) {
+    Detector detector;
+    const TetMesh a = test::random_soup(50, 1.0, 1.0, 91);
+    detector.add_object(a);
+    // The count alone decides: the tet array (one tet here) is never read past its end.
+    const std::size_t too_many = (std::size_t{1} << 29) - 50;
+    try {
+        detector.add_object(a.positions.data(), a.positions.size() / 3, a.tets.data(), too_many);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("too many tetrahedra"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("536870911"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(detector.object_count(), 1u);
+    EXPECT_NO_THROW(detector.add_object(a.positions.data(), a.positions.size() / 3, a.tets.data(), 1));
+}
+
 } // namespace
 } // namespace kdet
