@@ -541,7 +541,14 @@ struct FindCandidatesKernel {
     KDET_HD void operator()(std::uint64_t i) const {
         const auto t = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
         if (scene.info[t].layer < 0) return;
-        KeyBatch batch(&out, resume_from ? resume_from[i].stored : 0u);
+        const std::uint32_t already_stored = resume_from ? resume_from[i].stored : 0u;
+        // Once a first frame's buffer is full, a tet that has not started would only search until
+        // its first batch and then search again after the buffer grows: it waits for that at once.
+        if (stop_when_full && atomic_load_acquire(out.count) >= out.capacity) {
+            stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{t, already_stored};
+            return;
+        }
+        KeyBatch batch(&out, already_stored);
         Emit emit{&scene, &batch, stop_when_full, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
         load_tet(scene, t, emit.vertices);
         const GridParams grid_params = *params;
