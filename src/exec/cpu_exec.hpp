@@ -114,6 +114,11 @@ private:
     unsigned recorded_ = 0;
 };
 
+/// @brief Sorts keys[0, n) ascending, every key below 2^bits: least significant digit first, 11 bits
+/// a pass, a pass skipped where every key has the same digit; `scratch` holds n keys. Small inputs
+/// go to std::sort.
+void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch);
+
 class CpuExec {
 public:
     template <class T>

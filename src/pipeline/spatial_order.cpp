@@ -1,5 +1,6 @@
 #include "pipeline/spatial_order.hpp"
 
+#include "exec/cpu_exec.hpp"
 #include "grid/hash.hpp"
 
 #include <algorithm>
@@ -29,7 +30,8 @@ std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::u
                                    (hash_detail::spread_bits_3(quantize(c.z, lo.z, hi.z)) << 2);
         keys[t] = (static_cast<std::uint64_t>(code) << 32) | t;
     }
-    std::sort(keys.begin(), keys.end());
+    std::vector<std::uint64_t> scratch(tet_count);
+    radix_sort(keys.data(), tet_count, 62, scratch.data());
     std::vector<std::uint32_t> order(tet_count);
     for (std::size_t i = 0; i < tet_count; ++i) order[i] = static_cast<std::uint32_t>(keys[i] & 0xffffffffu);
     return order;
