@@ -61,20 +61,23 @@ KDET_HD inline bool edge_axes_separate(const LocalPair& p, int i, MtvState& best
 /// never the answer.
 template <bool track>
 KDET_HD inline bool sat_separates(const LocalPair& p, bool edges, MtvState& best, bool edges_first = false) {
-    vec3 axis;
-    float length2;
-    const bool edges_now = edges && edges_first && !track;
-    if (edges_now)
+    const auto face_axes_separate = [&]() {
+        vec3 axis;
+        float length2;
+        for (int k = 0; k < 4; ++k)
+            if (face_axis(p.a, k, axis, length2) && axis_separates<track>(p, axis, length2, 0.0f, best)) return true;
+        for (int k = 0; k < 4; ++k)
+            if (face_axis(p.b, k, axis, length2) && axis_separates<track>(p, axis, length2, 0.0f, best)) return true;
+        return false;
+    };
+    const auto all_edge_axes_separate = [&]() {
         for (int i = 0; i < 6; ++i)
             if (edge_axes_separate<track>(p, i, best)) return true;
-    for (int k = 0; k < 4; ++k)
-        if (face_axis(p.a, k, axis, length2) && axis_separates<track>(p, axis, length2, 0.0f, best)) return true;
-    for (int k = 0; k < 4; ++k)
-        if (face_axis(p.b, k, axis, length2) && axis_separates<track>(p, axis, length2, 0.0f, best)) return true;
-    if (!edges || edges_now) return false;
-    for (int i = 0; i < 6; ++i)
-        if (edge_axes_separate<track>(p, i, best)) return true;
-    return false;
+        return false;
+    };
+    if (!edges) return face_axes_separate();
+    if (edges_first && !track) return all_edge_axes_separate() || face_axes_separate();
+    return face_axes_separate() || all_edge_axes_separate();
 }
 
 /// @brief 44-axis SAT (edges true) or face normals only (edges false) on input coordinates;
