@@ -2,6 +2,8 @@
 /// @file cpu_exec.hpp
 /// @brief The CPU execution layer: OpenMP loops over the same per-element functors the CUDA layer launches.
 
+#include "exec/radix_sort.hpp"
+
 #include <kdet/options.hpp>
 
 #include <algorithm>
@@ -113,11 +115,6 @@ private:
     std::chrono::steady_clock::time_point marks_[mark_count]{};
     unsigned recorded_ = 0;
 };
-
-/// @brief Sorts keys[0, n) ascending, every key below 2^bits: least significant digit first, 11 bits
-/// a pass, a pass skipped where every key has the same digit; `scratch` holds n keys. Small inputs
-/// go to std::sort.
-void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch);
 
 class CpuExec {
 public:

@@ -1,6 +1,6 @@
 #include "pipeline/spatial_order.hpp"
 
-#include "exec/cpu_exec.hpp"
+#include "exec/radix_sort.hpp"
 #include "grid/hash.hpp"
 
 #include <algorithm>

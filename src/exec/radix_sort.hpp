@@ -1,0 +1,16 @@
+#pragma once
+/// @file radix_sort.hpp
+/// @brief The host's sort of 64-bit keys: the CPU backend's sort stage and the storage order of
+/// add_object use it.
+
+#include <cstddef>
+#include <cstdint>
+
+namespace kdet {
+
+/// @brief Sorts keys[0, n) ascending, every key below 2^bits: least significant digit first, 11 bits
+/// a pass, a pass skipped where every key has the same digit; `scratch` holds n keys. Small inputs
+/// go to std::sort.
+void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch);
+
+} // namespace kdet
