@@ -70,8 +70,9 @@ KDET_HD inline int face_edge(int k, int which) {
 /// each one rounded difference, so the bound above applies to every projection.
 struct FilterPair {
     vec3 a[4], b[4];
-    vec3 edge_a[6], edge_b[6];
-    float norm_a[6], norm_b[6]; ///< ||edge||_1
+    vec3 edge_a[6];
+    EdgeRows edge_b;
+    float norm_a[6], norm_b[8]; ///< ||edge||_1 (norm_b: 0 for the zero edges)
     float relative;             ///< k_float_gap_bound * max |coordinate of a translated vertex|
     float absolute;             ///< the underflow term
 };
@@ -91,10 +92,14 @@ KDET_HD inline bool make_filter_pair(const vec3 a[4], const vec3 b[4], FilterPai
     float longest = 0.0f;
     for (int k = 0; k < 6; ++k) {
         f.edge_a[k] = a[edge_second(k)] - a[edge_first(k)];
-        f.edge_b[k] = b[edge_second(k)] - b[edge_first(k)];
+        f.edge_b.set(k, b[edge_second(k)] - b[edge_first(k)]);
         f.norm_a[k] = norm1(f.edge_a[k]);
         f.norm_b[k] = norm1(f.edge_b[k]);
         longest = max_f(longest, max_f(f.norm_a[k], f.norm_b[k]));
+    }
+    for (int k = 6; k < 8; ++k) {
+        f.edge_b.set(k, vec3{0.0f, 0.0f, 0.0f});
+        f.norm_b[k] = 0.0f;
     }
     const float largest = max_f(extent.x, max_f(extent.y, extent.z));
     f.relative = k_float_gap_bound * largest;
@@ -117,17 +122,20 @@ KDET_HD inline void filter_project(const FilterPair& f, vec3 n, FilterProjection
     }
 }
 
-/// @brief Both gaps (b above a, a above b) against the bound: separates when one is certainly
-/// positive, overlaps when both are certainly negative.
+/// @brief Both gaps (`up`: b above a, `down`: a above b) against the bound: separates when one is
+/// certainly positive, overlaps when both are certainly negative.
+KDET_HD inline AxisVerdict gaps_verdict(float up, float down, float bound) {
+    if (up > bound || down > bound) return AxisVerdict::separates;
+    if (up < -bound && down < -bound) return AxisVerdict::overlaps;
+    return AxisVerdict::uncertain;
+}
+
 KDET_HD inline AxisVerdict filter_verdict(const FilterProjections& s, float bound) {
     const float lo_a = min_f(min_f(s.a[0], s.a[1]), min_f(s.a[2], s.a[3]));
     const float hi_a = max_f(max_f(s.a[0], s.a[1]), max_f(s.a[2], s.a[3]));
     const float lo_b = min_f(min_f(s.b[0], s.b[1]), min_f(s.b[2], s.b[3]));
     const float hi_b = max_f(max_f(s.b[0], s.b[1]), max_f(s.b[2], s.b[3]));
-    const float up = lo_b - hi_a, down = lo_a - hi_b;
-    if (up > bound || down > bound) return AxisVerdict::separates;
-    if (up < -bound && down < -bound) return AxisVerdict::overlaps;
-    return AxisVerdict::uncertain;
+    return gaps_verdict(lo_b - hi_a, lo_a - hi_b, bound);
 }
 
 // ---- Levels 2 and 3: double, then exact. Out of line: only pairs with an open axis get here.
@@ -373,10 +381,10 @@ KDET_HD inline bool exact_intersect(const vec3 a[4], const vec3 b[4], bool& exac
         const auto face_axes_separate = [&]() {
             for (int t = 0; t < 2; ++t)
                 for (int k = 0; k < 4; ++k) {
-                    const vec3* edges = t ? f.edge_b : f.edge_a;
                     const float* norms = t ? f.norm_b : f.norm_a;
                     const int e0 = face_edge(k, 0), e1 = face_edge(k, 1);
-                    filter_project(f, cross(edges[e0], edges[e1]), s);
+                    const vec3 first = t ? f.edge_b[e0] : f.edge_a[e0], second = t ? f.edge_b[e1] : f.edge_a[e1];
+                    filter_project(f, cross(first, second), s);
                     const float bound = norms[e0] * norms[e1] * f.relative + f.absolute;
                     const AxisVerdict verdict = filter_verdict(s, bound);
                     if (verdict == AxisVerdict::separates) return true;
@@ -388,12 +396,18 @@ KDET_HD inline bool exact_intersect(const vec3 a[4], const vec3 b[4], bool& exac
             return false;
         };
         const auto edge_axes_separate = [&]() {
+            EdgeAxisLanes lanes;
             for (int i = 0; i < 6; ++i)
-                for (int j = 0; j < 6; ++j) {
-                    filter_project(f, cross(f.edge_a[i], f.edge_b[j]), s);
-                    const AxisVerdict verdict = filter_verdict(s, f.norm_a[i] * f.norm_b[j] * f.relative + f.absolute);
-                    if (verdict == AxisVerdict::separates) return true;
-                    if (verdict == AxisVerdict::uncertain) open |= std::uint64_t{1} << (8 + 6 * i + j);
+                for (int first = 0; first < 6; first += k_edge_lanes) {
+                    edge_axis_lanes(f, i, first, lanes);
+                    for (int j = first; j < 6 && j < first + k_edge_lanes; ++j) {
+                        const float bound = f.norm_a[i] * f.norm_b[j] * f.relative + f.absolute;
+                        // The gaps are minus what remains of the overlap (negation is exact).
+                        const int l = j - first;
+                        const AxisVerdict verdict = gaps_verdict(-lanes.over_up[l], -lanes.over_down[l], bound);
+                        if (verdict == AxisVerdict::separates) return true;
+                        if (verdict == AxisVerdict::uncertain) open |= std::uint64_t{1} << (8 + 6 * i + j);
+                    }
                 }
             return false;
         };

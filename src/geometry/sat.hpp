@@ -17,15 +17,13 @@ struct MtvState {
     vec3 direction; ///< unit direction that moves the second tet out by `overlap`
 };
 
-/// @brief Tests one axis (any length; length2 is its squared length > 0): true when it separates the
-/// tets, i.e. gap > tolerance * |axis|, tested squared so that no square root is needed. With track,
-/// also keeps the axis of least overlap (normalised only when it becomes the best); `bias` is how
-/// much smaller an overlap must be to replace the current best.
+/// @brief Decides one axis (any length; length2 is its squared length > 0) from the overlaps left
+/// when the second tet moves along +axis (`up`) and -axis (`down`), times |axis|: true when it
+/// separates the tets, i.e. gap > tolerance * |axis|, tested squared so that no square root is needed.
+/// With track, also keeps the axis of least overlap (normalised only when it becomes the best); `bias`
+/// is how much smaller an overlap must be to replace the current best.
 template <bool track>
-KDET_HD inline bool axis_separates(const LocalPair& p, vec3 axis, float length2, float bias, MtvState& best) {
-    const Interval ia = project(p.a, axis), ib = project(p.b, axis);
-    const float up = ia.hi - ib.lo;   // overlap left if the second tet moves along +axis (times |axis|)
-    const float down = ib.hi - ia.lo; // overlap left if it moves along -axis
+KDET_HD inline bool overlaps_separate(float up, float down, vec3 axis, float length2, float bias, MtvState& best) {
     const float overlap = min_f(up, down);
     if (overlap < 0.0f && overlap * overlap > k_gap_tolerance * k_gap_tolerance * length2) return true;
     if constexpr (track) {
@@ -41,15 +39,46 @@ KDET_HD inline bool axis_separates(const LocalPair& p, vec3 axis, float length2,
     return false;
 }
 
-/// @brief Tests the 6 axes cross(edge i of A, edge j of B); true as soon as one separates.
+/// @brief Tests one axis: overlaps_separate on the tets' projections onto it.
+template <bool track>
+KDET_HD inline bool axis_separates(const LocalPair& p, vec3 axis, float length2, float bias, MtvState& best) {
+    const Interval ia = project(p.a, axis), ib = project(p.b, axis);
+    return overlaps_separate<track>(ia.hi - ib.lo, ib.hi - ia.lo, axis, length2, bias, best);
+}
+
+/// @brief Tests the 6 axes cross(edge i of A, edge j of B), k_edge_lanes at a time (edge_axis_lanes);
+/// true when one separates. With track they are decided in order of j, as one at a time would be.
 template <bool track>
 KDET_HD inline bool edge_axes_separate(const LocalPair& p, int i, MtvState& best) {
-    vec3 axis;
-    float length2;
-    for (int j = 0; j < 6; ++j)
-        if (edge_axis(p.edge_a[i], p.length2_a[i], p.edge_b[j], p.length2_b[j], axis, length2) &&
-            axis_separates<track>(p, axis, length2, k_gap_tolerance, best))
-            return true;
+    const float usable_scale = k_parallel_sine * k_parallel_sine * p.length2_a[i];
+    EdgeAxisLanes lanes;
+    for (int first = 0; first < 6; first += k_edge_lanes) {
+        edge_axis_lanes(p, i, first, lanes);
+        if constexpr (!track) {
+            int separates = 0;
+            KDET_VECTOR_LOOP
+            for (int l = 0; l < k_edge_lanes; ++l) {
+                const float length2 = lanes.x[l] * lanes.x[l] + lanes.y[l] * lanes.y[l] + lanes.z[l] * lanes.z[l];
+                const float overlap = min_f(lanes.over_up[l], lanes.over_down[l]);
+                // The conditions of edge_axis and overlaps_separate, combined without branches (& rather
+                // than &&) so that the lanes stay in vector instructions.
+                const int usable = length2 > usable_scale * p.length2_b[first + l];
+                const int gap = overlap < 0.0f;
+                const int wide = overlap * overlap > k_gap_tolerance * k_gap_tolerance * length2;
+                separates |= usable & gap & wide;
+            }
+            if (separates) return true;
+        } else {
+            for (int j = first; j < 6 && j < first + k_edge_lanes; ++j) {
+                const int l = j - first;
+                const vec3 axis{lanes.x[l], lanes.y[l], lanes.z[l]};
+                const float length2 = length_squared(axis);
+                if (length2 > usable_scale * p.length2_b[j] &&
+                    overlaps_separate<track>(lanes.over_up[l], lanes.over_down[l], axis, length2, k_gap_tolerance, best))
+                    return true;
+            }
+        }
+    }
     return false;
 }
 

@@ -29,14 +29,35 @@ constexpr float k_gap_tolerance = 32.0f * k_float_eps;
 /// @brief A value larger than any overlap in the unit frame.
 constexpr float k_huge = 3.0e38f;
 
+/// @brief Edge axes computed at once by edge_axis_lanes: on the host one per edge of the second tet,
+/// side by side in vector instructions (six, padded to eight); on the GPU one, so that a thread stops
+/// at the first axis that separates and keeps no lanes in registers.
+#if defined(__CUDA_ARCH__)
+constexpr int k_edge_lanes = 1;
+#else
+constexpr int k_edge_lanes = 8;
+#endif
+
+/// @brief A tet's six edges coordinate by coordinate (a row per coordinate), then two zero edges
+/// (which give no usable axis), so that edge_axis_lanes loads each coordinate of eight at once.
+struct EdgeRows {
+    float x[8], y[8], z[8];
+    KDET_HD vec3 operator[](int k) const { return vec3{x[k], y[k], z[k]}; }
+    KDET_HD void set(int k, vec3 e) {
+        x[k] = e.x;
+        y[k] = e.y;
+        z[k] = e.z;
+    }
+};
+
 /// @brief Both tets in the local frame: origin at a[0], longest edge of the pair 1.
 struct LocalPair {
     vec3 a[4];
     vec3 b[4];
-    vec3 edge_a[6]; ///< edges in the order (0,1) (0,2) (0,3) (1,2) (1,3) (2,3)
-    vec3 edge_b[6];
-    float length2_a[6]; ///< squared edge lengths in the local frame
-    float length2_b[6];
+    vec3 edge_a[6];            ///< edges in the order (0,1) (0,2) (0,3) (1,2) (1,3) (2,3)
+    EdgeRows edge_b;           ///< the same order, then zero edges
+    float length2_a[6];        ///< squared edge lengths in the local frame
+    float length2_b[8];
     float scale; ///< longest edge in input units: multiply local lengths by it to get input lengths
 };
 
@@ -55,7 +76,7 @@ KDET_HD inline bool make_local_pair(const vec3 a[4], const vec3 b[4], LocalPair&
     float longest2 = 0.0f;
     for (int k = 0; k < 6; ++k) {
         p.edge_a[k] = p.a[edge_second(k)] - p.a[edge_first(k)];
-        p.edge_b[k] = p.b[edge_second(k)] - p.b[edge_first(k)];
+        p.edge_b.set(k, p.b[edge_second(k)] - p.b[edge_first(k)]);
         longest2 = max_f(longest2, max_f(length_squared(p.edge_a[k]), length_squared(p.edge_b[k])));
     }
     if (!(longest2 > 0.0f)) return false;
@@ -67,9 +88,13 @@ KDET_HD inline bool make_local_pair(const vec3 a[4], const vec3 b[4], LocalPair&
     }
     for (int k = 0; k < 6; ++k) {
         p.edge_a[k] = p.edge_a[k] * inverse;
-        p.edge_b[k] = p.edge_b[k] * inverse;
+        p.edge_b.set(k, p.edge_b[k] * inverse);
         p.length2_a[k] = length_squared(p.edge_a[k]);
         p.length2_b[k] = length_squared(p.edge_b[k]);
+    }
+    for (int k = 6; k < 8; ++k) {
+        p.edge_b.set(k, vec3{0.0f, 0.0f, 0.0f});
+        p.length2_b[k] = 0.0f;
     }
     return true;
 }
@@ -109,6 +134,37 @@ struct Interval {
 KDET_HD inline Interval project(const vec3 v[4], vec3 axis) {
     const float d0 = dot(v[0], axis), d1 = dot(v[1], axis), d2 = dot(v[2], axis), d3 = dot(v[3], axis);
     return Interval{min_f(min_f(d0, d1), min_f(d2, d3)), max_f(max_f(d0, d1), max_f(d2, d3))};
+}
+
+/// @brief The axes cross(edge i of A, edge j of B) for j = first .. first + k_edge_lanes - 1 (those
+/// past 5 are zero axes), with both tets' projections onto them. `over_up` and `over_down` are what
+/// remains of the overlap when B moves along +axis and -axis (times |axis|): a negative one is a gap.
+struct EdgeAxisLanes {
+    float x[k_edge_lanes], y[k_edge_lanes], z[k_edge_lanes];
+    float over_up[k_edge_lanes], over_down[k_edge_lanes];
+};
+
+/// @brief Fills `lanes` for edge i of A and the edges of B from `first` on; Pair has vertices a, b
+/// and edges edge_a, edge_b (EdgeRows).
+template <class Pair>
+KDET_HD inline void edge_axis_lanes(const Pair& p, int i, int first, EdgeAxisLanes& lanes) {
+    const vec3 e = p.edge_a[i];
+    KDET_VECTOR_LOOP
+    for (int l = 0; l < k_edge_lanes; ++l) {
+        const int j = first + l;
+        const vec3 f{p.edge_b.x[j], p.edge_b.y[j], p.edge_b.z[j]};
+        const vec3 axis = cross(e, f);
+        // The four projections of each tet written out: a loop here would keep GCC from packing the lanes.
+        const float a0 = dot(p.a[0], axis), a1 = dot(p.a[1], axis), a2 = dot(p.a[2], axis), a3 = dot(p.a[3], axis);
+        const float b0 = dot(p.b[0], axis), b1 = dot(p.b[1], axis), b2 = dot(p.b[2], axis), b3 = dot(p.b[3], axis);
+        const float lo_a = min_f(min_f(a0, a1), min_f(a2, a3)), hi_a = max_f(max_f(a0, a1), max_f(a2, a3));
+        const float lo_b = min_f(min_f(b0, b1), min_f(b2, b3)), hi_b = max_f(max_f(b0, b1), max_f(b2, b3));
+        lanes.x[l] = axis.x;
+        lanes.y[l] = axis.y;
+        lanes.z[l] = axis.z;
+        lanes.over_up[l] = hi_a - lo_b;
+        lanes.over_down[l] = hi_b - lo_a;
+    }
 }
 
 /// @brief Largest gap between the projections of the two tets onto a unit axis, in the local frame:
