@@ -190,7 +190,7 @@ struct TestTable {
         const Compacted c = compacted(ids.size());
         EXPECT_EQ(c.failure, 0u);
         EveryEntry collect;
-        grid_for_each_in_cell(c.view, cell, 0u, everywhere, collect);
+        grid_for_each_in_cell(c.view, cell, 0u, any_object, everywhere, collect);
         return collect.found;
     }
 };
@@ -298,7 +298,7 @@ TEST(BucketTable, CompactionThatDoesNotFitSaysSoAndLeavesEmptyCells) {
     const auto short_of_room = table.compacted(25);
     EXPECT_EQ(short_of_room.failure, static_cast<std::uint32_t>(grid_entries_full));
     EveryEntry readable;
-    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, 0u, everywhere, readable);
+    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, 0u, any_object, everywhere, readable);
     EXPECT_EQ(readable.found.size(), 20u); // two cells of ten fit; the third reads as empty
     for (std::uint32_t id : readable.found) EXPECT_LT(id, 30u);
 }
@@ -320,7 +320,7 @@ TEST(BucketTable, CompactedCellsListTheirIdsInOrderAndSkipTheSmallerOnes) {
     std::sort(ids.begin(), ids.end());
     for (std::uint32_t first_id : {0u, 1u, 2u, 50u, 52u, 109u, 110u, 1000u}) {
         InOrder visit;
-        grid_for_each_in_cell(c.view, cell, first_id, everywhere, visit);
+        grid_for_each_in_cell(c.view, cell, first_id, any_object, everywhere, visit);
         const std::vector<std::uint32_t> expected(std::lower_bound(ids.begin(), ids.end(), first_id), ids.end());
         EXPECT_EQ(visit.seen, expected) << "first_id " << first_id;
     }
@@ -344,7 +344,7 @@ TEST(BucketTable, QueriesSkipTheBlocksOfEntriesWhoseBoundMissesTheirBox) {
     for (std::uint32_t first_id : {0u, 11u, 30u}) {
         const Aabb query{{10.2f, 0.5f, 0.5f}, {21.7f, 0.6f, 0.6f}};
         Seen seen;
-        grid_for_each_in_cell(c.view, row, first_id, query, seen);
+        grid_for_each_in_cell(c.view, row, first_id, any_object, query, seen);
         for (std::uint32_t i = std::max(first_id, 10u); i <= 21; ++i) EXPECT_TRUE(seen.ids.count(i)) << i;
         for (std::uint32_t id : seen.ids) EXPECT_GE(id, first_id);
         // Blocks are 8 entries: at most the blocks that hold 10 to 21 are read, whatever the alignment.
@@ -352,7 +352,7 @@ TEST(BucketTable, QueriesSkipTheBlocksOfEntriesWhoseBoundMissesTheirBox) {
         EXPECT_FALSE(seen.ids.count(40)) << first_id;
     }
     Seen everything;
-    grid_for_each_in_cell(c.view, row, 0u, everywhere, everything);
+    grid_for_each_in_cell(c.view, row, 0u, any_object, everywhere, everything);
     EXPECT_EQ(everything.ids.size(), 60u);
 }
 
@@ -374,9 +374,37 @@ TEST(BucketTable, CompactedEntriesKeepTheirStartBitsAndSortByIdAlone) {
         }
     };
     InOrder visit;
-    grid_for_each_in_cell(c.view, cell, grid_id_mask - 20, everywhere, visit);
+    grid_for_each_in_cell(c.view, cell, grid_id_mask - 20, any_object, everywhere, visit);
     std::sort(ids.begin(), ids.end());
     EXPECT_EQ(visit.seen, std::vector<std::uint32_t>(std::lower_bound(ids.begin(), ids.end(), grid_id_mask - 20), ids.end()));
+}
+
+TEST(BucketTable, ACellHoldingNoneOfTheObjectsAskedForIsSkippedUnread) {
+    // Cell `mixed` holds tets of objects 3 and 5, cell `alone` only of object 3; object_bit wraps at
+    // 32, so object 35 shares object 3's bit and reads the cell for nothing (the visitor's object check
+    // rejects such entries), which is allowed; a cell that may hold a wanted object is never skipped.
+    TestTable table(64, 4, 64, 32, HashFunction::djb2);
+    const CellCoord mixed{2, 3, 4, 1}, alone{7, 3, 4, 1};
+    for (std::uint32_t i = 0; i < 12; ++i) ASSERT_TRUE(grid_insert(table.view, mixed, i, 0u));
+    for (std::uint32_t i = 20; i < 26; ++i) ASSERT_TRUE(grid_insert(table.view, alone, i, 0u));
+    const auto c = table.compacted(18, [](std::uint32_t id) { return GridEntry{Aabb{}, id, id < 6 ? 5u : 3u}; });
+    ASSERT_EQ(c.failure, 0u);
+    struct Count {
+        std::uint32_t n = 0;
+        void operator()(const GridEntry&) { ++n; }
+    };
+    const auto visited = [&](CellCoord cell, std::uint32_t objects) {
+        Count count;
+        grid_for_each_in_cell(c.view, cell, 0u, objects, everywhere, count);
+        return count.n;
+    };
+    EXPECT_EQ(visited(mixed, object_bit(5)), 12u);
+    EXPECT_EQ(visited(mixed, object_bit(3)), 12u);
+    EXPECT_EQ(visited(mixed, object_bit(7)), 0u);
+    EXPECT_EQ(visited(alone, object_bit(5)), 0u);
+    EXPECT_EQ(visited(alone, object_bit(5) | object_bit(3)), 6u);
+    EXPECT_EQ(visited(alone, object_bit(35)), 6u);
+    EXPECT_EQ(visited(alone, any_object), 6u);
 }
 
 TEST(BucketCapacity, AutomaticIsFourTimesTheMeanIdsPerCellRoundedUpToAPowerOfTwoFrom4To32) {

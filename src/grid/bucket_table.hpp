@@ -40,8 +40,18 @@ struct BucketHeader {
     std::uint32_t count;
     std::uint32_t next;        ///< overflow bucket for the same cell, or no_bucket
     std::uint32_t first_entry; ///< once compacted, on the main bucket: where the cell's entries start
+    /// Once compacted, on the main bucket: the objects its entries belong to, bit (object mod 32)
+    /// (object_bit), so that a query checked against none of them skips the cell unread.
+    std::uint32_t objects;
     std::uint64_t key;
 };
+
+/// @brief An object's bit in BucketHeader::objects and in the query's mask of objects it is checked
+/// against; objects 32 apart share a bit, which only costs a cell read for nothing.
+KDET_HD inline std::uint32_t object_bit(std::uint32_t object) { return 1u << (object & 31u); }
+
+/// @brief The mask of a query that is checked against every object.
+constexpr std::uint32_t any_object = ~0u;
 
 /// @brief Bits of an id as the buckets and lists store it; above them, the axes along which the id's
 /// box starts in the cell (bit a: its first cell along axis a is this one), which decides the cell
@@ -178,15 +188,17 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
         atomic_fetch_or(g.failure, static_cast<std::uint32_t>(grid_entries_full));
         main.count = 0;
         main.first_entry = 0;
+        main.objects = 0;
         return;
     }
-    std::uint32_t k = first;
+    std::uint32_t k = first, objects = 0;
     for (std::uint32_t b = slot; b != no_bucket; b = g.headers[b].next) {
         const std::uint32_t n = g.headers[b].count < g.bucket_capacity ? g.headers[b].count : g.bucket_capacity;
         const std::uint32_t* ids = g.ids + static_cast<std::uint64_t>(b) * g.bucket_capacity;
         for (std::uint32_t i = 0; i < n; ++i) {
             GridEntry e = entry_of(ids[i] & grid_id_mask);
             e.id_and_starts = ids[i];
+            objects |= object_bit(e.object);
             g.entries[k++] = e;
         }
     }
@@ -199,6 +211,7 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
     }
     main.count = total;
     main.first_entry = first;
+    main.objects = objects;
 }
 
 /// @brief The bound of block `block` of the compacted entries (see entry_block), once every list is
@@ -218,14 +231,15 @@ KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, st
 }
 
 /// @brief Calls visit(entry) for every entry of `cell` whose id is at least `first_id` and whose box
-/// may overlap `box`, once the table is compacted: the smaller ids are skipped by a binary search,
-/// and the entries of a block whose bound misses `box` without being read (the visitor still tests
-/// each box it gets).
+/// may overlap `box`, once the table is compacted, unless the cell holds none of the `objects`
+/// (object_bit of each, or any_object): the smaller ids are skipped by a binary search, and the
+/// entries of a block whose bound misses `box` without being read (the visitor still tests each box
+/// and object it gets).
 template <class Visitor>
-KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std::uint32_t first_id, const Aabb& box,
-                                          Visitor& visit) {
+KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std::uint32_t first_id, std::uint32_t objects,
+                                          const Aabb& box, Visitor& visit) {
     const std::uint32_t bucket = grid_find(g, cell);
-    if (bucket == no_bucket) return;
+    if (bucket == no_bucket || !(g.headers[bucket].objects & objects)) return;
     const std::uint32_t first = g.headers[bucket].first_entry;
     const GridEntry* entries = g.entries + first;
     const std::uint32_t n = g.headers[bucket].count;

@@ -35,6 +35,7 @@ struct SceneView {
     TetInfo* info;
     TetPlanes* planes; ///< per tet, for the pre-test; computed for the tets that can collide this frame
     const std::uint8_t* pair_active; ///< [object_count * object_count]; diagonal = self-collision
+    const std::uint32_t* checked_objects; ///< [object_count] object_bit of every object a is checked against
     const Aabb* object_boxes;
     std::uint32_t tet_count;
     std::uint32_t object_count;
@@ -168,6 +169,7 @@ struct OrderedBox {
 struct ObjectCullingKernel {
     const std::uint8_t* pair_enabled; ///< [object_count * object_count]
     std::uint8_t* pair_active;
+    std::uint32_t* checked_objects; ///< [object_count] SceneView::checked_objects
     const Aabb* object_boxes;
     const std::uint32_t* object_tet_begin; ///< [object_count + 1]
     std::uint32_t object_count;
@@ -177,13 +179,16 @@ struct ObjectCullingKernel {
     KDET_HD void operator()(std::uint64_t a) const {
         const std::uint32_t tets = object_tet_begin[a + 1] - object_tet_begin[a];
         bool involved = false;
+        std::uint32_t checked = 0;
         for (std::uint32_t b = 0; b < object_count; ++b) {
             const std::uint64_t k = a * object_count + b;
             const bool on = tets && object_tet_begin[b + 1] != object_tet_begin[b] && pair_enabled[k] &&
                             (a == b || boxes_overlap(object_boxes[a], object_boxes[b]));
             pair_active[k] = on ? 1 : 0;
+            if (on) checked |= object_bit(b);
             involved = involved || on;
         }
+        checked_objects[a] = checked;
         if (!involved) return;
         const Aabb& box = object_boxes[a];
         for (int axis = 0; axis < 3; ++axis) {
@@ -404,6 +409,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     if (self.layer < 0) return;
     const std::uint32_t object = scene.tet_object[t];
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
+    const std::uint32_t checked_objects = scene.checked_objects[object];
     LargerNeighbourFilter<Visitor> filter{checked_against, self.box, &visit, 0};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
@@ -415,7 +421,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
                     filter.required_starts = (x != r.lo[0] ? 1u : 0u) | (y != r.lo[1] ? 2u : 0u) | (z != r.lo[2] ? 4u : 0u);
-                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, self.box, filter);
+                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, checked_objects, self.box, filter);
                     if (visit.finished()) return;
                 }
     }

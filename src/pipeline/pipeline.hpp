@@ -98,6 +98,7 @@ public:
         fill(object_boxes_, Aabb{{inf, inf, inf}, {-inf, -inf, -inf}});
         pair_enabled_.resize_discard(objects * objects);
         pair_active_.resize_discard(objects * objects);
+        checked_objects_.resize_discard(objects);
         counters_.resize_discard(1);
         // New geometry: the first frame plans the grid and sizes the pairs from what it finds; the bucket
         // size is chosen again from that plan (and only grows with later ones).
@@ -126,7 +127,7 @@ public:
                user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() + staged_positions_.capacity_bytes() +
                info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
-               pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() +
+               pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
                headers_.capacity_bytes() + ids_.capacity_bytes() + entries_.capacity_bytes() + block_bounds_.capacity_bytes() +
                counters_.capacity_bytes() +
                candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
@@ -143,7 +144,7 @@ public:
 private:
     SceneView scene_view() {
         return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), pair_active_.data(),
-                         object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
+                         checked_objects_.data(), object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
                          static_cast<std::uint32_t>(object_boxes_.size())};
     }
     template <class T>
@@ -198,6 +199,7 @@ private:
     buffer<Aabb> object_boxes_;
     buffer<std::uint8_t> pair_enabled_; ///< the caller's switches, [objects * objects]
     buffer<std::uint8_t> pair_active_;  ///< enabled and the boxes overlap, this frame
+    buffer<std::uint32_t> checked_objects_; ///< per object, the bits of the objects it is checked against this frame
     buffer<BucketHeader> headers_;
     buffer<std::uint32_t> ids_;
     buffer<GridEntry> entries_; ///< the compacted cells' lists
@@ -242,7 +244,7 @@ void Pipeline<Exec>::bounds_and_culling() {
                       run_boxes_.data(), &c->object_runs);
     exec_.for_each(objects, ObjectBoxesKernel{run_objects_.data(), run_boxes_.data(), &c->object_runs,
                                               object_boxes_.data()});
-    exec_.for_each(objects, ObjectCullingKernel{pair_enabled_.data(), pair_active_.data(), object_boxes_.data(),
+    exec_.for_each(objects, ObjectCullingKernel{pair_enabled_.data(), pair_active_.data(), checked_objects_.data(), object_boxes_.data(),
                                                 object_tet_begin_.data(), static_cast<std::uint32_t>(objects),
                                                 &c->region, &c->involved_tets});
 }
