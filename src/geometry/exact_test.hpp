@@ -72,7 +72,7 @@ struct FilterPair {
     vec3 a[4], b[4];
     vec3 edge_a[6];
     EdgeRows edge_b;
-    float norm_a[6], norm_b[8]; ///< ||edge||_1 (norm_b: 0 for the zero edges)
+    float norm_a[6], norm_b[EdgeRows::padded]; ///< ||edge||_1 (norm_b: 0 for the zero edges)
     float relative;             ///< k_float_gap_bound * max |coordinate of a translated vertex|
     float absolute;             ///< the underflow term
 };
@@ -97,10 +97,7 @@ KDET_HD inline bool make_filter_pair(const vec3 a[4], const vec3 b[4], FilterPai
         f.norm_b[k] = norm1(f.edge_b[k]);
         longest = max_f(longest, max_f(f.norm_a[k], f.norm_b[k]));
     }
-    for (int k = 6; k < 8; ++k) {
-        f.edge_b.set(k, vec3{0.0f, 0.0f, 0.0f});
-        f.norm_b[k] = 0.0f;
-    }
+    f.edge_b.pad(f.norm_b);
     const float largest = max_f(extent.x, max_f(extent.y, extent.z));
     f.relative = k_float_gap_bound * largest;
     f.absolute = k_float_smallest * (8.0f * (extent.x + extent.y + extent.z) + 16.0f);

@@ -41,14 +41,23 @@ constexpr int k_edge_lanes = 8;
 /// @brief A tet's six edges coordinate by coordinate (a row per coordinate), then two zero edges
 /// (which give no usable axis), so that edge_axis_lanes loads each coordinate of eight at once.
 struct EdgeRows {
-    float x[8], y[8], z[8];
+    static constexpr int padded = 8;
+    float x[padded], y[padded], z[padded];
     KDET_HD vec3 operator[](int k) const { return vec3{x[k], y[k], z[k]}; }
     KDET_HD void set(int k, vec3 e) {
         x[k] = e.x;
         y[k] = e.y;
         z[k] = e.z;
     }
+    /// @brief Sets the edges after the six to zero, and the same entries of a per-edge array.
+    KDET_HD void pad(float* per_edge) {
+        for (int k = 6; k < padded; ++k) {
+            set(k, vec3{0.0f, 0.0f, 0.0f});
+            per_edge[k] = 0.0f;
+        }
+    }
 };
+static_assert(k_edge_lanes <= EdgeRows::padded, "edge_axis_lanes reads k_edge_lanes edges from the first");
 
 /// @brief Both tets in the local frame: origin at a[0], longest edge of the pair 1.
 struct LocalPair {
@@ -57,7 +66,7 @@ struct LocalPair {
     vec3 edge_a[6];            ///< edges in the order (0,1) (0,2) (0,3) (1,2) (1,3) (2,3)
     EdgeRows edge_b;           ///< the same order, then zero edges
     float length2_a[6];        ///< squared edge lengths in the local frame
-    float length2_b[8];
+    float length2_b[EdgeRows::padded];
     float scale; ///< longest edge in input units: multiply local lengths by it to get input lengths
 };
 
@@ -92,10 +101,7 @@ KDET_HD inline bool make_local_pair(const vec3 a[4], const vec3 b[4], LocalPair&
         p.length2_a[k] = length_squared(p.edge_a[k]);
         p.length2_b[k] = length_squared(p.edge_b[k]);
     }
-    for (int k = 6; k < 8; ++k) {
-        p.edge_b.set(k, vec3{0.0f, 0.0f, 0.0f});
-        p.length2_b[k] = 0.0f;
-    }
+    p.edge_b.pad(p.length2_b);
     return true;
 }
 
