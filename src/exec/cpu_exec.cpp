@@ -1,4 +1,5 @@
 #include "exec/cpu_exec.hpp"
+#include "exec/radix_sort.hpp"
 
 #include <omp.h>
 

@@ -2,8 +2,6 @@
 /// @file cpu_exec.hpp
 /// @brief The CPU execution layer: OpenMP loops over the same per-element functors the CUDA layer launches.
 
-#include "exec/radix_sort.hpp"
-
 #include <kdet/options.hpp>
 
 #include <algorithm>

@@ -65,6 +65,12 @@ struct CellRange {
     std::uint32_t hi[3];
 };
 
+/// @brief The axes along which cell (x, y, z) of range r is the range's first (bit a for axis a):
+/// a box's start bits in the grid, and what the one-cell rule asks of the other box elsewhere.
+KDET_HD inline std::uint32_t first_cell_axes(const CellRange& r, std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+    return (x == r.lo[0] ? 1u : 0u) | (y == r.lo[1] ? 2u : 0u) | (z == r.lo[2] ? 4u : 0u);
+}
+
 KDET_HD inline CellRange cell_range(const GridParams& grid, const Aabb& box, int layer) {
     CellRange r;
     r.lo[0] = cell_index(grid, box.lo.x, grid.origin.x, layer);

@@ -341,10 +341,9 @@ struct PopulateKernel {
         const CellRange r = cell_range(*params, info.box, info.layer);
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
-                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    const std::uint32_t starts = (x == r.lo[0] ? 1u : 0u) | (y == r.lo[1] ? 2u : 0u) | (z == r.lo[2] ? 4u : 0u);
-                    if (!grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t), starts)) return;
-                }
+                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
+                    if (!grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t), first_cell_axes(r, x, y, z)))
+                        return;
     }
 };
 
@@ -420,7 +419,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    filter.required_starts = (x != r.lo[0] ? 1u : 0u) | (y != r.lo[1] ? 2u : 0u) | (z != r.lo[2] ? 4u : 0u);
+                    filter.required_starts = ~first_cell_axes(r, x, y, z) & 7u;
                     grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, checked_objects, self.box, filter);
                     if (visit.finished()) return;
                 }
