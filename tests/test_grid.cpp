@@ -160,7 +160,7 @@ struct TestTable {
     /// `room` entries; each entry carries its id, and its id again as the object.
     struct Compacted {
         std::vector<BucketHeader> headers;
-        std::vector<GridEntry> entries;
+        std::vector<EntryBlock> entry_blocks;
         std::vector<Aabb> block_bounds;
         std::uint32_t used = 0, failure = 0;
         GridView view;
@@ -170,9 +170,10 @@ struct TestTable {
     }
     template <class EntryOf>
     Compacted compacted(std::size_t room, const EntryOf& entry_of) const {
-        Compacted c{headers, std::vector<GridEntry>(room), std::vector<Aabb>(room / entry_block + 1), 0, 0, view};
+        const std::size_t blocks = (room + entry_block - 1) / entry_block;
+        Compacted c{headers, std::vector<EntryBlock>(blocks), std::vector<Aabb>(blocks), 0, 0, view};
         c.view.headers = c.headers.data();
-        c.view.entries = c.entries.data();
+        c.view.entry_blocks = c.entry_blocks.data();
         c.view.block_bounds = c.block_bounds.data();
         c.view.entries_used = &c.used;
         c.view.entry_capacity = static_cast<std::uint32_t>(room);
@@ -190,7 +191,7 @@ struct TestTable {
         const Compacted c = compacted(ids.size());
         EXPECT_EQ(c.failure, 0u);
         EveryEntry collect;
-        grid_for_each_in_cell(c.view, cell, 0u, any_object, everywhere, collect);
+        grid_for_each_in_cell(c.view, cell, 0u, any_object, everywhere, 0u, collect);
         return collect.found;
     }
 };
@@ -298,7 +299,7 @@ TEST(BucketTable, CompactionThatDoesNotFitSaysSoAndLeavesEmptyCells) {
     const auto short_of_room = table.compacted(25);
     EXPECT_EQ(short_of_room.failure, static_cast<std::uint32_t>(grid_entries_full));
     EveryEntry readable;
-    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, 0u, any_object, everywhere, readable);
+    for (std::uint32_t x = 0; x < 3; ++x) grid_for_each_in_cell(short_of_room.view, CellCoord{x, 0, 0, 0}, 0u, any_object, everywhere, 0u, readable);
     EXPECT_EQ(readable.found.size(), 20u); // two cells of ten fit; the third reads as empty
     for (std::uint32_t id : readable.found) EXPECT_LT(id, 30u);
 }
@@ -320,13 +321,13 @@ TEST(BucketTable, CompactedCellsListTheirIdsInOrderAndSkipTheSmallerOnes) {
     std::sort(ids.begin(), ids.end());
     for (std::uint32_t first_id : {0u, 1u, 2u, 50u, 52u, 109u, 110u, 1000u}) {
         InOrder visit;
-        grid_for_each_in_cell(c.view, cell, first_id, any_object, everywhere, visit);
+        grid_for_each_in_cell(c.view, cell, first_id, any_object, everywhere, 0u, visit);
         const std::vector<std::uint32_t> expected(std::lower_bound(ids.begin(), ids.end(), first_id), ids.end());
         EXPECT_EQ(visit.seen, expected) << "first_id " << first_id;
     }
 }
 
-TEST(BucketTable, QueriesSkipTheBlocksOfEntriesWhoseBoundMissesTheirBox) {
+TEST(BucketTable, QueriesVisitExactlyTheEntriesWhoseBoxesOverlapTheirsAndBlocksBoundTheirEntries) {
     // Two cells whose lists interleave in memory with blocks; entry i's box spans x in [i, i + 0.5].
     TestTable table(64, 4, 64, 32, HashFunction::djb2);
     const CellCoord row{1, 1, 1, 0}, other{9, 9, 9, 0};
@@ -337,23 +338,63 @@ TEST(BucketTable, QueriesSkipTheBlocksOfEntriesWhoseBoundMissesTheirBox) {
         return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
     });
     ASSERT_EQ(c.failure, 0u);
+    // Each block's bound is the union of its entries' boxes (what lets a query skip it unread).
+    for (std::uint32_t block = 0; block < c.block_bounds.size(); ++block) {
+        Aabb expected{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+        for (std::uint32_t k = block * entry_block; k < std::min(c.used, (block + 1) * entry_block); ++k) {
+            const GridEntry e = load_entry(c.view, k);
+            expected.lo = min_v(expected.lo, e.box.lo);
+            expected.hi = max_v(expected.hi, e.box.hi);
+        }
+        EXPECT_EQ(c.block_bounds[block].lo.x, expected.lo.x) << block;
+        EXPECT_EQ(c.block_bounds[block].hi.x, expected.hi.x) << block;
+        EXPECT_EQ(c.block_bounds[block].hi.y, expected.hi.y) << block;
+    }
     struct Seen {
-        std::set<std::uint32_t> ids;
-        void operator()(const GridEntry& e) { ids.insert(e.id()); }
+        std::vector<std::uint32_t> ids;
+        void operator()(const GridEntry& e) { ids.push_back(e.id()); }
     };
     for (std::uint32_t first_id : {0u, 11u, 30u}) {
         const Aabb query{{10.2f, 0.5f, 0.5f}, {21.7f, 0.6f, 0.6f}};
         Seen seen;
-        grid_for_each_in_cell(c.view, row, first_id, any_object, query, seen);
-        for (std::uint32_t i = std::max(first_id, 10u); i <= 21; ++i) EXPECT_TRUE(seen.ids.count(i)) << i;
-        for (std::uint32_t id : seen.ids) EXPECT_GE(id, first_id);
-        // Blocks are 8 entries: at most the blocks that hold 10 to 21 are read, whatever the alignment.
-        EXPECT_LE(seen.ids.size(), 12u + 2 * (entry_block - 1)) << first_id;
-        EXPECT_FALSE(seen.ids.count(40)) << first_id;
+        grid_for_each_in_cell(c.view, row, first_id, any_object, query, 0u, seen);
+        std::vector<std::uint32_t> expected;
+        for (std::uint32_t i = std::max(first_id, 10u); i <= 21; ++i) expected.push_back(i);
+        EXPECT_EQ(seen.ids, expected) << first_id;
+    }
+    // Boxes that only touch the query's count (closed boxes), in every lane of a block.
+    for (std::uint32_t i = 0; i < 60; ++i) {
+        const float x = static_cast<float>(i);
+        const Aabb touching{{x + 0.5f, 1.0f, 1.0f}, {x + 0.75f, 2.0f, 2.0f}};
+        Seen seen;
+        grid_for_each_in_cell(c.view, row, 0u, any_object, touching, 0u, seen);
+        EXPECT_EQ(seen.ids, std::vector<std::uint32_t>{i}) << i;
     }
     Seen everything;
-    grid_for_each_in_cell(c.view, row, 0u, any_object, everywhere, everything);
+    grid_for_each_in_cell(c.view, row, 0u, any_object, everywhere, 0u, everything);
     EXPECT_EQ(everything.ids.size(), 60u);
+}
+
+TEST(BucketTable, QueriesPassOnlyTheEntriesWhoseBoxesStartAlongTheRequiredAxes) {
+    // 70 ids across a chain of buckets, id i starting along the axes i % 8; every subset asked for.
+    TestTable table(64, 4, 64, 32, HashFunction::morton);
+    const CellCoord cell{3, 1, 4, 0};
+    for (std::uint32_t i = 0; i < 70; ++i) ASSERT_TRUE(grid_insert(table.view, cell, 5 * i, i % 8u));
+    const auto c = table.compacted(70);
+    ASSERT_EQ(c.failure, 0u);
+    struct Seen {
+        std::vector<std::uint32_t> ids;
+        void operator()(const GridEntry& e) { ids.push_back(e.id()); }
+    };
+    for (std::uint32_t required = 0; required < 8; ++required)
+        for (std::uint32_t first_id : {0u, 7u, 100u}) {
+            Seen seen;
+            grid_for_each_in_cell(c.view, cell, first_id, any_object, everywhere, required, seen);
+            std::vector<std::uint32_t> expected;
+            for (std::uint32_t i = 0; i < 70; ++i)
+                if (5 * i >= first_id && ((i % 8u) & required) == required) expected.push_back(5 * i);
+            EXPECT_EQ(seen.ids, expected) << "required " << required << ", first_id " << first_id;
+        }
 }
 
 TEST(BucketTable, CompactedEntriesKeepTheirStartBitsAndSortByIdAlone) {
@@ -374,7 +415,7 @@ TEST(BucketTable, CompactedEntriesKeepTheirStartBitsAndSortByIdAlone) {
         }
     };
     InOrder visit;
-    grid_for_each_in_cell(c.view, cell, grid_id_mask - 20, any_object, everywhere, visit);
+    grid_for_each_in_cell(c.view, cell, grid_id_mask - 20, any_object, everywhere, 0u, visit);
     std::sort(ids.begin(), ids.end());
     EXPECT_EQ(visit.seen, std::vector<std::uint32_t>(std::lower_bound(ids.begin(), ids.end(), grid_id_mask - 20), ids.end()));
 }
@@ -395,7 +436,7 @@ TEST(BucketTable, ACellHoldingNoneOfTheObjectsAskedForIsSkippedUnread) {
     };
     const auto visited = [&](CellCoord cell, std::uint32_t objects) {
         Count count;
-        grid_for_each_in_cell(c.view, cell, 0u, objects, everywhere, count);
+        grid_for_each_in_cell(c.view, cell, 0u, objects, everywhere, 0u, count);
         return count.n;
     };
     EXPECT_EQ(visited(mixed, object_bit(5)), 12u);

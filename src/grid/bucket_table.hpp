@@ -62,8 +62,8 @@ constexpr std::uint32_t grid_id_mask = (1u << grid_id_bits) - 1u;
 /// @brief An id with its start bits, as a bucket stores it.
 KDET_HD inline std::uint32_t tag_starts(std::uint32_t id, std::uint32_t starts) { return id | starts << grid_id_bits; }
 
-/// @brief One id of a compacted cell with what a query filters on, so that scanning a cell reads
-/// one contiguous list instead of each id's data wherever it lies.
+/// @brief One id of a compacted cell with what a query filters on: what CompactCells takes for each
+/// id, and what a query's visitor gets for each entry that passes.
 struct GridEntry {
     Aabb box;
     std::uint32_t id_and_starts; ///< tag_starts(id, starts)
@@ -72,17 +72,28 @@ struct GridEntry {
     KDET_HD std::uint32_t starts() const { return id_and_starts >> grid_id_bits; }
 };
 
-/// @brief Entries of the compacted lists per block: block b bounds the boxes of entries
-/// [b * entry_block, (b + 1) * entry_block), whatever lists they belong to, so that a query skips the
-/// entries of a block whose bound misses its box without reading them.
+/// @brief Entries of the compacted lists per block: block b holds entries [b * entry_block,
+/// (b + 1) * entry_block), whatever lists they belong to, and bounds their boxes, so that a query
+/// skips the entries of a block whose bound misses its box without reading them.
 constexpr std::uint32_t entry_block = 8;
+
+/// @brief The compacted lists' entries, entry_block at a time, each field a row with a lane per
+/// entry (entry k is lane k % entry_block of block k / entry_block): a query tests the boxes and
+/// start bits of a whole block at once, which the host does in vector instructions without a branch
+/// per entry. 32 bytes per entry, as a GridEntry.
+struct EntryBlock {
+    float lo[3][entry_block];
+    float hi[3][entry_block];
+    std::uint32_t id_and_starts[entry_block];
+    std::uint32_t object[entry_block];
+};
 
 /// @brief A plain view of the table's buffers, passed by value into per-element code.
 struct GridView {
     BucketHeader* headers;          ///< slot_count main buckets, then overflow_capacity pool buckets
     std::uint32_t* ids;             ///< bucket_capacity ids per bucket
-    GridEntry* entries;             ///< the compacted cells' lists
-    Aabb* block_bounds;             ///< [entry_capacity / entry_block rounded up] the bound of each block of entries
+    EntryBlock* entry_blocks;       ///< the compacted cells' lists, [entry_capacity / entry_block rounded up]
+    Aabb* block_bounds;             ///< the bound of each block of entries
     std::uint32_t* entries_used;
     std::uint32_t entry_capacity;
     std::uint32_t* overflow_used;   ///< pool buckets handed out this frame
@@ -172,6 +183,19 @@ KDET_HD inline std::uint32_t grid_find(const GridView& g, CellCoord cell) {
     return no_bucket;
 }
 
+/// @brief The id (with its start bits) of entry k of the compacted lists.
+KDET_HD inline std::uint32_t& entry_id_and_starts(const GridView& g, std::uint32_t k) {
+    return g.entry_blocks[k / entry_block].id_and_starts[k % entry_block];
+}
+
+/// @brief Entry k of the compacted lists, gathered from its block's rows.
+KDET_HD inline GridEntry load_entry(const GridView& g, std::uint32_t k) {
+    const EntryBlock& b = g.entry_blocks[k / entry_block];
+    const std::uint32_t i = k % entry_block;
+    return GridEntry{Aabb{{b.lo[0][i], b.lo[1][i], b.lo[2][i]}, {b.hi[0][i], b.hi[1][i], b.hi[2][i]}},
+                     b.id_and_starts[i], b.object[i]};
+}
+
 /// @brief Copies the ids of the cell whose main bucket is `slot` (if it is occupied this frame) into
 /// one list of entries, entry_of(id) each with the id's start bits, sorted by id, and points the main
 /// bucket at it. When the list does not fit, the cell reads as empty and grid_entries_full is set:
@@ -191,23 +215,35 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
         main.objects = 0;
         return;
     }
-    std::uint32_t k = first, objects = 0;
+    const std::uint32_t end = first + total;
+    std::uint32_t k = first;
     for (std::uint32_t b = slot; b != no_bucket; b = g.headers[b].next) {
         const std::uint32_t n = g.headers[b].count < g.bucket_capacity ? g.headers[b].count : g.bucket_capacity;
         const std::uint32_t* ids = g.ids + static_cast<std::uint64_t>(b) * g.bucket_capacity;
-        for (std::uint32_t i = 0; i < n; ++i) {
-            GridEntry e = entry_of(ids[i] & grid_id_mask);
-            e.id_and_starts = ids[i];
-            objects |= object_bit(e.object);
-            g.entries[k++] = e;
-        }
+        for (std::uint32_t i = 0; i < n; ++i) entry_id_and_starts(g, k++) = ids[i];
     }
-    // Insertion sort: threads populate in about id order, so few entries move.
-    for (std::uint32_t i = first + 1; i < first + total; ++i) {
-        const GridEntry e = g.entries[i];
+    // The ids alone sorted first, by insertion (threads populate in about id order, so few move);
+    // then each entry's box and object filled in beside its id.
+    for (std::uint32_t i = first + 1; i < end; ++i) {
+        const std::uint32_t tagged = entry_id_and_starts(g, i);
         std::uint32_t j = i;
-        for (; j > first && g.entries[j - 1].id() > e.id(); --j) g.entries[j] = g.entries[j - 1];
-        g.entries[j] = e;
+        for (; j > first && (entry_id_and_starts(g, j - 1) & grid_id_mask) > (tagged & grid_id_mask); --j)
+            entry_id_and_starts(g, j) = entry_id_and_starts(g, j - 1);
+        entry_id_and_starts(g, j) = tagged;
+    }
+    std::uint32_t objects = 0;
+    for (k = first; k < end; ++k) {
+        EntryBlock& block = g.entry_blocks[k / entry_block];
+        const std::uint32_t i = k % entry_block;
+        const GridEntry e = entry_of(block.id_and_starts[i] & grid_id_mask);
+        block.lo[0][i] = e.box.lo.x;
+        block.lo[1][i] = e.box.lo.y;
+        block.lo[2][i] = e.box.lo.z;
+        block.hi[0][i] = e.box.hi.x;
+        block.hi[1][i] = e.box.hi.y;
+        block.hi[2][i] = e.box.hi.z;
+        block.object[i] = e.object;
+        objects |= object_bit(e.object);
     }
     main.count = total;
     main.first_entry = first;
@@ -221,45 +257,73 @@ KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, st
     if (used > g.entry_capacity) used = g.entry_capacity;
     const std::uint32_t begin = block * entry_block;
     if (begin >= used) return;
-    const std::uint32_t end = used - begin < entry_block ? used : begin + entry_block;
-    Aabb bound = g.entries[begin].box;
-    for (std::uint32_t k = begin + 1; k < end; ++k) {
-        bound.lo = min_v(bound.lo, g.entries[k].box.lo);
-        bound.hi = max_v(bound.hi, g.entries[k].box.hi);
+    const std::uint32_t lanes = used - begin < entry_block ? used - begin : entry_block;
+    const EntryBlock& b = g.entry_blocks[block];
+    Aabb bound{{b.lo[0][0], b.lo[1][0], b.lo[2][0]}, {b.hi[0][0], b.hi[1][0], b.hi[2][0]}};
+    for (std::uint32_t i = 1; i < lanes; ++i) {
+        bound.lo = min_v(bound.lo, vec3{b.lo[0][i], b.lo[1][i], b.lo[2][i]});
+        bound.hi = max_v(bound.hi, vec3{b.hi[0][i], b.hi[1][i], b.hi[2][i]});
     }
     g.block_bounds[block] = bound;
 }
 
-/// @brief Calls visit(entry) for every entry of `cell` whose id is at least `first_id` and whose box
-/// may overlap `box`, once the table is compacted, unless the cell holds none of the `objects`
-/// (object_bit of each, or any_object): the smaller ids are skipped by a binary search, and the
-/// entries of a block whose bound misses `box` without being read (the visitor still tests each box
-/// and object it gets).
+/// @brief The lanes of a block whose boxes overlap `box` and whose start bits include `required_starts`,
+/// as a mask (bit i for lane i). Every lane is computed, without a branch, so that the host's compiler
+/// turns the loop into a few vector instructions per block where a branch per entry mispredicts about
+/// as often as a box overlaps; the caller masks the lanes outside its list.
+KDET_HD inline std::uint32_t matching_lanes(const EntryBlock& b, const Aabb& box, std::uint32_t required_starts) {
+    const std::uint32_t lane_bit[entry_block] = {1u, 2u, 4u, 8u, 16u, 32u, 64u, 128u};
+    std::uint32_t mask = 0;
+    KDET_VECTOR_LOOP
+    for (std::uint32_t i = 0; i < entry_block; ++i) {
+        const bool overlaps = (b.lo[0][i] <= box.hi.x) & (box.lo.x <= b.hi[0][i]) & (b.lo[1][i] <= box.hi.y) &
+                              (box.lo.y <= b.hi[1][i]) & (b.lo[2][i] <= box.hi.z) & (box.lo.z <= b.hi[2][i]);
+        const bool starts = ((b.id_and_starts[i] >> grid_id_bits) & required_starts) == required_starts;
+        mask |= overlaps & starts ? lane_bit[i] : 0u;
+    }
+    return mask;
+}
+
+/// @brief Index of the lowest set bit of a non-zero mask.
+KDET_HD inline std::uint32_t lowest_bit(std::uint32_t mask) {
+#if defined(__CUDA_ARCH__)
+    return static_cast<std::uint32_t>(__ffs(static_cast<int>(mask)) - 1);
+#else
+    return static_cast<std::uint32_t>(__builtin_ctz(mask));
+#endif
+}
+
+/// @brief Calls visit(entry) for every entry of `cell` whose id is at least `first_id`, whose box
+/// overlaps `box` and whose start bits include `required_starts` (see GridEntry::starts), once the
+/// table is compacted, unless the cell holds none of the `objects` (object_bit of each, or
+/// any_object): the smaller ids are skipped by a binary search, and the entries of a block whose bound
+/// misses `box` without being read. The visitor checks the entry's object itself.
 template <class Visitor>
 KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std::uint32_t first_id, std::uint32_t objects,
-                                          const Aabb& box, Visitor& visit) {
+                                          const Aabb& box, std::uint32_t required_starts, Visitor& visit) {
     const std::uint32_t bucket = grid_find(g, cell);
     if (bucket == no_bucket || !(g.headers[bucket].objects & objects)) return;
     const std::uint32_t first = g.headers[bucket].first_entry;
-    const GridEntry* entries = g.entries + first;
-    const std::uint32_t n = g.headers[bucket].count;
-    std::uint32_t begin = 0;
-    for (std::uint32_t end = n; begin < end;) {
-        const std::uint32_t middle = begin + (end - begin) / 2;
-        if (entries[middle].id() < first_id)
+    const std::uint32_t end = first + g.headers[bucket].count;
+    std::uint32_t begin = first;
+    for (std::uint32_t high = end; begin < high;) {
+        const std::uint32_t middle = begin + (high - begin) / 2;
+        if ((entry_id_and_starts(g, middle) & grid_id_mask) < first_id)
             begin = middle + 1;
         else
-            end = middle;
+            high = middle;
     }
-    for (std::uint32_t k = begin; k < n;) {
-        const std::uint32_t block = (first + k) / entry_block;
-        const std::uint32_t block_end = (block + 1) * entry_block - first;
-        const std::uint32_t end = block_end < n ? block_end : n;
-        if (!boxes_overlap(box, g.block_bounds[block])) {
-            k = end;
-            continue;
+    if (begin == end) return;
+    for (std::uint32_t block = begin / entry_block, last = (end - 1) / entry_block; block <= last; ++block) {
+        if (!boxes_overlap(box, g.block_bounds[block])) continue;
+        std::uint32_t mask = matching_lanes(g.entry_blocks[block], box, required_starts);
+        const std::uint32_t base = block * entry_block;
+        if (base < begin) mask &= ~0u << (begin - base);
+        if (end - base < entry_block) mask &= (1u << (end - base)) - 1u;
+        while (mask) {
+            visit(load_entry(g, base + lowest_bit(mask)));
+            mask &= mask - 1u;
         }
-        for (; k < end; ++k) visit(entries[k]);
     }
 }
 

@@ -371,6 +371,19 @@ struct BoundEntryBlocksKernel {
     }
 };
 
+/// @brief Passes on the entries whose object t's object is checked against.
+template <class Visitor>
+struct ObjectFilter {
+    /// t's object's row of the active pairs: one load per entry, where pair_is_active would reload
+    /// the scene's fields for each (the visitor's stores keep the compiler from hoisting them).
+    const std::uint8_t* checked_against;
+    Visitor* visit;
+
+    KDET_HD void operator()(const GridEntry& e) const {
+        if (checked_against[e.object]) (*visit)(e);
+    }
+};
+
 /// @brief Calls visit(entry) once for every tet u (entry.id) that tet t must test, with what the
 /// cell's list holds about u (box, object): u is stored in a cell that t's
 /// box overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
@@ -382,25 +395,8 @@ struct BoundEntryBlocksKernel {
 /// holding the lower corner of the boxes' intersection. That corner is max(t.lo, u.lo) per axis, and
 /// cell indices are monotone, so its cell is max(t's first cell, u's first cell): inside both ranges,
 /// hence always visited. No duplicates are written, so the candidate buffer holds unique pairs. Along
-/// an axis where the cell is not t's first, it must be u's: the entry says so (GridEntry::starts).
-template <class Visitor>
-struct LargerNeighbourFilter {
-    /// t's object's row of the active pairs: one load per entry, where pair_is_active would reload
-    /// the scene's fields for each (the visitor's stores keep the compiler from hoisting them).
-    const std::uint8_t* checked_against;
-    Aabb box;
-    Visitor* visit;
-    /// Bit a set when the cell being visited is not t's first along axis a: there the pair is
-    /// reported only if u's box starts in the cell.
-    std::uint32_t required_starts;
-
-    KDET_HD void operator()(const GridEntry& e) const {
-        if (!checked_against[e.object]) return;
-        if ((e.starts() & required_starts) != required_starts) return;
-        if (boxes_overlap(box, e.box)) (*visit)(e);
-    }
-};
-
+/// an axis where the cell is not t's first, it must be u's: the entry says so (GridEntry::starts),
+/// and the cell's scan passes only such entries.
 template <class Visitor>
 KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const GridView& grid, const GridParams& params,
                                              std::uint32_t layer_mask, std::uint32_t t, Visitor& visit) {
@@ -409,7 +405,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     const std::uint32_t object = scene.tet_object[t];
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
     const std::uint32_t checked_objects = scene.checked_objects[object];
-    LargerNeighbourFilter<Visitor> filter{checked_against, self.box, &visit, 0};
+    ObjectFilter<Visitor> filter{checked_against, &visit};
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
         // A cell holds only tets of its own layer: on t's, the larger tets are the higher ids, and the
@@ -419,8 +415,10 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    filter.required_starts = ~first_cell_axes(r, x, y, z) & 7u;
-                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, checked_objects, self.box, filter);
+                    // Along an axis where this is not t's first cell, u's box must start here.
+                    const std::uint32_t required_starts = ~first_cell_axes(r, x, y, z) & 7u;
+                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, checked_objects, self.box,
+                                          required_starts, filter);
                     if (visit.finished()) return;
                 }
     }
