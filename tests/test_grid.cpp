@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <set>
 #include <tuple>
@@ -153,7 +154,7 @@ struct TestTable {
         : headers(slots + pool, BucketHeader{}), ids(static_cast<std::size_t>(slots + pool) * capacity) {
         std::uint32_t bits = 0;
         while ((1u << bits) < slots) ++bits;
-        view = GridView{headers.data(), ids.data(), nullptr, nullptr, nullptr, 0, &overflow_used, &failure, &claimed,
+        view = GridView{headers.data(), ids.data(), nullptr, nullptr, nullptr, nullptr, 0, &overflow_used, &failure, &claimed,
                         slots, bits, capacity, pool, 1, probes, hash};
     }
     /// A compacted copy of the table (the table itself stays open for inserts), with room for
@@ -311,7 +312,7 @@ TEST(BucketTable, CompactedCellsListTheirIdsInOrderAndSkipTheSmallerOnes) {
     for (std::uint32_t i = 0; i < ids.size(); ++i) ids[i] = 3 * i + 1;
     std::shuffle(ids.begin(), ids.end(), std::mt19937(11));
     const CellCoord cell{2, 0, 5, 1};
-    for (std::uint32_t id : ids) ASSERT_TRUE(grid_insert(table.view, cell, id, 0u));
+    for (std::uint32_t id : ids) ASSERT_NE(grid_insert(table.view, cell, id, 0u), no_bucket);
     const auto c = table.compacted(ids.size());
     ASSERT_EQ(c.failure, 0u);
     struct InOrder {
@@ -331,8 +332,8 @@ TEST(BucketTable, QueriesVisitExactlyTheEntriesWhoseBoxesOverlapTheirsAndBlocksB
     // Two cells whose lists interleave in memory with blocks; entry i's box spans x in [i, i + 0.5].
     TestTable table(64, 4, 64, 32, HashFunction::djb2);
     const CellCoord row{1, 1, 1, 0}, other{9, 9, 9, 0};
-    for (std::uint32_t i = 0; i < 60; ++i) ASSERT_TRUE(grid_insert(table.view, row, i, 0u));
-    for (std::uint32_t i = 100; i < 105; ++i) ASSERT_TRUE(grid_insert(table.view, other, i, 0u));
+    for (std::uint32_t i = 0; i < 60; ++i) ASSERT_NE(grid_insert(table.view, row, i, 0u), no_bucket);
+    for (std::uint32_t i = 100; i < 105; ++i) ASSERT_NE(grid_insert(table.view, other, i, 0u), no_bucket);
     const auto c = table.compacted(65, [](std::uint32_t id) {
         const float x = static_cast<float>(id);
         return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
@@ -379,7 +380,7 @@ TEST(BucketTable, QueriesPassOnlyTheEntriesWhoseBoxesStartAlongTheRequiredAxes) 
     // 70 ids across a chain of buckets, id i starting along the axes i % 8; every subset asked for.
     TestTable table(64, 4, 64, 32, HashFunction::morton);
     const CellCoord cell{3, 1, 4, 0};
-    for (std::uint32_t i = 0; i < 70; ++i) ASSERT_TRUE(grid_insert(table.view, cell, 5 * i, i % 8u));
+    for (std::uint32_t i = 0; i < 70; ++i) ASSERT_NE(grid_insert(table.view, cell, 5 * i, i % 8u), no_bucket);
     const auto c = table.compacted(70);
     ASSERT_EQ(c.failure, 0u);
     struct Seen {
@@ -397,13 +398,66 @@ TEST(BucketTable, QueriesPassOnlyTheEntriesWhoseBoxesStartAlongTheRequiredAxes) 
         }
 }
 
+TEST(BucketTable, OwnCellRowsStartWhereTheLookupAndBinarySearchAfterTheTetDo) {
+    // 40 tets whose ranges of 2 x 2 x 1 cells overlap their neighbours', inserted in a shuffled order as
+    // populating inserts them (start bits included); each records its main buckets in its row, and
+    // compacting records where its entries lie.
+    TestTable table(256, 4, 256, 32, HashFunction::djb2);
+    std::vector<OwnCells> rows(40);
+    table.view.own_cells = rows.data();
+    const auto range_of = [](std::uint32_t id) { return CellRange{{id / 3, id % 2, 5}, {id / 3 + 1, id % 2 + 1, 5}}; };
+    std::vector<std::uint32_t> order(40);
+    std::iota(order.begin(), order.end(), 0u);
+    std::shuffle(order.begin(), order.end(), std::mt19937(5));
+    for (std::uint32_t id : order) {
+        const CellRange r = range_of(id);
+        ASSERT_TRUE(has_own_cells(r));
+        for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+            for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
+                const std::uint32_t bucket = grid_insert(table.view, make_cell(x, y, 5, 0), id, first_cell_axes(r, x, y, 5));
+                ASSERT_NE(bucket, no_bucket);
+                rows[id].bucket[own_cell_index(r, x, y, 5)] = bucket;
+            }
+    }
+    const auto c = table.compacted(160);
+    ASSERT_EQ(c.failure, 0u);
+    struct Seen {
+        std::vector<std::uint32_t> ids;
+        void operator()(const GridEntry& e) { ids.push_back(e.id()); }
+    };
+    std::size_t visited = 0;
+    for (std::uint32_t id = 0; id < 40; ++id) {
+        const CellRange r = range_of(id);
+        for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+            for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
+                for (std::uint32_t required : {0u, 1u, 3u, 7u}) {
+                    Seen by_row, by_lookup;
+                    grid_for_each_after_own_entry(c.view, id, own_cell_index(r, x, y, 5), any_object, everywhere, required, by_row);
+                    grid_for_each_in_cell(c.view, make_cell(x, y, 5, 0), id + 1, any_object, everywhere, required, by_lookup);
+                    EXPECT_EQ(by_row.ids, by_lookup.ids) << "tet " << id << " cell " << x << " " << y << " required " << required;
+                    visited += by_row.ids.size();
+                }
+    }
+    EXPECT_GT(visited, 200u);
+    // Under a later frame's stamp every header of this frame is stale, though it still holds its list:
+    // the rows (as a frame whose grid failed before populating would find them) read nothing.
+    GridView later = c.view;
+    ++later.stamp;
+    for (std::uint32_t id = 0; id < 40; ++id)
+        for (std::uint32_t index = 0; index < 4; ++index) {
+            Seen stale;
+            grid_for_each_after_own_entry(later, id, index, any_object, everywhere, 0u, stale);
+            EXPECT_TRUE(stale.ids.empty()) << id << " " << index;
+        }
+}
+
 TEST(BucketTable, CompactedEntriesKeepTheirStartBitsAndSortByIdAlone) {
     TestTable table(64, 4, 64, 32, HashFunction::djb2);
     const CellCoord cell{4, 5, 6, 2};
     std::vector<std::uint32_t> ids(40);
     for (std::uint32_t i = 0; i < ids.size(); ++i) ids[i] = grid_id_mask - 2 * i; // the largest ids there are
     std::shuffle(ids.begin(), ids.end(), std::mt19937(3));
-    for (std::uint32_t id : ids) ASSERT_TRUE(grid_insert(table.view, cell, id, id % 8u));
+    for (std::uint32_t id : ids) ASSERT_NE(grid_insert(table.view, cell, id, id % 8u), no_bucket);
     const auto c = table.compacted(ids.size());
     ASSERT_EQ(c.failure, 0u);
     struct InOrder {
@@ -426,8 +480,8 @@ TEST(BucketTable, ACellHoldingNoneOfTheObjectsAskedForIsSkippedUnread) {
     // rejects such entries), which is allowed; a cell that may hold a wanted object is never skipped.
     TestTable table(64, 4, 64, 32, HashFunction::djb2);
     const CellCoord mixed{2, 3, 4, 1}, alone{7, 3, 4, 1};
-    for (std::uint32_t i = 0; i < 12; ++i) ASSERT_TRUE(grid_insert(table.view, mixed, i, 0u));
-    for (std::uint32_t i = 20; i < 26; ++i) ASSERT_TRUE(grid_insert(table.view, alone, i, 0u));
+    for (std::uint32_t i = 0; i < 12; ++i) ASSERT_NE(grid_insert(table.view, mixed, i, 0u), no_bucket);
+    for (std::uint32_t i = 20; i < 26; ++i) ASSERT_NE(grid_insert(table.view, alone, i, 0u), no_bucket);
     const auto c = table.compacted(18, [](std::uint32_t id) { return GridEntry{Aabb{}, id, id < 6 ? 5u : 3u}; });
     ASSERT_EQ(c.failure, 0u);
     struct Count {

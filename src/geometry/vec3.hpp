@@ -14,6 +14,14 @@
 #else
 #define KDET_NOINLINE __attribute__((noinline))
 #endif
+/// @brief Inlines a small step that a hot loop calls (KDET_ALWAYS_INLINE, in place of `inline`), so
+/// that what it computes from the loop's invariants is hoisted out of the loop, where GCC otherwise
+/// keeps a call and redoes that setup each time.
+#if defined(__CUDACC__)
+#define KDET_ALWAYS_INLINE __forceinline__
+#else
+#define KDET_ALWAYS_INLINE inline __attribute__((always_inline))
+#endif
 #if defined(__CUDA_ARCH__)
 #define KDET_NO_UNROLL _Pragma("unroll 1")
 #else

@@ -88,12 +88,35 @@ struct EntryBlock {
     std::uint32_t object[entry_block];
 };
 
+/// @brief Where a tet sits in the cells of its own layer, so that its queries there need neither a
+/// hash lookup nor a binary search: for cell lo + d of its range there (d.x + 2 d.y + 4 d.z, see
+/// own_cell_index), the cell's main bucket, written while populating, and the position just after the
+/// tet's entry in the cell's list, written while compacting. Kept for a tet whose range spans at most
+/// two cells along each axis (has_own_cells): every tet but those that rounding or the top layer's cap
+/// widens, which look their cells up.
+struct OwnCells {
+    std::uint32_t bucket[8];
+    std::uint32_t after[8];
+};
+
+KDET_HD inline bool has_own_cells(const CellRange& r) {
+    return r.hi[0] - r.lo[0] <= 1u && r.hi[1] - r.lo[1] <= 1u && r.hi[2] - r.lo[2] <= 1u;
+}
+
+/// @brief Index of cell (x, y, z) of range r in OwnCells, for a range with has_own_cells. The start
+/// bits of the tet's entry there say the same: bit a is set when d along a is 0 (own_cell_index_of).
+KDET_HD inline std::uint32_t own_cell_index(const CellRange& r, std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+    return (x - r.lo[0]) + 2u * (y - r.lo[1]) + 4u * (z - r.lo[2]);
+}
+KDET_HD inline std::uint32_t own_cell_index_of(std::uint32_t starts) { return ~starts & 7u; }
+
 /// @brief A plain view of the table's buffers, passed by value into per-element code.
 struct GridView {
     BucketHeader* headers;          ///< slot_count main buckets, then overflow_capacity pool buckets
     std::uint32_t* ids;             ///< bucket_capacity ids per bucket
     EntryBlock* entry_blocks;       ///< the compacted cells' lists, [entry_capacity / entry_block rounded up]
     Aabb* block_bounds;             ///< the bound of each block of entries
+    OwnCells* own_cells;            ///< [tets] for the pipeline's queries; null where none use them (the table's own tests)
     std::uint32_t* entries_used;
     std::uint32_t entry_capacity;
     std::uint32_t* overflow_used;   ///< pool buckets handed out this frame
@@ -164,10 +187,11 @@ KDET_HD inline bool append_to_chain(const GridView& g, std::uint32_t bucket, std
 }
 
 /// @brief Inserts `id` into `cell`, with the axes along which its box starts there (`starts`, bit a
-/// for axis a); false (with a failure bit set) when the table must grow.
-KDET_HD inline bool grid_insert(const GridView& g, CellCoord cell, std::uint32_t id, std::uint32_t starts) {
+/// for axis a); returns the cell's main bucket, or no_bucket (with a failure bit set) when the table
+/// must grow.
+KDET_HD inline std::uint32_t grid_insert(const GridView& g, CellCoord cell, std::uint32_t id, std::uint32_t starts) {
     const std::uint32_t bucket = claim_bucket(g, cell);
-    return bucket != no_bucket && append_to_chain(g, bucket, tag_starts(id, starts));
+    return bucket != no_bucket && append_to_chain(g, bucket, tag_starts(id, starts)) ? bucket : no_bucket;
 }
 
 /// @brief Main bucket of `cell` after populating, or no_bucket when the cell is empty.
@@ -189,7 +213,7 @@ KDET_HD inline std::uint32_t& entry_id_and_starts(const GridView& g, std::uint32
 }
 
 /// @brief Entry k of the compacted lists, gathered from its block's rows.
-KDET_HD inline GridEntry load_entry(const GridView& g, std::uint32_t k) {
+KDET_HD KDET_ALWAYS_INLINE GridEntry load_entry(const GridView& g, std::uint32_t k) {
     const EntryBlock& b = g.entry_blocks[k / entry_block];
     const std::uint32_t i = k % entry_block;
     return GridEntry{Aabb{{b.lo[0][i], b.lo[1][i], b.lo[2][i]}, {b.hi[0][i], b.hi[1][i], b.hi[2][i]}},
@@ -244,6 +268,10 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
         block.hi[2][i] = e.box.hi.z;
         block.object[i] = e.object;
         objects |= object_bit(e.object);
+        if (g.own_cells) {
+            const std::uint32_t tagged = block.id_and_starts[i];
+            g.own_cells[tagged & grid_id_mask].after[own_cell_index_of(tagged >> grid_id_bits)] = k + 1;
+        }
     }
     main.count = total;
     main.first_entry = first;
@@ -271,7 +299,7 @@ KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, st
 /// as a mask (bit i for lane i). Every lane is computed, without a branch, so that the host's compiler
 /// turns the loop into a few vector instructions per block where a branch per entry mispredicts about
 /// as often as a box overlaps; the caller masks the lanes outside its list.
-KDET_HD inline std::uint32_t matching_lanes(const EntryBlock& b, const Aabb& box, std::uint32_t required_starts) {
+KDET_HD KDET_ALWAYS_INLINE std::uint32_t matching_lanes(const EntryBlock& b, const Aabb& box, std::uint32_t required_starts) {
     const std::uint32_t lane_bit[entry_block] = {1u, 2u, 4u, 8u, 16u, 32u, 64u, 128u};
     std::uint32_t mask = 0;
     KDET_VECTOR_LOOP
@@ -293,11 +321,30 @@ KDET_HD inline std::uint32_t lowest_bit(std::uint32_t mask) {
 #endif
 }
 
+/// @brief Calls visit(entry) for every entry k in [begin, end) of the compacted lists (begin < end) whose
+/// box overlaps `box` and whose start bits include `required_starts` (see GridEntry::starts); the
+/// entries of a block whose bound misses `box` are not read.
+template <class Visitor>
+KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t begin, std::uint32_t end, const Aabb& box,
+                                             std::uint32_t required_starts, Visitor& visit) {
+    for (std::uint32_t block = begin / entry_block, last = (end - 1) / entry_block; block <= last; ++block) {
+        if (!boxes_overlap(box, g.block_bounds[block])) continue;
+        std::uint32_t mask = matching_lanes(g.entry_blocks[block], box, required_starts);
+        const std::uint32_t base = block * entry_block;
+        if (base < begin) mask &= ~0u << (begin - base);
+        if (end - base < entry_block) mask &= (1u << (end - base)) - 1u;
+        while (mask) {
+            visit(load_entry(g, base + lowest_bit(mask)));
+            mask &= mask - 1u;
+        }
+    }
+}
+
 /// @brief Calls visit(entry) for every entry of `cell` whose id is at least `first_id`, whose box
-/// overlaps `box` and whose start bits include `required_starts` (see GridEntry::starts), once the
-/// table is compacted, unless the cell holds none of the `objects` (object_bit of each, or
-/// any_object): the smaller ids are skipped by a binary search, and the entries of a block whose bound
-/// misses `box` without being read. The visitor checks the entry's object itself.
+/// overlaps `box` and whose start bits include `required_starts`, once the table is compacted, unless
+/// the cell holds none of the `objects` (object_bit of each, or any_object): the smaller ids are
+/// skipped by a binary search (grid_for_each_in_entries for the rest). The visitor checks the entry's
+/// object itself.
 template <class Visitor>
 KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std::uint32_t first_id, std::uint32_t objects,
                                           const Aabb& box, std::uint32_t required_starts, Visitor& visit) {
@@ -313,18 +360,24 @@ KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std
         else
             high = middle;
     }
-    if (begin == end) return;
-    for (std::uint32_t block = begin / entry_block, last = (end - 1) / entry_block; block <= last; ++block) {
-        if (!boxes_overlap(box, g.block_bounds[block])) continue;
-        std::uint32_t mask = matching_lanes(g.entry_blocks[block], box, required_starts);
-        const std::uint32_t base = block * entry_block;
-        if (base < begin) mask &= ~0u << (begin - base);
-        if (end - base < entry_block) mask &= (1u << (end - base)) - 1u;
-        while (mask) {
-            visit(load_entry(g, base + lowest_bit(mask)));
-            mask &= mask - 1u;
-        }
-    }
+    if (begin < end) grid_for_each_in_entries(g, begin, end, box, required_starts, visit);
+}
+
+/// @brief grid_for_each_in_cell on cell `index` of tet `id`'s own cells (OwnCells) with first_id
+/// id + 1, found through the tet's row. A row left over from an earlier frame (when this frame's grid
+/// failed and will run again) reads only entries of this frame's lists.
+template <class Visitor>
+KDET_HD inline void grid_for_each_after_own_entry(const GridView& g, std::uint32_t id, std::uint32_t index,
+                                                  std::uint32_t objects, const Aabb& box, std::uint32_t required_starts,
+                                                  Visitor& visit) {
+    const OwnCells& row = g.own_cells[id];
+    const std::uint32_t bucket = row.bucket[index];
+    if (bucket >= g.slot_count) return;
+    const BucketHeader& h = g.headers[bucket];
+    if ((h.state >> 1) != g.stamp || !(h.objects & objects)) return;
+    const std::uint32_t first = h.first_entry, end = first + h.count;
+    const std::uint32_t begin = row.after[index] > first ? row.after[index] : first;
+    if (begin < end) grid_for_each_in_entries(g, begin, end, box, required_starts, visit);
 }
 
 } // namespace kdet

@@ -339,11 +339,15 @@ struct PopulateKernel {
         const TetInfo& info = scene.info[t];
         if (info.layer < 0 || atomic_load_acquire(grid.failure)) return;
         const CellRange r = cell_range(*params, info.box, info.layer);
+        const bool own_cells = has_own_cells(r);
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
-                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
-                    if (!grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t), first_cell_axes(r, x, y, z)))
-                        return;
+                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
+                    const std::uint32_t bucket = grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t),
+                                                             first_cell_axes(r, x, y, z));
+                    if (bucket == no_bucket) return;
+                    if (own_cells) grid.own_cells[t].bucket[own_cell_index(r, x, y, z)] = bucket;
+                }
     }
 };
 
@@ -409,16 +413,22 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     for (int layer = self.layer; layer < params.layer_count; ++layer) {
         if (!((layer_mask >> layer) & 1u)) continue;
         // A cell holds only tets of its own layer: on t's, the larger tets are the higher ids, and the
-        // sorted list skips the others unread; on a higher layer every tet is larger.
-        const std::uint32_t first_id = layer == self.layer ? t + 1 : 0u;
+        // sorted list skips the others unread (from t's own entry on, found through its row where it
+        // has one); on a higher layer every tet is larger.
+        const bool own_layer = layer == self.layer;
         const CellRange r = cell_range(params, self.box, layer);
+        const bool own_cells = own_layer && has_own_cells(r);
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                 for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
                     // Along an axis where this is not t's first cell, u's box must start here.
                     const std::uint32_t required_starts = ~first_cell_axes(r, x, y, z) & 7u;
-                    grid_for_each_in_cell(grid, make_cell(x, y, z, layer), first_id, checked_objects, self.box,
-                                          required_starts, filter);
+                    if (own_cells)
+                        grid_for_each_after_own_entry(grid, t, own_cell_index(r, x, y, z), checked_objects, self.box,
+                                                      required_starts, filter);
+                    else
+                        grid_for_each_in_cell(grid, make_cell(x, y, z, layer), own_layer ? t + 1 : 0u, checked_objects,
+                                              self.box, required_starts, filter);
                     if (visit.finished()) return;
                 }
     }

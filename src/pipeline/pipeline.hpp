@@ -128,7 +128,7 @@ public:
                info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
-               headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() + block_bounds_.capacity_bytes() +
+               headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() + block_bounds_.capacity_bytes() + own_cells_.capacity_bytes() +
                counters_.capacity_bytes() +
                candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
                resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
@@ -204,6 +204,7 @@ private:
     buffer<std::uint32_t> ids_;
     buffer<EntryBlock> entry_blocks_; ///< the compacted cells' lists
     buffer<Aabb> block_bounds_; ///< the bound of each block of entry_block entries
+    buffer<OwnCells> own_cells_; ///< per stored tet, where it sits in its own layer's cells
     buffer<FrameCounters> counters_;
     buffer<std::uint64_t> candidates_;
     buffer<std::uint64_t> candidates_grown_; ///< the next candidate buffer while one grows keeping its contents
@@ -331,7 +332,8 @@ GridView Pipeline<Exec>::populate() {
         // The lanes of the last block past the lists are read (and masked out) by every query there.
         fill(entry_blocks_, EntryBlock{});
     }
-    const GridView grid{headers_.data(), ids_.data(), entry_blocks_.data(), block_bounds_.data(), &c->grid_entries, entry_capacity_,
+    own_cells_.resize_discard(tets_.size());
+    const GridView grid{headers_.data(), ids_.data(), entry_blocks_.data(), block_bounds_.data(), own_cells_.data(), &c->grid_entries, entry_capacity_,
                         &c->overflow_used, &c->grid_failure, &c->cells_claimed, slot_count_, slot_bits, capacity,
                         overflow_capacity_, stamp_, 64u, options_.hash};
     exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, &c->params});
@@ -639,7 +641,7 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
         }
     }
     result.memory_bytes = memory_bytes();
-    result.grid_bytes = headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() + block_bounds_.capacity_bytes();
+    result.grid_bytes = headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() + block_bounds_.capacity_bytes() + own_cells_.capacity_bytes();
     result.candidate_bytes = candidates_.capacity_bytes();
     StageTimes& t = result.times;
     t = StageTimes{};
