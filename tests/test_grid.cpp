@@ -398,6 +398,27 @@ TEST(BucketTable, QueriesPassOnlyTheEntriesWhoseBoxesStartAlongTheRequiredAxes) 
         }
 }
 
+TEST(BucketTable, InsertsStartAtTheChainsLastBucketAndLeaveTheFullOnesAlone) {
+    // 50 ids into one cell of buckets of 4: 13 buckets, each filled to exactly its capacity (an insert
+    // that added to every full bucket's count on its way would leave the main bucket counting 50).
+    TestTable table(64, 4, 64, 32, HashFunction::simple);
+    const CellCoord cell{6, 6, 6, 2};
+    std::uint32_t main = no_bucket;
+    for (std::uint32_t i = 0; i < 50; ++i) {
+        main = grid_insert(table.view, cell, i, 0u);
+        ASSERT_NE(main, no_bucket);
+    }
+    std::vector<std::uint32_t> counts;
+    for (std::uint32_t b = main; b != no_bucket; b = table.headers[b].next) counts.push_back(table.headers[b].count);
+    std::vector<std::uint32_t> expected(12, 4u);
+    expected.push_back(2u);
+    EXPECT_EQ(counts, expected);
+    EXPECT_EQ(table.headers[main].tail, table.view.slot_count + 11u); // the 12th pool bucket is the last
+    std::multiset<std::uint32_t> all;
+    for (std::uint32_t i = 0; i < 50; ++i) all.insert(i);
+    EXPECT_EQ(table.contents(cell), all);
+}
+
 TEST(BucketTable, OwnCellRowsStartWhereTheLookupAndBinarySearchAfterTheTetDo) {
     // 40 tets whose ranges of 2 x 2 x 1 cells overlap their neighbours', inserted in a shuffled order as
     // populating inserts them (start bits included); each records its main buckets in its row, and

@@ -43,8 +43,12 @@ struct BucketHeader {
     /// Once compacted, on the main bucket: the objects its entries belong to, bit (object mod 32)
     /// (object_bit), so that a query checked against none of them skips the cell unread.
     std::uint32_t objects;
+    /// On the main bucket while populating: the last bucket chained to it so far (itself at first),
+    /// where inserts start instead of walking the chain's full buckets.
+    std::uint32_t tail;
     std::uint64_t key;
 };
+static_assert(sizeof(BucketHeader) == 32, "a table slot takes 32 bytes");
 
 /// @brief An object's bit in BucketHeader::objects and in the query's mask of objects it is checked
 /// against; objects 32 apart share a bit, which only costs a cell read for nothing.
@@ -145,6 +149,7 @@ KDET_HD inline std::uint32_t claim_bucket(const GridView& g, CellCoord cell) {
             h.key = key;
             h.count = 0;
             h.next = no_bucket;
+            h.tail = slot;
             atomic_store_release(&h.state, ready);
             atomic_fetch_add(g.cells_claimed, 1u);
             return slot;
@@ -157,14 +162,20 @@ KDET_HD inline std::uint32_t claim_bucket(const GridView& g, CellCoord cell) {
     return no_bucket;
 }
 
-/// @brief Appends `id` to the chain that starts at `bucket`, chaining pool buckets when full.
-KDET_HD inline bool append_to_chain(const GridView& g, std::uint32_t bucket, std::uint32_t id) {
+/// @brief Appends `id` to the chain of main bucket `main`, chaining pool buckets when full. It starts
+/// at the chain's last bucket as far as it is known (BucketHeader::tail) and passes a full bucket
+/// without an atomic add on its count: inserts into a cell of many ids took one per bucket of the
+/// chain.
+KDET_HD inline bool append_to_chain(const GridView& g, std::uint32_t main, std::uint32_t id) {
+    std::uint32_t bucket = atomic_load_acquire(&g.headers[main].tail);
     for (;;) {
         BucketHeader& h = g.headers[bucket];
-        const std::uint32_t index = atomic_fetch_add(&h.count, 1u);
-        if (index < g.bucket_capacity) {
-            g.ids[static_cast<std::uint64_t>(bucket) * g.bucket_capacity + index] = id;
-            return true;
+        if (atomic_load_acquire(&h.count) < g.bucket_capacity) {
+            const std::uint32_t index = atomic_fetch_add(&h.count, 1u);
+            if (index < g.bucket_capacity) {
+                g.ids[static_cast<std::uint64_t>(bucket) * g.bucket_capacity + index] = id;
+                return true;
+            }
         }
         std::uint32_t next = atomic_load_acquire(&h.next);
         if (next == no_bucket) {
@@ -180,7 +191,11 @@ KDET_HD inline bool append_to_chain(const GridView& g, std::uint32_t bucket, std
             f.next = no_bucket;
             f.state = g.stamp * 2u + 1u;
             // Losing the race leaves `fresh` unused for this frame; the winner's bucket is followed.
-            if (atomic_compare_exchange(&h.next, next, fresh)) next = fresh;
+            if (atomic_compare_exchange(&h.next, next, fresh)) {
+                next = fresh;
+                // A tail stored late by a slower winner points a few buckets back: still in the chain.
+                atomic_store_release(&g.headers[main].tail, fresh);
+            }
         }
         bucket = next;
     }
