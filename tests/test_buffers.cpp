@@ -1,6 +1,7 @@
 // The CPU execution layer's buffers: the host twin of the CUDA layer's device buffers.
 
 #include "exec/cpu_exec.hpp"
+#include "pipeline/capacity.hpp"
 
 #include <gtest/gtest.h>
 
@@ -35,6 +36,26 @@ TEST(HostBuffer, ShrinkingKeepsTheMemory) {
     EXPECT_EQ(buffer.data(), memory);
     EXPECT_EQ(buffer.size(), 5u);
     EXPECT_EQ(buffer.capacity_bytes(), 100u * sizeof(std::uint32_t));
+}
+
+TEST(GrownCapacity, KeepsWhatSufficesAndOtherwiseGrowsByAQuarterAtLeast) {
+    EXPECT_EQ(grown_capacity(0, 1000, 1u << 30), 1000u);        // the first sizing: what is asked for
+    EXPECT_EQ(grown_capacity(1000, 1000, 1u << 30), 1000u);     // enough: unchanged
+    EXPECT_EQ(grown_capacity(1000, 10, 1u << 30), 1000u);       // never shrinks
+    EXPECT_EQ(grown_capacity(1000, 1001, 1u << 30), 1250u);     // a little more: a quarter more
+    EXPECT_EQ(grown_capacity(1000, 5000, 1u << 30), 5000u);     // much more: what is asked for
+    EXPECT_EQ(grown_capacity(1000, 1001, 1100), 1100u);         // never beyond the limit
+    // A need that creeps up by 0.1 % a frame for 1,000 frames reallocates a few times, not every frame.
+    std::uint64_t capacity = 0, growths = 0;
+    double need = 100000.0;
+    for (int frame = 0; frame < 1000; ++frame, need *= 1.001) {
+        const std::uint64_t grown = grown_capacity(capacity, static_cast<std::uint64_t>(need), 1ull << 40);
+        growths += grown != capacity;
+        capacity = grown;
+        EXPECT_GE(capacity, static_cast<std::uint64_t>(need));
+        EXPECT_LE(capacity, static_cast<std::uint64_t>(1.25 * need) + 1);
+    }
+    EXPECT_LE(growths, 6u);
 }
 
 } // namespace

@@ -6,6 +6,7 @@
 /// It reads the counters (and the results, when they go to the host) once at the end, and grows a
 /// buffer and reruns the frame only when a counter says that the buffer was too small.
 
+#include "pipeline/capacity.hpp"
 #include "pipeline/pipeline_base.hpp"
 
 #include <kdet/error.hpp>
@@ -267,8 +268,8 @@ void Pipeline<Exec>::grid_geometry() {
 /// bound (probing stays short), and the overflow pool one bucket
 /// per bucket_capacity entries, which holds every chain whatever the cells' fill, plus room for the
 /// buckets that racing threads waste; the compacted lists
-/// get room for the entries, which the plan counts exactly. All only grow, so a scene that keeps its
-/// size sizes them once.
+/// get room for the entries, which the plan counts exactly. All only grow, by a quarter at least
+/// (grown_capacity), so a scene that keeps its size sizes them once and a growing one a few times.
 template <class Exec>
 void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     const GridParams& params = plan.params;
@@ -298,11 +299,13 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     // frame: an eighth more (and 64) keeps such losses from failing the pass and running it again.
     const double wanted_pool = std::min(std::ceil(1.125 * entries / capacity) + 64.0, static_cast<double>(1u << 30));
     slot_count_ = std::max(slot_count_, wanted_slots);
-    overflow_capacity_ = std::max(overflow_capacity_, static_cast<std::uint32_t>(wanted_pool));
+    overflow_capacity_ = static_cast<std::uint32_t>(
+        grown_capacity(overflow_capacity_, static_cast<std::uint64_t>(wanted_pool), std::uint64_t{1} << 30));
     // An eighth more than the plan's count: a deforming scene's cells gain entries from frame to frame,
     // and each time the lists outgrew their room the frame would run twice.
     const double wanted_entries = std::min(std::ceil(1.125 * entries), 4294967295.0);
-    entry_capacity_ = std::max(entry_capacity_, static_cast<std::uint32_t>(wanted_entries));
+    entry_capacity_ = static_cast<std::uint32_t>(
+        grown_capacity(entry_capacity_, static_cast<std::uint64_t>(wanted_entries), 4294967295u));
 }
 
 /// @brief Stage 2: fills the hash table as sized so far, then compacts each cell's ids into one list

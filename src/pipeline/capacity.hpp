@@ -1,0 +1,20 @@
+#pragma once
+/// @file capacity.hpp
+/// @brief How the detector's buffers grow when a frame needs more room than they have.
+
+#include <algorithm>
+#include <cstdint>
+
+namespace kdet {
+
+/// @brief The capacity a buffer of `current` elements grows to when a frame needs `wanted`, at most
+/// `limit`: unchanged while it suffices, else a quarter more than before when that is more than
+/// asked for. A deforming scene's need creeps up by a little most frames; growing to the exact need
+/// reallocated (and cleared) the grid's buffers every few frames, where geometric steps do it a
+/// logarithmic number of times for at most a quarter more memory.
+constexpr std::uint64_t grown_capacity(std::uint64_t current, std::uint64_t wanted, std::uint64_t limit) {
+    if (wanted <= current) return current;
+    return std::min(limit, std::max(wanted, current + current / 4));
+}
+
+} // namespace kdet
