@@ -402,6 +402,44 @@ TEST(Detector, ALaterFrameThatNeedsMoreRoomRunsAgainAndLosesNothing) {
     }
 }
 
+TEST(Detector, ALaterFrameWhosePairsOutgrowOnlyTheirWindowRunsItsNarrowPhaseAgainAndLosesNothing) {
+    // A deep overlap sizes every buffer, a graze then shrinks the colliding pairs' window (the GPU sorts
+    // all of it), and the deep overlap again outgrows only that window: the candidates found are kept
+    // and the narrow phase runs again. Pairs, flags, contacts and counts are those of a fresh detector
+    // (with contacts on, the first attempt must not read the window's unwritten slots).
+    const TetMesh a = random_soup(12000, 6.0, 1.0, 67);
+    const TetMesh graze = moved(a, 0.0, 5.9, 0.0, 0.0), deep = moved(a, 0.3, 0.1, 0.0, 0.0);
+    for (Method method : {Method::kdet, Method::brute_force_loop}) {
+        DetectorOptions options = with_method(method);
+        options.contacts = true;
+        options.narrow_phase = NarrowPhase::exact;
+        Detector detector(options), fresh(options);
+        detector.add_object(a);
+        const ObjectId b = detector.add_object(deep);
+        const std::size_t deep_pairs = detector.detect().pairs.size();
+        ASSERT_GT(deep_pairs, 4096u) << to_string(method);
+        detector.set_positions(b, graze.positions.data(), graze.num_vertices());
+        ASSERT_LT(detector.detect().counts.colliding_pairs, deep_pairs / 4) << to_string(method);
+        detector.set_positions(b, deep.positions.data(), deep.num_vertices());
+        const FrameResult grown = detector.detect();
+        EXPECT_EQ(grown.counts.buffer_regrows, 1u) << to_string(method);
+        EXPECT_EQ(grown.counts.host_waits, 2u) << to_string(method);
+        fresh.add_object(a);
+        fresh.add_object(deep);
+        const FrameResult& expected = fresh.detect();
+        EXPECT_EQ(grown.pairs, expected.pairs) << to_string(method);
+        EXPECT_EQ(grown.colliding, expected.colliding) << to_string(method);
+        EXPECT_EQ(grown.counts.colliding_tets, expected.counts.colliding_tets) << to_string(method);
+        EXPECT_EQ(grown.counts.candidates, expected.counts.candidates) << to_string(method);
+        EXPECT_EQ(grown.counts.exact_stage_pairs, expected.counts.exact_stage_pairs) << to_string(method);
+        ASSERT_EQ(grown.contacts.size(), expected.contacts.size()) << to_string(method);
+        for (std::size_t k = 0; k < grown.contacts.size(); ++k) {
+            EXPECT_EQ(grown.contacts[k].depth, expected.contacts[k].depth) << k;
+            EXPECT_EQ(grown.contacts[k].direction[0], expected.contacts[k].direction[0]) << k;
+        }
+    }
+}
+
 TEST(Detector, BucketsGrowWhenObjectsThatStartedApartMeet) {
     // Apart, nothing is gridded and the automatic bucket capacity starts at its smallest; once the
     // objects overlap, the buckets grow to what a detector that saw the overlap first chose, so both

@@ -738,12 +738,17 @@ struct NarrowPhaseKernel {
 };
 
 /// @brief Stage 6: contact of each colliding pair given in the caller's ids; tet b is the pair's second.
+/// Nothing when the pairs outgrew their window: a batch that did not fit left its slots unwritten
+/// (they hold no pair, maybe no valid id), and the narrow phase runs again with a larger window.
 struct ContactKernel {
     SceneView scene;
     const std::uint32_t* stored_id; ///< [tets] caller's global id -> stored id
     const std::uint64_t* keys;
+    const unsigned long long* key_count; ///< the pairs appended, counted past the window's end
+    std::uint64_t window;
     Contact* contacts;
     KDET_HD void operator()(std::uint64_t k) const {
+        if (*key_count > window) return;
         vec3 a[4], b[4];
         load_tet(scene, stored_id[key_first(keys[k])], a);
         load_tet(scene, stored_id[key_second(keys[k])], b);

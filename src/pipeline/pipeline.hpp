@@ -454,7 +454,8 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     if (options_.contacts) {
         out_contacts_.resize_discard(pairs_window_);
         exec_.for_each_counted(&c->colliding_pairs, out_contacts_.size(),
-                               ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), out_contacts_.data()});
+                               ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), &c->colliding_pairs,
+                                             out_keys_.size(), out_contacts_.data()});
     }
     clock_.mark(results_done);
 }
