@@ -173,7 +173,13 @@ private:
     std::optional<FrameCounters> find_candidates(const GridView& grid);
     void brute_force();
     void narrow_phase_and_results();
-    bool grow_for(const FrameCounters& c);
+    void enqueue_results();
+    void enqueue_results_again(const FrameCounters& c);
+
+    /// What a frame that outgrew a buffer runs again: nothing, its colliding pairs only (the window
+    /// for them was too small, everything before it fitted), or all of it.
+    enum class Rerun { none, results, frame };
+    Rerun grow_for(const FrameCounters& c);
 
     /// Marks between the stages of a frame, for StageTimes.
     enum StageMark { frame_start, boxes_done, grid_done, candidates_done, narrow_phase_done, sorted, results_done, frame_end };
@@ -504,15 +510,22 @@ void Pipeline<Exec>::enqueue_frame() {
     }
     clock_.mark(candidates_done);
 
-    if (method != Method::kdet_no_pairs) {
-        if (!pairs_sized_) {
-            // The colliding pairs are at most the candidates.
-            if (!found) found = read_counters_now();
-            pairs_window_ = std::max<std::size_t>(pairs_window_, std::min<std::size_t>(found->candidates, candidates_.size()));
-            pairs_sized_ = true;
-        }
-        narrow_phase_and_results();
+    if (method != Method::kdet_no_pairs && !pairs_sized_) {
+        // The colliding pairs are at most the candidates.
+        if (!found) found = read_counters_now();
+        pairs_window_ = std::max<std::size_t>(pairs_window_, std::min<std::size_t>(found->candidates, candidates_.size()));
+        pairs_sized_ = true;
     }
+    enqueue_results();
+}
+
+/// @brief The end of a frame's attempt, from the candidates on: the narrow phase and the colliding
+/// pairs (not for kdet_no_pairs), the per-tet flags, and the copies of the counters and results.
+template <class Exec>
+void Pipeline<Exec>::enqueue_results() {
+    const Method method = options_.method;
+    FrameCounters* c = counters_.data();
+    if (method != Method::kdet_no_pairs) narrow_phase_and_results();
 
     const std::size_t tets = tets_.size();
     exec_.for_each(tets, UserFlagsKernel{stored_id_.data(), colliding_.data(), user_colliding_.data()});
@@ -526,6 +539,20 @@ void Pipeline<Exec>::enqueue_frame() {
     exec_.download_later(host_flags_.data(), user_colliding_.data(), tets);
     host_contacts_.resize(options_.contacts ? host_keys_.size() : 0);
     exec_.download_later(host_contacts_.data(), out_contacts_.data(), host_contacts_.size());
+}
+
+/// @brief Runs the narrow phase and what follows it again over the candidates already found, when
+/// only the window for the colliding pairs was too small (grow_for has grown it): the counters of the
+/// earlier stages are kept (`c`, read back at the attempt's end), those of the narrow phase start anew.
+template <class Exec>
+void Pipeline<Exec>::enqueue_results_again(const FrameCounters& c) {
+    FrameCounters kept = c;
+    kept.colliding_pairs = 0;
+    kept.colliding_tets = 0;
+    kept.exact_stage_pairs = 0;
+    exec_.upload(counters_.data(), &kept, 1);
+    fill(colliding_, 0u);
+    enqueue_results();
 }
 
 /// @brief Checks the positions staged on the device and makes them current if every one is finite,
@@ -543,7 +570,7 @@ void Pipeline<Exec>::adopt_staged_positions() {
 /// @brief After a frame: grows what was too small for it and says whether it must run again.
 /// The grid also grows for its plan, so the next frame of a growing scene fits at once.
 template <class Exec>
-bool Pipeline<Exec>::grow_for(const FrameCounters& c) {
+typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) {
     bool again = false;
     if (grid_method() && c.params.layer_count > 0) {
         if (c.grid_failure & grid_table_full) slot_count_ *= 2;
@@ -556,16 +583,19 @@ bool Pipeline<Exec>::grow_for(const FrameCounters& c) {
         candidates_.resize_discard(c.candidates + c.candidates / 4);
         again = true;
     }
+    bool pairs_again = false;
     if (options_.method != Method::kdet_no_pairs) {
         if (c.colliding_pairs > pairs_window_) {
             pairs_window_ = c.colliding_pairs + c.colliding_pairs / 4;
-            again = true;
+            pairs_again = true;
         } else if (c.colliding_pairs * 4 < pairs_window_ && pairs_window_ > 4096) {
             // Far fewer pairs than room: the GPU sorts the whole window, so it shrinks (memory stays).
             pairs_window_ = std::max<std::size_t>(4096, 2 * c.colliding_pairs);
         }
     }
-    return again;
+    // The pairs' window fills as collisions set in, while the candidates fitted: those are still
+    // there, so only the narrow phase runs again.
+    return again ? Rerun::frame : pairs_again ? Rerun::results : Rerun::none;
 }
 
 template <class Exec>
@@ -585,9 +615,13 @@ template <class Exec>
 std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
     for (;;) {
         exec_.finish_downloads(); // the frame's one wait
-        if (!grow_for(last_)) break;
+        const Rerun rerun = grow_for(last_);
+        if (rerun == Rerun::none) break;
         ++regrows_;
-        enqueue_frame();
+        if (rerun == Rerun::results)
+            enqueue_results_again(last_);
+        else
+            enqueue_frame();
     }
     clock_.mark(frame_end);
     clock_.wait(frame_end); // recorded after the frame's wait, on an idle stream: no wait more
