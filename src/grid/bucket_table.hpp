@@ -284,8 +284,10 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
         block.object[i] = e.object;
         objects |= object_bit(e.object);
         if (g.own_cells) {
+            // Relaxed atomic: for a tet spanning more than two cells along an axis (which keeps no row)
+            // two cells' compactions may store to the same slot.
             const std::uint32_t tagged = block.id_and_starts[i];
-            g.own_cells[tagged & grid_id_mask].after[own_cell_index_of(tagged >> grid_id_bits)] = k + 1;
+            atomic_store_relaxed(&g.own_cells[tagged & grid_id_mask].after[own_cell_index_of(tagged >> grid_id_bits)], k + 1);
         }
     }
     main.count = total;
