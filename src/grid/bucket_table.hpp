@@ -370,7 +370,8 @@ KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std
     const std::uint32_t first = g.headers[bucket].first_entry;
     const std::uint32_t end = first + g.headers[bucket].count;
     std::uint32_t begin = first;
-    for (std::uint32_t high = end; begin < high;) {
+    // With first_id 0 (a higher layer, where every tet is larger) the search would only read ids.
+    for (std::uint32_t high = first_id ? end : first; begin < high;) {
         const std::uint32_t middle = begin + (high - begin) / 2;
         if ((entry_id_and_starts(g, middle) & grid_id_mask) < first_id)
             begin = middle + 1;
