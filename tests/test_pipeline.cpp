@@ -440,6 +440,37 @@ TEST(Detector, ALaterFrameWhosePairsOutgrowOnlyTheirWindowRunsItsNarrowPhaseAgai
     }
 }
 
+TEST(Detector, AFrameWhoseObjectsMeetRunsAgainFromEachStageThatLackedRoomAndLosesNothing) {
+    // Apart, the objects grid nothing and the buffers stay at their smallest; when they overlap, the
+    // frame outgrows the grid (it runs again from populating), then, with the grid in place, the
+    // candidate buffer (again from the candidate stage) and the pairs' window. Everything equals a
+    // fresh detector's.
+    const TetMesh a = random_soup(6000, 4.0, 1.0, 71);
+    const TetMesh apart = moved(a, 0.0, 10.0, 0.0, 0.0), deep = moved(a, 0.3, 0.1, 0.0, 0.0);
+    for (Method method : {Method::kdet, Method::brute_force_loop}) {
+        const DetectorOptions options = with_method(method);
+        Detector detector(options), fresh(options);
+        detector.add_object(a);
+        const ObjectId b = detector.add_object(apart);
+        ASSERT_EQ(detector.detect().counts.colliding_pairs, 0u) << to_string(method);
+        detector.set_positions(b, deep.positions.data(), deep.num_vertices());
+        const FrameResult grown = detector.detect();
+        EXPECT_GE(grown.counts.buffer_regrows, method == Method::kdet ? 2u : 1u) << to_string(method);
+        EXPECT_EQ(grown.counts.host_waits, 1u + grown.counts.buffer_regrows) << to_string(method);
+        fresh.add_object(a);
+        fresh.add_object(deep);
+        const FrameResult& expected = fresh.detect();
+        ASSERT_GT(expected.pairs.size(), 4096u) << to_string(method);
+        EXPECT_EQ(grown.pairs, expected.pairs) << to_string(method);
+        EXPECT_EQ(grown.colliding, expected.colliding) << to_string(method);
+        EXPECT_EQ(grown.counts.candidates, expected.counts.candidates) << to_string(method);
+        EXPECT_EQ(grown.counts.unique_candidates, expected.counts.unique_candidates) << to_string(method);
+        EXPECT_EQ(grown.counts.colliding_tets, expected.counts.colliding_tets) << to_string(method);
+        EXPECT_EQ(grown.counts.exact_stage_pairs, expected.counts.exact_stage_pairs) << to_string(method);
+        EXPECT_EQ(grown.counts.grid_cells, expected.counts.grid_cells) << to_string(method);
+    }
+}
+
 TEST(Detector, BucketsGrowWhenObjectsThatStartedApartMeet) {
     // Apart, nothing is gridded and the automatic bucket capacity starts at its smallest; once the
     // objects overlap, the buckets grow to what a detector that saw the overlap first chose, so both

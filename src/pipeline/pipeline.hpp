@@ -4,7 +4,8 @@
 /// A frame is enqueued whole: each stage finds the sizes and the grid's geometry that the stages
 /// before it computed in the backend's memory (FrameCounters), so the host reads nothing in between.
 /// It reads the counters (and the results, when they go to the host) once at the end, and grows a
-/// buffer and reruns the frame only when a counter says that the buffer was too small.
+/// buffer only when a counter says that the buffer was too small, running the frame again from the
+/// stage that lacked room.
 
 #include "pipeline/capacity.hpp"
 #include "pipeline/pipeline_base.hpp"
@@ -173,13 +174,15 @@ private:
     std::optional<FrameCounters> find_candidates(const GridView& grid);
     void brute_force();
     void narrow_phase_and_results();
-    void enqueue_results();
-    void enqueue_results_again(const FrameCounters& c);
 
-    /// What a frame that outgrew a buffer runs again: nothing, its colliding pairs only (the window
-    /// for them was too small, everything before it fitted), or all of it.
-    enum class Rerun { none, results, frame };
+    /// Where an attempt at a frame starts again once a buffer has grown: from the first stage whose
+    /// buffer was too small, since what the stages before it computed is still in place (or nowhere,
+    /// when everything fitted).
+    enum class Rerun { none, results, candidates, grid };
     Rerun grow_for(const FrameCounters& c);
+    void enqueue_from(Rerun stage);
+    void enqueue_results();
+    void enqueue_again(const FrameCounters& c, Rerun stage);
 
     /// Marks between the stages of a frame, for StageTimes.
     enum StageMark { frame_start, boxes_done, grid_done, candidates_done, narrow_phase_done, sorted, results_done, frame_end };
@@ -228,6 +231,7 @@ private:
     bool grid_planned_ = false;      ///< the grid has been sized from a plan read back once
     bool pairs_sized_ = false;       ///< the pairs' window has been sized from a count read back once
     std::size_t colliding_count_ = 0; ///< pairs in out_keys_ after the last detection
+    GridView grid_{}; ///< the frame's grid, once populated
 
     // The frame in flight: the staged ranges it adopts, and what it copies back at its end, read by finish().
     std::vector<VertexRange> staged_;
@@ -471,50 +475,57 @@ void Pipeline<Exec>::narrow_phase_and_results() {
 /// queries grow nothing), and the candidate count, to size the window for the colliding pairs.
 template <class Exec>
 void Pipeline<Exec>::enqueue_frame() {
-    const Method method = options_.method;
-    FrameCounters* c = counters_.data();
-    std::optional<FrameCounters> found; ///< the counters after the candidate stage, when read back
     reset_counters();
     adopt_staged_positions();
     fill(colliding_, 0u);
     bounds_and_culling();
     if (grid_method()) grid_geometry();
     clock_.mark(boxes_done);
+    if (grid_method() && !grid_planned_) {
+        const FrameCounters plan = read_counters_now();
+        size_grid(plan);
+        // Linear in the tets (thesis 7.3): k-freeness bounds the larger neighbours of each tet.
+        const std::size_t estimate = options_.initial_candidate_capacity
+                                         ? options_.initial_candidate_capacity
+                                         : std::max<std::size_t>(4096, 16 * plan.involved_tets);
+        if (candidates_.size() < estimate) candidates_.resize_discard(estimate);
+        grid_planned_ = true;
+    }
+    enqueue_from(Rerun::grid);
+}
 
-    if (grid_method()) {
-        if (!grid_planned_) {
-            const FrameCounters plan = read_counters_now();
-            size_grid(plan);
-            // Linear in the tets (thesis 7.3): k-freeness bounds the larger neighbours of each tet.
-            const std::size_t estimate = options_.initial_candidate_capacity
-                                             ? options_.initial_candidate_capacity
-                                             : std::max<std::size_t>(4096, 16 * plan.involved_tets);
-            if (candidates_.size() < estimate) candidates_.resize_discard(estimate);
-            grid_planned_ = true;
-        }
-        const GridView grid = populate();
+/// @brief The stages of an attempt from `stage` on (grid: populating, candidates: the candidate
+/// stage, results: the narrow phase and after), once those before it have run.
+template <class Exec>
+void Pipeline<Exec>::enqueue_from(Rerun stage) {
+    const Method method = options_.method;
+    FrameCounters* c = counters_.data();
+    if (stage == Rerun::grid && grid_method()) {
+        grid_ = populate();
         clock_.mark(grid_done);
+    }
+    if (stage != Rerun::results) {
+        std::optional<FrameCounters> found; ///< the counters after the candidate stage, when read back
         if (method == Method::kdet) {
-            found = find_candidates(grid);
-        } else {
+            found = find_candidates(grid_);
+        } else if (method == Method::kdet_no_pairs) {
             with_narrow_phase(options_.narrow_phase, [&](auto test) {
-                exec_.for_each(tets_.size(), NoPairsKernel<decltype(test)::value>{scene_view(), grid, &c->params, &c->layer_mask,
+                exec_.for_each(tets_.size(), NoPairsKernel<decltype(test)::value>{scene_view(), grid_, &c->params, &c->layer_mask,
                                                                        colliding_.data(), &c->tests_run,
                                                                        &c->exact_stage_pairs});
             });
+        } else {
+            if (candidates_.size() == 0)
+                candidates_.resize_discard(options_.initial_candidate_capacity ? options_.initial_candidate_capacity : 4096);
+            brute_force();
         }
-    } else {
-        if (candidates_.size() == 0)
-            candidates_.resize_discard(options_.initial_candidate_capacity ? options_.initial_candidate_capacity : 4096);
-        brute_force();
-    }
-    clock_.mark(candidates_done);
-
-    if (method != Method::kdet_no_pairs && !pairs_sized_) {
-        // The colliding pairs are at most the candidates.
-        if (!found) found = read_counters_now();
-        pairs_window_ = std::max<std::size_t>(pairs_window_, std::min<std::size_t>(found->candidates, candidates_.size()));
-        pairs_sized_ = true;
+        clock_.mark(candidates_done);
+        if (method != Method::kdet_no_pairs && !pairs_sized_) {
+            // The colliding pairs are at most the candidates.
+            if (!found) found = read_counters_now();
+            pairs_window_ = std::max<std::size_t>(pairs_window_, std::min<std::size_t>(found->candidates, candidates_.size()));
+            pairs_sized_ = true;
+        }
     }
     enqueue_results();
 }
@@ -541,18 +552,32 @@ void Pipeline<Exec>::enqueue_results() {
     exec_.download_later(host_contacts_.data(), out_contacts_.data(), host_contacts_.size());
 }
 
-/// @brief Runs the narrow phase and what follows it again over the candidates already found, when
-/// only the window for the colliding pairs was too small (grow_for has grown it): the counters of the
-/// earlier stages are kept (`c`, read back at the attempt's end), those of the narrow phase start anew.
+/// @brief Runs an attempt again from `stage` (grow_for has grown what it needs): the counters of the
+/// stages before it are kept as the attempt left them (`c`, read back at its end), those from it on
+/// start anew, and so do the per-tet flags.
 template <class Exec>
-void Pipeline<Exec>::enqueue_results_again(const FrameCounters& c) {
+void Pipeline<Exec>::enqueue_again(const FrameCounters& c, Rerun stage) {
     FrameCounters kept = c;
+    if (stage == Rerun::grid) {
+        kept.grid_failure = 0;
+        kept.overflow_used = 0;
+        kept.cells_claimed = 0;
+        kept.grid_entries = 0;
+    }
+    if (stage != Rerun::results) {
+        kept.candidates = 0;
+        kept.candidate_padding = 0;
+        kept.tests_run = 0;
+        kept.rejected = 0;
+        kept.stopped_tets = 0;
+        kept.brute_force_exact_stage = 0;
+    }
+    kept.exact_stage_pairs = 0;
     kept.colliding_pairs = 0;
     kept.colliding_tets = 0;
-    kept.exact_stage_pairs = 0;
     exec_.upload(counters_.data(), &kept, 1);
     fill(colliding_, 0u);
-    enqueue_results();
+    enqueue_from(stage);
 }
 
 /// @brief Checks the positions staged on the device and makes them current if every one is finite,
@@ -571,17 +596,17 @@ void Pipeline<Exec>::adopt_staged_positions() {
 /// The grid also grows for its plan, so the next frame of a growing scene fits at once.
 template <class Exec>
 typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) {
-    bool again = false;
+    bool grid_again = false, candidates_again = false;
     if (grid_method() && c.params.layer_count > 0) {
         if (c.grid_failure & grid_table_full) slot_count_ *= 2;
         if (c.grid_failure & grid_overflow_pool_full)
             overflow_capacity_ = std::max(overflow_capacity_ * 2, c.overflow_used);
         size_grid(c);
-        again = c.grid_failure != 0;
+        grid_again = c.grid_failure != 0;
     }
     if (c.candidates > candidates_.size()) {
         candidates_.resize_discard(c.candidates + c.candidates / 4);
-        again = true;
+        candidates_again = true;
     }
     bool pairs_again = false;
     if (options_.method != Method::kdet_no_pairs) {
@@ -593,9 +618,12 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
             pairs_window_ = std::max<std::size_t>(4096, 2 * c.colliding_pairs);
         }
     }
-    // The pairs' window fills as collisions set in, while the candidates fitted: those are still
-    // there, so only the narrow phase runs again.
-    return again ? Rerun::frame : pairs_again ? Rerun::results : Rerun::none;
+    // A scene whose overlap grows outgrows these as collisions set in, frame after frame: the boxes,
+    // sizes and plan (and the grid, and the candidates) are still in place, so the frame runs again
+    // from the first stage that lacked room.
+    if (grid_again) return Rerun::grid;
+    if (candidates_again) return Rerun::candidates;
+    return pairs_again ? Rerun::results : Rerun::none;
 }
 
 template <class Exec>
@@ -618,10 +646,7 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
         const Rerun rerun = grow_for(last_);
         if (rerun == Rerun::none) break;
         ++regrows_;
-        if (rerun == Rerun::results)
-            enqueue_results_again(last_);
-        else
-            enqueue_frame();
+        enqueue_again(last_, rerun);
     }
     clock_.mark(frame_end);
     clock_.wait(frame_end); // recorded after the frame's wait, on an idle stream: no wait more
