@@ -302,12 +302,12 @@ KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, st
     if (used > g.entry_capacity) used = g.entry_capacity;
     const std::uint32_t begin = block * entry_block;
     if (begin >= used) return;
-    const std::uint32_t lanes = used - begin < entry_block ? used - begin : entry_block;
-    const EntryBlock& b = g.entry_blocks[block];
-    Aabb bound{{b.lo[0][0], b.lo[1][0], b.lo[2][0]}, {b.hi[0][0], b.hi[1][0], b.hi[2][0]}};
-    for (std::uint32_t i = 1; i < lanes; ++i) {
-        bound.lo = min_v(bound.lo, vec3{b.lo[0][i], b.lo[1][i], b.lo[2][i]});
-        bound.hi = max_v(bound.hi, vec3{b.hi[0][i], b.hi[1][i], b.hi[2][i]});
+    const std::uint32_t end = used - begin < entry_block ? used : begin + entry_block;
+    Aabb bound = load_entry(g, begin).box;
+    for (std::uint32_t k = begin + 1; k < end; ++k) {
+        const Aabb box = load_entry(g, k).box;
+        bound.lo = min_v(bound.lo, box.lo);
+        bound.hi = max_v(bound.hi, box.hi);
     }
     g.block_bounds[block] = bound;
 }

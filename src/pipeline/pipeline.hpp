@@ -130,11 +130,16 @@ public:
                info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
-               headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() + block_bounds_.capacity_bytes() + own_cells_.capacity_bytes() +
-               counters_.capacity_bytes() +
+               grid_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
                resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
                blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes() + exec_.scratch_bytes();
+    }
+
+    /// The grid's buffers: the table, the compacted lists and their bounds, the own-layer rows.
+    std::size_t grid_bytes() const {
+        return headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() +
+               block_bounds_.capacity_bytes() + own_cells_.capacity_bytes();
     }
 
     std::string device_name() const override { return exec_.device_name(); }
@@ -440,7 +445,7 @@ void Pipeline<Exec>::brute_force() {
 }
 
 /// @brief Stages 5 and 6: the narrow phase once per candidate (they are unique, see
-/// LargerNeighbourFilter), over the count the candidate stage left in the backend's memory; the
+/// for_each_larger_neighbour), over the count the candidate stage left in the backend's memory; the
 /// colliding pairs, appended under the caller's ids into the window, sorted into the output order,
 /// and their contacts.
 template <class Exec>
@@ -592,7 +597,8 @@ void Pipeline<Exec>::adopt_staged_positions() {
         exec_.for_each(r.count, AdoptPositionsKernel{staged_positions_.data(), positions_.data(), r.first, verdict});
 }
 
-/// @brief After a frame: grows what was too small for it and says whether it must run again.
+/// @brief After a frame: grows what was too small for it and says from which stage it must run
+/// again, if at all.
 /// The grid also grows for its plan, so the next frame of a growing scene fits at once.
 template <class Exec>
 typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) {
@@ -704,7 +710,7 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
         }
     }
     result.memory_bytes = memory_bytes();
-    result.grid_bytes = headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() + block_bounds_.capacity_bytes() + own_cells_.capacity_bytes();
+    result.grid_bytes = grid_bytes();
     result.candidate_bytes = candidates_.capacity_bytes();
     StageTimes& t = result.times;
     t = StageTimes{};
