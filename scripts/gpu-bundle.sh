@@ -6,7 +6,7 @@
 #
 # usage: scripts/gpu-bundle.sh            builds build-gpu/ (preset cuda) and fills .gpu-bundle/
 # then, with the device tool, one call per part:
-#   run(command="bash scripts/gpu-session.sh checks", carry=[".gpu-bundle"]), then matrix, then scaling
+#   run(command="bash scripts/gpu-session.sh tests r4 sanitizers scaling", carry=[".gpu-bundle"])
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="$repo/.gpu-bundle"
@@ -31,6 +31,8 @@ for program in "$bundle/kdet" "$bundle/kdet_tests"; do
   ldd "$program" | awk '/=> \//{print $3}' | grep -Ev '/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|libgomp|ld-linux[^/]*)\.so' |
     xargs -r cp -Ln -t "$bundle/lib/"
 done
+git -C "$repo" log -1 --format='built at commit %H %s' >"$bundle/commit.txt"
+git -C "$repo" status --short --untracked-files=no >>"$bundle/commit.txt"
 tar -C "$data_dir" -cJf "$bundle/models.tar.xz" .
 tar -C "$cache_dir" -cJf "$bundle/cache.tar.xz" .
 du -sh "$bundle"

@@ -1,72 +1,109 @@
 #!/usr/bin/env bash
-# The GPU checks of the CUDA backend on the `device` machine (bundle: scripts/gpu-bundle.sh), in parts
-# that each fit one device call of at most 10 minutes:
-#   checks   the CUDA tests (GPU pair sets against the CPU backend's), compute-sanitizer memcheck and
-#            racecheck on them, and resolution-4 kdet against GPU brute force on the same frames
-#   matrix   the thesis benchmark matrix with --backend cuda (scripts/run-thesis-matrix.sh), bounded
-#            by MATRIX_MINUTES [8]
-#   scaling  the procedural scene from 100k to 4M tets, frames around the deepest one (60)
-# usage: scripts/gpu-session.sh checks|matrix|scaling
-# Everything goes into $OUT/gpu-<part>.tar.gz, and each step's exit status into $OUT/steps.txt.
-# A failing step does not stop the others.
+# The GPU checks of the CUDA backend on the `device` machine (bundle: scripts/gpu-bundle.sh). One call
+# runs the parts it is given, in order, under one deadline:
+#   tests       the CUDA tests (GPU pairs, flags and contacts against the CPU backend's)
+#   sanitizers  compute-sanitizer memcheck, racecheck, synccheck and initcheck on the smaller of them
+#   r4       the thesis scenes at resolution 4 with --backend cuda, self-collision off and on, and GPU
+#            brute force on armadillos r4 at the frames where they touch
+#   scaling  the procedural scene from 100k to 4M tets (and 8M), frames around the deepest one (60)
+#   matrix   the thesis benchmark matrix (scripts/run-thesis-matrix.sh) until the deadline
+# usage: scripts/gpu-session.sh PART [PART ...]   (e.g. tests r4 sanitizers scaling)
+# Settings: KDET_GPU_DEADLINE, seconds after which no step starts and running ones are stopped [500].
+# Everything goes into $OUT/gpu-session.tar.gz, each step's exit status and seconds into $OUT/steps.txt,
+# and the benchmark summaries are printed last.
 set -uo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="${KDET_GPU_BUNDLE:-$repo/.gpu-bundle}"
 out="${OUT:-$repo/exports/gpu-session}"
+deadline="${KDET_GPU_DEADLINE:-500}"
+(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|matrix ..." >&2; exit 2; }
+for part in "$@"; do
+  case "$part" in
+  tests | sanitizers | r4 | scaling | matrix) ;;
+  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, matrix)" >&2; exit 2 ;;
+  esac
+done
 work="$(mktemp -d)"
-mkdir -p "$out" "$work/models" "$work/cache"
+mkdir -p "$out" "$work/models" "$work/cache" "$work/bench"
 tar -C "$work/models" -xJf "$bundle/models.tar.xz"
 tar -C "$work/cache" -xJf "$bundle/cache.tar.xz"
 export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export KDET_DATA_DIR="$work/models" KDET_CACHE_DIR="$work/cache"
 kdet="$bundle/kdet"
 tests="$bundle/kdet_tests"
-part="${1:-}"
-case "$part" in
-checks | matrix | scaling) ;;
-*)
-  echo "usage: scripts/gpu-session.sh checks|matrix|scaling" >&2
-  exit 2
-  ;;
-esac
 sanitizer="$(command -v compute-sanitizer || ls /usr/local/cuda*/bin/compute-sanitizer 2>/dev/null | head -1)"
 
+# step NAME LIMIT COMMAND...: runs COMMAND for at most LIMIT seconds (less when the deadline is nearer),
+# its output into NAME.log; skipped once the deadline has passed.
 step() {
-  local name="$1"
-  shift
+  local name="$1" limit="$2"
+  shift 2
+  local left=$((deadline - SECONDS))
+  if ((left < 5)); then
+    echo "$name: not run, deadline" | tee -a "$out/steps.txt"
+    return
+  fi
+  ((limit < left)) || limit=$left
   local start=$SECONDS
-  "$@" >"$work/$name.log" 2>&1
+  timeout --kill-after=5 "$limit" "$@" >"$work/$name.log" 2>&1
   local rc=$?
-  echo "$name: exit $rc, $((SECONDS - start)) s" | tee -a "$out/steps.txt"
+  echo "$name: exit $rc, $((SECONDS - start)) s$( ((rc == 124)) && echo " (stopped at $limit s)")" | tee -a "$out/steps.txt"
 }
 
 {
   nvidia-smi
+  nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv
   nvcc --version
   "$kdet" --version
+  cat "$bundle/commit.txt"
 } >"$work/device.txt" 2>&1
-case "$part" in
-checks)
-  step tests "$tests" --gtest_filter='Cuda*'
-  cuda_filter='CudaBackend.EveryMethodTestAndHashMatchesTheCpuOnSoups:CudaBackend.DevicePositions*'
-  step memcheck "${sanitizer:-compute-sanitizer}" --tool memcheck --error-exitcode 1 "$tests" --gtest_filter="$cuda_filter"
-  step racecheck "${sanitizer:-compute-sanitizer}" --tool racecheck --error-exitcode 1 "$tests" --gtest_filter="$cuda_filter"
-  for method in kdet gpu gpu_no_loop; do
-    step "brute-force-r4-$method" "$kdet" bench armadillos -r 4 -s yes -c "$method" -n 1 --frames 80:82 \
-      --backend cuda --quiet -d "$work/brute-force-r4"
-  done
-  ;;
-matrix)
-  step matrix env KDET="$kdet" RUNS=3 BUDGET_MINUTES="${MATRIX_MINUTES:-8}" BENCH_FLAGS="--backend cuda" \
-    "$repo/scripts/run-thesis-matrix.sh" "$work/matrix"
-  ;;
-scaling)
-  for tets in 100000 300000 1000000 2000000 4000000; do
-    for self in no yes; do
-      step "scaling-$tets-$self" "$kdet" bench procedural --tets "$tets" -s "$self" -n 3 --frames 55:65 \
-        --backend cuda --quiet -d "$work/scaling"
+head -20 "$work/device.txt"
+
+bench() { # NAME LIMIT ARGS...: one kdet bench into bench/
+  local name="$1" limit="$2"
+  shift 2
+  step "$name" "$limit" "$kdet" bench "$@" --backend cuda --quiet -d "$work/bench"
+}
+
+for part in "$@"; do
+  case "$part" in
+  tests)
+    step tests 200 "$tests" --gtest_filter='Cuda*'
+    ;;
+  sanitizers)
+    small='CudaBackend.DevicePositions*:CudaBackend.AFrameOnTheCallersStream*:CudaBackend.RealMeshes*'
+    for tool in memcheck racecheck synccheck initcheck; do
+      step "$tool" 45 "${sanitizer:-compute-sanitizer}" --tool "$tool" --error-exitcode 1 "$tests" --gtest_filter="$small"
     done
-  done
-  ;;
-esac
-tar -C "$work" --exclude=models --exclude=cache -czf "$out/gpu-$part.tar.gz" .
+    ;;
+  r4)
+    for scene in armadillos buddha_and_armadillo bunny_and_planck; do
+      for self in no yes; do
+        bench "r4-$scene-self-$self" 60 "$scene" -r 4 -s "$self" -n 3
+      done
+    done
+    bench r2-pass_through_armadillos 60 pass_through_armadillos -r 2 -s no -n 3
+    for method in gpu gpu_no_loop; do
+      bench "r4-armadillos-brute-force-$method" 90 armadillos -r 4 -s yes -c "$method" -n 1 --frames 80:82
+    done
+    ;;
+  scaling)
+    for tets in 100000 300000 1000000 2000000 4000000 8000000; do
+      for self in no yes; do
+        bench "scaling-$tets-$self" 90 procedural --tets "$tets" -s "$self" -n 3 --frames 55:65
+      done
+    done
+    ;;
+  matrix)
+    step matrix $((deadline - SECONDS)) env KDET="$kdet" RUNS=3 BUDGET_MINUTES=$(((deadline - SECONDS) / 60)) \
+      BENCH_FLAGS="--backend cuda" "$repo/scripts/run-thesis-matrix.sh" "$work/matrix"
+    ;;
+  esac
+done
+
+ls "$work/bench"/*.csv >/dev/null 2>&1 && python3 "$repo/python/kdet_summary.py" "$work/bench" >/dev/null 2>&1
+tar -C "$work" --exclude=models --exclude=cache -czf "$out/gpu-session.tar.gz" .
+grep -h "FAILED\|PASSED\|ERROR SUMMARY\|RACECHECK SUMMARY" "$work"/*.log 2>/dev/null | sort | uniq -c | head -40
+cat "$out/steps.txt"
+[[ -f "$work/bench/summary.md" ]] && grep '^|' "$work/bench/summary.md"
+exit 0
