@@ -227,7 +227,9 @@ TEST_F(CudaBackend, AFrameOnTheCallersStreamReadsPositionsWrittenBeforeItOnThatS
     detector.set_positions_on_device(ib, device_xyz, b.num_vertices());
     const FrameResult& got = detector.detect();
 
-    Detector cpu;
+    DetectorOptions cpu_options;
+    cpu_options.contacts = true;
+    Detector cpu(cpu_options);
     cpu.set_self_collision(cpu.add_object(a), true);
     cpu.add_object(b_moved);
     const FrameResult& expected = cpu.detect();

@@ -371,6 +371,7 @@ struct CompactCellsKernel {
 struct BoundEntryBlocksKernel {
     GridView grid;
     KDET_HD void operator()(std::uint64_t block) const {
+        if (*grid.failure) return; // the lists of a failed grid are partly unwritten; it fills again
         bound_entry_block(grid, static_cast<std::uint32_t>(block), *grid.entries_used);
     }
 };
@@ -405,7 +406,9 @@ template <class Visitor>
 KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const GridView& grid, const GridParams& params,
                                              std::uint32_t layer_mask, std::uint32_t t, Visitor& visit) {
     const TetInfo self = scene.info[t];
-    if (self.layer < 0) return;
+    // A grid that failed to fill runs again before anything reads its results; its rows and lists
+    // are partly unwritten.
+    if (self.layer < 0 || *grid.failure) return;
     const std::uint32_t object = scene.tet_object[t];
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
     const std::uint32_t checked_objects = scene.checked_objects[object];

@@ -451,7 +451,12 @@ void Pipeline<Exec>::brute_force() {
 template <class Exec>
 void Pipeline<Exec>::narrow_phase_and_results() {
     FrameCounters* c = counters_.data();
-    out_keys_.resize_discard(pairs_window_);
+    // The whole window is copied out (the count is not known when the copy is enqueued): a new one is
+    // filled once, so that no byte copied is undefined.
+    if (out_keys_.size() != pairs_window_) {
+        out_keys_.resize_discard(pairs_window_);
+        fill(out_keys_, no_pair_key);
+    }
     const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
     with_narrow_phase(options_.narrow_phase, [&](auto test) {
         constexpr std::uint32_t per_item = Exec::keys_per_appending_item;
@@ -467,7 +472,10 @@ void Pipeline<Exec>::narrow_phase_and_results() {
                pair_key_bits(static_cast<std::uint32_t>(tets_.size())));
     clock_.mark(sorted);
     if (options_.contacts) {
-        out_contacts_.resize_discard(pairs_window_);
+        if (out_contacts_.size() != pairs_window_) {
+            out_contacts_.resize_discard(pairs_window_);
+            fill(out_contacts_, Contact{});
+        }
         exec_.for_each_counted(&c->colliding_pairs, out_contacts_.size(),
                                ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), &c->colliding_pairs,
                                              out_keys_.size(), out_contacts_.data()});
