@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Packs what the GPU checks of the CUDA backend need on the `device` machine, which has the CUDA
 # toolkit and CMake but none of kdet's other dependencies and no network: the CUDA build for sm_90
-# (made here), the shared libraries it needs beyond the C/C++ runtimes, the models and the prepared
-# meshes of the thesis scenes. The bundle is a git-ignored folder that the device tool carries.
+# (made here: kdet, the tests and the sort-and-sweep peer), the shared libraries they need beyond the
+# C/C++ runtimes, the models and the prepared meshes of the thesis scenes. The bundle is a git-ignored
+# folder that the device tool carries.
 #
 # usage: scripts/gpu-bundle.sh            builds build-gpu/ (preset cuda) and fills .gpu-bundle/
-# then, with the device tool, one call per part:
-#   run(command="bash scripts/gpu-session.sh tests r4 sanitizers scaling", carry=[".gpu-bundle"])
+# then, with the device tool, one call that runs the parts it needs, e.g.:
+#   run(command="KDET_GPU_DEADLINE=500 bash scripts/gpu-session.sh tests sanitizers r4 peer scaling",
+#       carry=[".gpu-bundle"])
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="$repo/.gpu-bundle"
@@ -18,16 +20,16 @@ exclude="$(git -C "$repo" rev-parse --absolute-git-dir)/info/exclude"
 mkdir -p "$(dirname "$exclude")"
 grep -qx '/.gpu-bundle/' "$exclude" 2>/dev/null || echo '/.gpu-bundle/' >>"$exclude"
 (cd "$repo" && cmake --preset cuda -B "$build" >/dev/null)
-cmake --build "$build" -j"$(nproc)" --target kdet_cli kdet_tests
+cmake --build "$build" -j"$(nproc)" --target kdet_cli kdet_tests kdet_gpu_vs_sweep
 
 # The thesis scenes read their models and prepared meshes; prepare any that are missing.
 KDET_DATA_DIR="$data_dir" KDET_CACHE_DIR="$cache_dir" "$build/kdet" prepare >/dev/null
 
 rm -rf "$bundle"
 mkdir -p "$bundle/lib"
-cp "$build/kdet" "$build/tests/kdet_tests" "$bundle/"
+cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bundle/"
 # Libraries beyond glibc (and its libdl, libpthread, librt), libstdc++, libgcc and libgomp, which the device image has.
-for program in "$bundle/kdet" "$bundle/kdet_tests"; do
+for program in "$bundle/kdet" "$bundle/kdet_tests" "$bundle/kdet_gpu_vs_sweep"; do
   ldd "$program" | awk '/=> \//{print $3}' | grep -Ev '/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|libgomp|ld-linux[^/]*)\.so' |
     xargs -r cp -Ln -t "$bundle/lib/"
 done

@@ -6,6 +6,11 @@
 #   r4       the thesis scenes at resolution 4 with --backend cuda, self-collision off and on, and GPU
 #            brute force on armadillos r4 at the frames where they touch
 #   scaling  the procedural scene from 100k to 4M tets (and 8M), frames around the deepest one (60)
+#   peer     kdet against a CUB sort-and-sweep + sat peer on the same frames (bench/gpu_vs_sweep.cu)
+#   profile  each kernel's GPU time in two frames of four cases (Nsight Compute), and the bucket
+#            capacity and block size against the automatic choice on armadillos r4
+#   compare  the bundle's kdet against the one it holds as kdet-before (copied there by hand), two
+#            alternating rounds on three cases
 #   matrix   the thesis benchmark matrix (scripts/run-thesis-matrix.sh) until the deadline
 # usage: scripts/gpu-session.sh PART [PART ...]   (e.g. tests r4 sanitizers scaling)
 # Settings: KDET_GPU_DEADLINE, seconds after which no step starts and running ones are stopped [500].
@@ -16,11 +21,11 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="${KDET_GPU_BUNDLE:-$repo/.gpu-bundle}"
 out="${OUT:-$repo/exports/gpu-session}"
 deadline="${KDET_GPU_DEADLINE:-500}"
-(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|matrix ..." >&2; exit 2; }
+(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|profile|compare|matrix ..." >&2; exit 2; }
 for part in "$@"; do
   case "$part" in
-  tests | sanitizers | r4 | scaling | matrix) ;;
-  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, matrix)" >&2; exit 2 ;;
+  tests | sanitizers | r4 | scaling | peer | profile | compare | matrix) ;;
+  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, profile, compare, matrix)" >&2; exit 2 ;;
   esac
 done
 work="$(mktemp -d)"
@@ -32,6 +37,7 @@ export KDET_DATA_DIR="$work/models" KDET_CACHE_DIR="$work/cache"
 kdet="$bundle/kdet"
 tests="$bundle/kdet_tests"
 sanitizer="$(command -v compute-sanitizer || ls /usr/local/cuda*/bin/compute-sanitizer 2>/dev/null | head -1)"
+nsight_compute="$(command -v ncu || ls /usr/local/cuda*/bin/ncu /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -1)"
 
 # step NAME LIMIT COMMAND...: runs COMMAND for at most LIMIT seconds (less when the deadline is nearer),
 # its output into NAME.log; skipped once the deadline has passed.
@@ -73,7 +79,7 @@ for part in "$@"; do
   sanitizers)
     small='CudaBackend.DevicePositions*:CudaBackend.AFrameOnTheCallersStream*:CudaBackend.RealMeshes*'
     for tool in memcheck racecheck synccheck initcheck; do
-      step "$tool" 45 "${sanitizer:-compute-sanitizer}" --tool "$tool" --error-exitcode 1 "$tests" --gtest_filter="$small"
+      step "$tool" 60 "${sanitizer:-compute-sanitizer}" --tool "$tool" --error-exitcode 1 "$tests" --gtest_filter="$small"
     done
     ;;
   r4)
@@ -94,6 +100,39 @@ for part in "$@"; do
       done
     done
     ;;
+  peer)
+    step peer 150 "$bundle/kdet_gpu_vs_sweep" --csv "$work/peer.csv"
+    ;;
+  profile)
+    for case in "armadillos-r4-self-yes armadillos -r 4 -s yes --frames 80:81" \
+      "armadillos-r4-self-no armadillos -r 4 -s no --frames 80:81" \
+      "pass_through-r2 pass_through_armadillos -r 2 -s no --frames 40:41" \
+      "procedural-100k procedural --tets 100000 -s no --frames 59:60"; do
+      read -r name arguments <<<"$case"
+      step "ncu-$name" 90 "${nsight_compute:-ncu}" --clock-control none --metrics gpu__time_duration.sum --csv \
+        --log-file "$work/ncu-$name.csv" "$kdet" bench $arguments -n 1 --backend cuda --quiet -d "$work/ncu-bench"
+    done
+    # The bench files do not name the bucket capacity: one folder per variant.
+    for variant in "automatic" "buckets-8 --bucket-capacity 8" "buckets-32 --bucket-capacity 32" "block-64 -g 64" \
+      "block-256 -g 256"; do
+      read -r name flags <<<"$variant"
+      step "variant-$name" 30 "$kdet" bench armadillos -r 4 -s yes -n 3 --frames 70:99 $flags --backend cuda --quiet \
+        -d "$work/variants/$name"
+    done
+    ;;
+  compare)
+    for round in 1 2; do
+      for program in kdet-before kdet; do
+        for case in "procedural-100k procedural --tets 100000 -s no --frames 55:65" \
+          "armadillos-r4-self armadillos -r 4 -s yes --frames 70:99" \
+          "pass_through-r2 pass_through_armadillos -r 2 -s no --frames 20:59"; do
+          read -r name arguments <<<"$case"
+          step "compare-$round-$program-$name" 30 "$bundle/$program" bench $arguments -n 3 --backend cuda --quiet \
+            -d "$work/compare/$program-$round"
+        done
+      done
+    done
+    ;;
   matrix)
     step matrix $((deadline - SECONDS)) env KDET="$kdet" RUNS=3 BUDGET_MINUTES=$(((deadline - SECONDS) / 60)) \
       BENCH_FLAGS="--backend cuda" "$repo/scripts/run-thesis-matrix.sh" "$work/matrix"
@@ -103,7 +142,13 @@ done
 
 ls "$work/bench"/*.csv >/dev/null 2>&1 && python3 "$repo/python/kdet_summary.py" "$work/bench" >/dev/null 2>&1
 tar -C "$work" --exclude=models --exclude=cache -czf "$out/gpu-session.tar.gz" .
+[[ -f "$work/peer.log" ]] && tail -15 "$work/peer.log"
 grep -h "FAILED\|PASSED\|ERROR SUMMARY\|RACECHECK SUMMARY" "$work"/*.log 2>/dev/null | sort | uniq -c | head -40
 cat "$out/steps.txt"
 [[ -f "$work/bench/summary.md" ]] && grep '^|' "$work/bench/summary.md"
+for variant in "$work"/variants/*/ "$work"/compare/*/; do
+  [[ -d "$variant" ]] || continue
+  python3 "$repo/python/kdet_summary.py" "$variant" >/dev/null 2>&1 &&
+    grep '^| [a-z]' "$variant/summary.md" | sed "s|^|$(basename "$variant"): |"
+done
 exit 0
