@@ -1,7 +1,9 @@
 // Every method must return exactly the pair set of brute force; the flags of kdet_no_pairs must equal
 // the tets that appear in brute force's pairs.
 
+#include "exec/cpu_exec.hpp"
 #include "near_touching.hpp"
+#include "pipeline/pipeline.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -190,6 +192,66 @@ TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
     DetectorOptions tiny_brute = with_method(Method::brute_force_pairs);
     tiny_brute.initial_candidate_capacity = 1;
     EXPECT_EQ(run({a, b}, true, tiny_brute).pairs, reference.pairs);
+}
+
+/// The CPU backend with the candidate search split as the GPU splits it (Exec::search_parts_per_tet).
+template <std::uint32_t Parts>
+struct SplitSearchExec : CpuExec {
+    using CpuExec::CpuExec;
+    static constexpr std::uint32_t search_parts_per_tet = Parts;
+};
+
+/// One frame of `pipeline` over `meshes`, every object against the others and, with `self`, itself.
+FrameResult run_pipeline(PipelineBase& pipeline, const std::vector<TetMesh>& meshes, bool self) {
+    SceneTopology topology;
+    std::vector<vec3> positions;
+    for (std::uint32_t o = 0; o < meshes.size(); ++o) {
+        topology.object_tet_begin.push_back(static_cast<std::uint32_t>(topology.tets.size()));
+        const std::uint32_t first_vertex = static_cast<std::uint32_t>(positions.size());
+        for (std::size_t t = 0; t < meshes[o].num_tets(); ++t) {
+            TetIndices tet;
+            for (int k = 0; k < 4; ++k) tet.v[k] = first_vertex + meshes[o].tets[4 * t + k];
+            topology.tet_user_id.push_back(static_cast<std::uint32_t>(topology.tets.size()));
+            topology.tets.push_back(tet);
+            topology.tet_object.push_back(o);
+        }
+        for (std::size_t v = 0; v < meshes[o].num_vertices(); ++v)
+            positions.push_back(vec3{static_cast<float>(meshes[o].positions[3 * v]), static_cast<float>(meshes[o].positions[3 * v + 1]),
+                                     static_cast<float>(meshes[o].positions[3 * v + 2])});
+    }
+    topology.object_tet_begin.push_back(static_cast<std::uint32_t>(topology.tets.size()));
+    topology.vertex_count = static_cast<std::uint32_t>(positions.size());
+    pipeline.set_topology(topology);
+    std::vector<std::uint8_t> pair_enabled(meshes.size() * meshes.size(), 1);
+    for (std::size_t o = 0; o < meshes.size(); ++o) pair_enabled[o * meshes.size() + o] = self ? 1 : 0;
+    pipeline.start({PositionUpload{0, positions.data(), topology.vertex_count}}, {}, pair_enabled);
+    FrameResult result;
+    EXPECT_EQ(pipeline.finish(result), no_vertex);
+    return result;
+}
+
+TEST(Pipeline, ACandidateSearchSplitByLayersFindsEveryCandidateOnce) {
+    const TetMesh a = random_soup(3000, 4.0, 3.0, 61), b = random_soup(3000, 4.0, 3.0, 62);
+    const TetMesh folded = load_model("bunny.mesh");
+    for (std::size_t capacity : {std::size_t{0}, std::size_t{1}, std::size_t{200}}) {
+        DetectorOptions options;
+        options.initial_candidate_capacity = capacity; // small ones make the split items stop and resume
+        for (const auto& [meshes, self] : {std::pair{std::vector<TetMesh>{a, b}, true},
+                                           std::pair{std::vector<TetMesh>{folded, moved(folded, 0.4, 0.02, 0.01, 0.0)}, true}}) {
+            Pipeline<CpuExec> whole(options);
+            Pipeline<SplitSearchExec<3>> in_three(options);
+            Pipeline<SplitSearchExec<4>> in_four(options);
+            const FrameResult expected = run_pipeline(whole, meshes, self);
+            ASSERT_GT(expected.pairs.size(), 20u);
+            for (PipelineBase* split : {static_cast<PipelineBase*>(&in_three), static_cast<PipelineBase*>(&in_four)}) {
+                const FrameResult got = run_pipeline(*split, meshes, self);
+                EXPECT_EQ(got.pairs, expected.pairs) << "capacity " << capacity;
+                EXPECT_EQ(got.colliding, expected.colliding);
+                EXPECT_EQ(got.counts.candidates, expected.counts.candidates);
+                EXPECT_EQ(got.counts.unique_candidates, expected.counts.unique_candidates);
+            }
+        }
+    }
 }
 
 TEST(Pipeline, OrdinaryInputGrowsNoBuffer) {

@@ -139,6 +139,10 @@ public:
     /// thread: for_each below runs 512 items or fewer serially).
     static constexpr std::uint32_t keys_per_appending_item = 16;
 
+    /// @brief Work items a tet's candidate search is split into (FindCandidatesKernel::layer_parts):
+    /// one, so that a thread loads the tet once and its dynamic chunks stay balanced.
+    static constexpr std::uint32_t search_parts_per_tet = 1;
+
     /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`),
     /// divided by `per_item` (rounded up) when each item takes that many: a stage whose size an earlier
     /// stage counted is launched without the host reading the count.

@@ -402,9 +402,13 @@ struct ObjectFilter {
 /// hence always visited. No duplicates are written, so the candidate buffer holds unique pairs. Along
 /// an axis where the cell is not t's first, it must be u's: the entry says so (GridEntry::starts),
 /// and the cell's scan passes only such entries.
+///
+/// A search may be split into `layer_parts` parts, part p searching the layers t's own + p,
+/// + p + layer_parts, ...: the parts together visit what the whole search does, each pair once.
 template <class Visitor>
 KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const GridView& grid, const GridParams& params,
-                                             std::uint32_t layer_mask, std::uint32_t t, Visitor& visit) {
+                                             std::uint32_t layer_mask, std::uint32_t t, Visitor& visit,
+                                             std::uint32_t part = 0, std::uint32_t layer_parts = 1) {
     const TetInfo self = scene.info[t];
     // A grid that failed to fill runs again before anything reads its results; its rows and lists
     // are partly unwritten.
@@ -413,7 +417,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
     const std::uint32_t checked_objects = scene.checked_objects[object];
     ObjectFilter<Visitor> filter{checked_against, &visit};
-    for (int layer = self.layer; layer < params.layer_count; ++layer) {
+    for (int layer = self.layer + static_cast<int>(part); layer < params.layer_count; layer += static_cast<int>(layer_parts)) {
         if (!((layer_mask >> layer) & 1u)) continue;
         // A cell holds only tets of its own layer: on t's, the larger tets are the higher ids, and the
         // sorted list skips the others unread (from t's own entry on, found through its row where it
@@ -520,9 +524,13 @@ struct FindCandidatesKernel {
     const std::uint32_t* layer_mask; ///< GridPlanKernel's
     KeyAppender out;
     unsigned long long* rejected; ///< pairs the pre-test proved separated
-    const ResumePoint* resume_from; ///< null: every tet, from the start; else item i resumes resume_from[i]
-    ResumePoint* stopped;           ///< [tets] where the tets that did not fit stopped
+    const ResumePoint* resume_from; ///< null: every item, from the start; else item i resumes resume_from[i]
+    ResumePoint* stopped;           ///< [items] where the items that did not fit stopped
     std::uint32_t* stopped_count;
+    /// Work items per tet, each searching part of its layers (for_each_larger_neighbour's parts): item
+    /// t * layer_parts + p. The GPU splits a tet's search (Exec::search_parts_per_tet), so that its
+    /// threads' chains of dependent loads are shorter; the CPU searches a tet whole.
+    std::uint32_t layer_parts;
     /// A frame that resumes the tets that did not fit (a first frame): such a tet stops searching at
     /// once, since its resumption searches again. Otherwise it searches on, counting the room the
     /// whole frame needs, so that a single rerun fits.
@@ -555,23 +563,25 @@ struct FindCandidatesKernel {
     };
 
     KDET_HD void operator()(std::uint64_t i) const {
-        const auto t = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
-        if (scene.info[t].layer < 0) return;
+        const auto item = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
+        const std::uint32_t t = item / layer_parts, part = item % layer_parts;
+        const int layer = scene.info[t].layer;
+        if (layer < 0 || layer + static_cast<int>(part) >= params->layer_count) return;
         const std::uint32_t already_stored = resume_from ? resume_from[i].stored : 0u;
-        // Once a first frame's buffer is full, a tet that has not started would only search until
+        // Once a first frame's buffer is full, an item that has not started would only search until
         // its first batch and then search again after the buffer grows: it waits for that at once.
         if (stop_when_full && atomic_load_acquire(out.count) >= out.capacity) {
-            stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{t, already_stored};
+            stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{item, already_stored};
             return;
         }
         KeyBatch batch(&out, already_stored);
         Emit emit{&scene, &batch, stop_when_full, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
         load_tet(scene, t, emit.vertices);
         const GridParams grid_params = *params;
-        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit);
+        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part, layer_parts);
         batch.flush();
         if (batch.stopped) {
-            stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{t, batch.stored};
+            stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{item, batch.stored};
             return;
         }
         if (emit.rejected) atomic_fetch_add(rejected, emit.rejected);

@@ -362,13 +362,15 @@ GridView Pipeline<Exec>::populate() {
 
 /// @brief Stage 3 (kdet): candidate pairs, each written once. A frame that reads its counters back
 /// here (a first frame, to size the pairs' window) does not rerun when the buffer overflows: the
-/// buffer grows keeping what was stored and only the tets that did not fit search again, each
-/// resuming after the keys it had stored (they stopped searching when they did not fit). Later frames read nothing here; an overflow shows in the
+/// buffer grows keeping what was stored and only the search items (tets, or parts of their searches:
+/// Exec::search_parts_per_tet) that did not fit search again, each resuming after the keys it had
+/// stored (they stopped searching when they did not fit). Later frames read nothing here; an overflow shows in the
 /// frame's counters and the frame reruns (grow_for). Returns the counters when it read them.
 template <class Exec>
 std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
-    for (auto& points : resume_points_) points.resize_discard(tets_.size());
-    std::size_t items = tets_.size();
+    constexpr std::uint32_t parts = Exec::search_parts_per_tet;
+    for (auto& points : resume_points_) points.resize_discard(tets_.size() * parts);
+    std::size_t items = tets_.size() * parts;
     std::size_t first_slot = 0; ///< where this run's keys start in the buffer
     const ResumePoint* resume_from = nullptr;
     for (int run = 0;; ++run) {
@@ -376,12 +378,12 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         ResumePoint* stopped = resume_points_[run % 2].data();
         const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
         exec_.for_each(items, FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected,
-                                                   resume_from, stopped, &c->stopped_tets, !pairs_sized_});
+                                                   resume_from, stopped, &c->stopped_tets, parts, !pairs_sized_});
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
         if (!after.stopped_tets) return after;
-        // The tets that stopped quit searching when they did not fit, so their need is estimated from
-        // the keys per tet of the ones that finished in this run, with a quarter more (room for the
+        // The items that stopped quit searching when they did not fit, so their need is estimated from
+        // the keys per item of the ones that finished in this run, with a quarter more (room for the
         // next frames, whose overflow would rerun the whole frame); the buffer grows by half at
         // least, so a poor estimate costs few rounds.
         const std::size_t kept = candidates_.size();
