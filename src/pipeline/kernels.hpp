@@ -528,8 +528,10 @@ struct FindCandidatesKernel {
     ResumePoint* stopped;           ///< [items] where the items that did not fit stopped
     std::uint32_t* stopped_count;
     /// Work items per tet, each searching part of its layers (for_each_larger_neighbour's parts): item
-    /// t * layer_parts + p. The GPU splits a tet's search (Exec::search_parts_per_tet), so that its
-    /// threads' chains of dependent loads are shorter; the CPU searches a tet whole.
+    /// p * tets + t, so that neighbouring items are neighbouring tets on the same part (a scene whose
+    /// tets sit on one or two layers leaves whole warps of later parts idle, not three lanes in four).
+    /// The GPU splits a tet's search (Exec::search_parts_per_tet), so that its threads' chains of
+    /// dependent loads are shorter; the CPU searches a tet whole.
     std::uint32_t layer_parts;
     /// A frame that resumes the tets that did not fit (a first frame): such a tet stops searching at
     /// once, since its resumption searches again. Otherwise it searches on, counting the room the
@@ -564,7 +566,7 @@ struct FindCandidatesKernel {
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto item = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
-        const std::uint32_t t = item / layer_parts, part = item % layer_parts;
+        const std::uint32_t t = item % scene.tet_count, part = item / scene.tet_count;
         const int layer = scene.info[t].layer;
         if (layer < 0 || layer + static_cast<int>(part) >= params->layer_count) return;
         const std::uint32_t already_stored = resume_from ? resume_from[i].stored : 0u;
