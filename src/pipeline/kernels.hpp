@@ -529,7 +529,7 @@ struct FindCandidatesKernel {
     std::uint32_t* stopped_count;
     /// Work items per tet, each searching part of its layers (for_each_larger_neighbour's parts): item
     /// p * tets + t, so that neighbouring items are neighbouring tets on the same part (a scene whose
-    /// tets sit on one or two layers leaves whole warps of later parts idle, not three lanes in four).
+    /// tets sit on one or two layers leaves whole warps of later parts idle, not lanes of every warp).
     /// The GPU splits a tet's search (Exec::search_parts_per_tet), so that its threads' chains of
     /// dependent loads are shorter; the CPU searches a tet whole.
     std::uint32_t layer_parts;
