@@ -143,6 +143,10 @@ public:
     /// one, so that a thread loads the tet once and its dynamic chunks stay balanced.
     static constexpr std::uint32_t search_parts_per_tet = 1;
 
+    /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): many, since an item
+    /// adds its counts with a few atomics and bounds the cells by what its previous tet covered.
+    static constexpr std::uint32_t plan_chunk = 256;
+
     /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`),
     /// divided by `per_item` (rounded up) when each item takes that many: a stage whose size an earlier
     /// stage counted is launched without the host reading the count.

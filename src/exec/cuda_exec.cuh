@@ -174,6 +174,11 @@ public:
     /// kernel took about as long for 20k tets as for 164k (1-4 ms, the longest threads' chains).
     static constexpr std::uint32_t search_parts_per_tet = 4;
 
+    /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): few, since a thread
+    /// walks its tets in series (256 took 0.2-0.33 ms on an H200, a tenth of the frame's kernels);
+    /// the plan's bound on the cells loosens a little (each item counts its first tet's cells whole).
+    static constexpr std::uint32_t plan_chunk = 16;
+
     explicit CudaExec(const DetectorOptions& options)
         : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
         int devices = 0;

@@ -273,7 +273,7 @@ void Pipeline<Exec>::grid_geometry() {
     FrameCounters* c = counters_.data();
     exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size});
     exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, &c->region, &c->params});
-    constexpr std::uint32_t chunk = 256;
+    constexpr std::uint32_t chunk = Exec::plan_chunk;
     exec_.for_each((tets_.size() + chunk - 1) / chunk,
                    GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask});
 }
