@@ -9,8 +9,8 @@
 #   peer     kdet against a CUB sort-and-sweep + sat peer on the same frames (bench/gpu_vs_sweep.cu)
 #   profile  each kernel's GPU time in two frames of four cases (Nsight Compute), and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
-#   compare  the bundle's kdet against the one it holds as kdet-before (copied there by hand), two
-#            alternating rounds on three cases
+#   compare  the bundle's kdet against the other builds it holds as kdet-NAME (copied there by hand,
+#            e.g. kdet-before), two alternating rounds on three cases
 #   matrix   the thesis benchmark matrix (scripts/run-thesis-matrix.sh) until the deadline
 # usage: scripts/gpu-session.sh PART [PART ...]   (e.g. tests r4 sanitizers scaling)
 # Settings: KDET_GPU_DEADLINE, seconds after which no step starts and running ones are stopped [500].
@@ -121,8 +121,9 @@ for part in "$@"; do
     done
     ;;
   compare)
+    others=$(cd "$bundle" && ls kdet-* 2>/dev/null)
     for round in 1 2; do
-      for program in kdet-before kdet; do
+      for program in $others kdet; do
         for case in "procedural-100k procedural --tets 100000 -s no --frames 55:65" \
           "armadillos-r4-self armadillos -r 4 -s yes --frames 70:99" \
           "pass_through-r2 pass_through_armadillos -r 2 -s no --frames 20:59"; do
