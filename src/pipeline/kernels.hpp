@@ -533,7 +533,7 @@ struct FindCandidatesKernel {
     /// The GPU splits a tet's search (Exec::search_parts_per_tet), so that its threads' chains of
     /// dependent loads are shorter; the CPU searches a tet whole.
     std::uint32_t layer_parts;
-    /// A frame that resumes the tets that did not fit (a first frame): such a tet stops searching at
+    /// A frame that resumes the items that did not fit (a first frame): such an item stops searching at
     /// once, since its resumption searches again. Otherwise it searches on, counting the room the
     /// whole frame needs, so that a single rerun fits.
     bool stop_when_full;

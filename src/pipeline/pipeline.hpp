@@ -33,7 +33,7 @@ struct FrameCounters {
     unsigned long long colliding_pairs;   ///< appended (counts past the window's end)
     unsigned long long colliding_tets;
     unsigned long long involved_tets; ///< tets of the objects in a pair checked this frame
-    std::uint32_t stopped_tets; ///< ResumePoints the candidate search left: its buffer was full
+    std::uint32_t stopped_items; ///< ResumePoints the candidate search left (items, not tets): its buffer was full
     std::uint32_t grid_failure;
     std::uint32_t overflow_used;
     std::uint32_t layer_mask;
@@ -378,18 +378,18 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         ResumePoint* stopped = resume_points_[run % 2].data();
         const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
         exec_.for_each(items, FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected,
-                                                   resume_from, stopped, &c->stopped_tets, parts, !pairs_sized_});
+                                                   resume_from, stopped, &c->stopped_items, parts, !pairs_sized_});
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
-        if (!after.stopped_tets) return after;
+        if (!after.stopped_items) return after;
         // The items that stopped quit searching when they did not fit, so their need is estimated from
         // the keys per item of the ones that finished in this run, with a quarter more (room for the
         // next frames, whose overflow would rerun the whole frame); the buffer grows by half at
         // least, so a poor estimate costs few rounds.
         const std::size_t kept = candidates_.size();
-        const double finished = static_cast<double>(items - after.stopped_tets);
+        const double finished = static_cast<double>(items - after.stopped_items);
         const double stored_now = static_cast<double>(kept - std::min(kept, first_slot));
-        const double estimate = finished > 0.0 ? 1.25 * stored_now / finished * after.stopped_tets : 0.0;
+        const double estimate = finished > 0.0 ? 1.25 * stored_now / finished * after.stopped_items : 0.0;
         const std::size_t more = std::max(static_cast<std::size_t>(estimate), kept / 2);
         candidates_grown_.resize_discard(kept + more + KeyBatch::size);
         exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
@@ -397,8 +397,8 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         ++regrows_;
         after.candidates = kept;
         first_slot = kept;
-        items = after.stopped_tets;
-        after.stopped_tets = 0;
+        items = after.stopped_items;
+        after.stopped_items = 0;
         exec_.upload(counters_.data(), &after, 1);
         resume_from = stopped;
     }
@@ -584,7 +584,7 @@ void Pipeline<Exec>::enqueue_again(const FrameCounters& c, Rerun stage) {
         kept.candidate_padding = 0;
         kept.tests_run = 0;
         kept.rejected = 0;
-        kept.stopped_tets = 0;
+        kept.stopped_items = 0;
         kept.brute_force_exact_stage = 0;
     }
     kept.exact_stage_pairs = 0;
