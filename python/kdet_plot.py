@@ -100,9 +100,19 @@ def grid_figure(files: list[BenchFile], draw: Callable, title: str, path: str, w
     save(fig, path, written)
 
 
+# One colour per method in every panel and figure (where a panel holds one file of that method).
+METHOD_COLORS = {"kdet": "tab:red", "kdet_no_pairs": "tab:green", "gpu": "tab:orange", "gpu_no_loop": "tab:blue"}
+
+
+def method_color(bench: BenchFile, panel: list[BenchFile]) -> str | None:
+    alone = sum(1 for other in panel if other.algorithm == bench.algorithm) == 1
+    return METHOD_COLORS.get(bench.algorithm) if alone else None
+
+
 def draw_frame_times(ax, panel: list[BenchFile]) -> None:
     for bench in panel:
-        ax.plot(bench.column("frame"), bench.column("device time"), label=series_label(bench, panel), linewidth=1.2)
+        ax.plot(bench.column("frame"), bench.column("device time"), label=series_label(bench, panel), linewidth=1.2,
+                color=method_color(bench, panel))
     ax.set_ylabel("frame time (ms)")
     ax.legend(fontsize=7)
 
@@ -194,7 +204,7 @@ def memory_figure(files: list[BenchFile], title: str, path: str, written: list[s
         for case in cases:
             match = [f for f in files if (f.resolution, f.scene, f.total_tets, f.algorithm) == case + (method,)]
             mib.append(int(match[0].header.get("peak memory bytes", "0")) / 2**20 if match else 0.0)
-        ax.barh(np.arange(len(cases)) + m * height, mib, height=height, label=method)
+        ax.barh(np.arange(len(cases)) + m * height, mib, height=height, label=method, color=METHOD_COLORS.get(method))
     ax.set_yticks(np.arange(len(cases)) + 0.4 - height / 2, [case_label(case_of[c], files) for c in cases],
                   fontsize=8)
     ax.set_xlabel("peak detector memory (MiB)")
