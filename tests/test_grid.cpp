@@ -148,14 +148,15 @@ struct EveryEntry {
 struct TestTable {
     std::vector<BucketHeader> headers;
     std::vector<std::uint32_t> ids;
+    std::vector<std::uint32_t> claimed_slots;
     std::uint32_t overflow_used = 0, failure = 0, claimed = 0;
     GridView view{};
     TestTable(std::uint32_t slots, std::uint32_t capacity, std::uint32_t pool, std::uint32_t probes, HashFunction hash)
-        : headers(slots + pool, BucketHeader{}), ids(static_cast<std::size_t>(slots + pool) * capacity) {
+        : headers(slots + pool, BucketHeader{}), ids(static_cast<std::size_t>(slots + pool) * capacity), claimed_slots(slots) {
         std::uint32_t bits = 0;
         while ((1u << bits) < slots) ++bits;
         view = GridView{headers.data(), ids.data(), nullptr, nullptr, nullptr, nullptr, 0, &overflow_used, &failure, &claimed,
-                        slots, bits, capacity, pool, 1, probes, hash};
+                        claimed_slots.data(), slots, bits, capacity, pool, 1, probes, hash};
     }
     /// A compacted copy of the table (the table itself stays open for inserts), with room for
     /// `room` entries; each entry carries its id, and its id again as the object.
@@ -262,6 +263,9 @@ TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
     });
     ASSERT_EQ(table.failure, 0u);
     EXPECT_EQ(table.claimed, cells);
+    std::set<std::uint32_t> main_buckets;
+    for (std::uint32_t c = 0; c < cells; ++c) main_buckets.insert(grid_find(table.view, CellCoord{c, 1, 2, 0}));
+    EXPECT_EQ(std::set<std::uint32_t>(table.claimed_slots.begin(), table.claimed_slots.begin() + cells), main_buckets);
     EXPECT_GT(table.overflow_used, 1000u);
     for (std::uint32_t c = 0; c < cells; ++c) {
         std::multiset<std::uint32_t> expected;
@@ -269,6 +273,21 @@ TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
         EXPECT_EQ(table.contents(CellCoord{c, 1, 2, 0}), expected) << "cell " << c;
     }
     EXPECT_TRUE(table.contents(CellCoord{99, 1, 2, 0}).empty());
+}
+
+TEST(BucketTable, RecordsTheCellsInTheOrderTheyWereClaimed) {
+    TestTable table(64, 4, 16, 32, HashFunction::djb2);
+    const CellCoord cells[] = {{5, 1, 0, 0}, {2, 7, 1, 0}, {5, 1, 0, 0}, {0, 0, 3, 1}, {2, 7, 1, 0}};
+    std::uint32_t id = 0;
+    for (const CellCoord& cell : cells) ASSERT_NE(grid_insert(table.view, cell, id++, 0u), no_bucket);
+    ASSERT_EQ(table.claimed, 3u);
+    EXPECT_EQ(table.claimed_slots[0], grid_find(table.view, cells[0]));
+    EXPECT_EQ(table.claimed_slots[1], grid_find(table.view, cells[1]));
+    EXPECT_EQ(table.claimed_slots[2], grid_find(table.view, cells[3]));
+    table.next_frame(); // a new frame claims anew, in its own order
+    ASSERT_NE(grid_insert(table.view, cells[3], 0u, 0u), no_bucket);
+    ASSERT_EQ(table.claimed, 1u);
+    EXPECT_EQ(table.claimed_slots[0], grid_find(table.view, cells[3]));
 }
 
 TEST(BucketTable, ReportsAFullTableAndAnExhaustedPool) {

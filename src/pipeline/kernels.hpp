@@ -351,8 +351,11 @@ struct PopulateKernel {
     }
 };
 
-/// @brief Stage 2, after populating: one work item per main slot of the table; copies each occupied
-/// cell's ids, with their boxes and objects, into one contiguous list (compact_cell).
+/// @brief Stage 2, after populating: one work item per occupied cell, in the order the cells were
+/// claimed (GridView::claimed_slots; the items past the claimed cells do nothing); copies each cell's
+/// ids, with their boxes and objects, into one contiguous list (compact_cell). Cells claimed one after
+/// the other belong to neighbouring tets, so the boxes it gathers and the lists it writes stay close
+/// together in memory, as do the lists a tet's search reads.
 struct CompactCellsKernel {
     SceneView scene;
     GridView grid;
@@ -362,8 +365,9 @@ struct CompactCellsKernel {
         KDET_HD GridEntry operator()(std::uint32_t u) const { return GridEntry{scene->info[u].box, u, scene->tet_object[u]}; }
     };
 
-    KDET_HD void operator()(std::uint64_t slot) const {
-        compact_cell(grid, static_cast<std::uint32_t>(slot), EntryOf{&scene});
+    KDET_HD void operator()(std::uint64_t i) const {
+        if (i >= *grid.cells_claimed) return;
+        compact_cell(grid, grid.claimed_slots[i], EntryOf{&scene});
     }
 };
 

@@ -136,10 +136,10 @@ public:
                blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes() + exec_.scratch_bytes();
     }
 
-    /// The grid's buffers: the table, the compacted lists and their bounds, the own-layer rows.
+    /// The grid's buffers: the table, the compacted lists and their bounds, the own-layer rows, the claim order.
     std::size_t grid_bytes() const {
         return headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() +
-               block_bounds_.capacity_bytes() + own_cells_.capacity_bytes();
+               block_bounds_.capacity_bytes() + own_cells_.capacity_bytes() + claimed_slots_.capacity_bytes();
     }
 
     std::string device_name() const override { return exec_.device_name(); }
@@ -220,6 +220,7 @@ private:
     buffer<EntryBlock> entry_blocks_; ///< the compacted cells' lists
     buffer<Aabb> block_bounds_; ///< the bound of each block of entry_block entries
     buffer<OwnCells> own_cells_; ///< per stored tet, where it sits in its own layer's cells
+    buffer<std::uint32_t> claimed_slots_; ///< the main buckets in the order they were claimed
     buffer<FrameCounters> counters_;
     buffer<std::uint64_t> candidates_;
     buffer<std::uint64_t> candidates_grown_; ///< the next candidate buffer while one grows keeping its contents
@@ -351,8 +352,9 @@ GridView Pipeline<Exec>::populate() {
         fill(entry_blocks_, EntryBlock{});
     }
     own_cells_.resize_discard(tets_.size());
+    claimed_slots_.resize_discard(slot_count_);
     const GridView grid{headers_.data(), ids_.data(), entry_blocks_.data(), block_bounds_.data(), own_cells_.data(), &c->grid_entries, entry_capacity_,
-                        &c->overflow_used, &c->grid_failure, &c->cells_claimed, slot_count_, slot_bits, capacity,
+                        &c->overflow_used, &c->grid_failure, &c->cells_claimed, claimed_slots_.data(), slot_count_, slot_bits, capacity,
                         overflow_capacity_, stamp_, 64u, options_.hash};
     exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, &c->params});
     exec_.for_each(slot_count_, CompactCellsKernel{scene_view(), grid});
