@@ -74,6 +74,34 @@ TEST(EnclosingSphere, MatchesAnIterativeSolverAndEnclosesEveryVertex) {
     }
 }
 
+TEST(EnclosingSphere, LiesWithinTheBoundsOfTheLongestEdge) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    const float a = std::sqrt(0.5f);
+    const vec3 regular[4] = {{1, 0, -a}, {-1, 0, -a}, {0, 1, a}, {0, -1, a}}; // edge 2
+    for (int i = 0; i < 20000; ++i) {
+        // Random tets at scales over six decades, far from the origin; every 4th flat, every 4th a needle;
+        // every 50th the regular tet at the origin, which needs the whole of Jung's bound.
+        const bool is_regular = i % 50 == 0;
+        const float scale = std::pow(10.0f, 3.0f * unit(rng));
+        const vec3 offset = is_regular ? vec3{0, 0, 0} : vec3{100.0f * unit(rng), 100.0f * unit(rng), 100.0f * unit(rng)};
+        vec3 v[4];
+        for (int k = 0; k < 4; ++k) {
+            vec3 q = is_regular ? regular[k] : vec3{unit(rng), unit(rng), unit(rng)};
+            if (!is_regular && i % 4 == 1) q.z *= 1e-3f;
+            if (!is_regular && i % 4 == 2) q.y *= 1e-3f, q.z *= 1e-3f;
+            v[k] = offset + q * scale;
+        }
+        const float d = enclosing_sphere_diameter(v);
+        const SphereDiameterBounds bounds = sphere_diameter_bounds(longest_edge(v));
+        EXPECT_LE(bounds.lower, d) << "tet " << i;
+        EXPECT_GE(bounds.upper, d) << "tet " << i;
+        if (is_regular) {
+            EXPECT_GT(d, 0.998f * bounds.upper) << "the regular tet fills the bound";
+        }
+    }
+}
+
 TEST(OrderedFloat, PreservesOrderAndRoundTrips) {
     const float values[] = {-3.4e38f, -1.0f, -1e-30f, -0.0f, 0.0f, 1e-30f, 2.5f, 3.4e38f};
     for (std::size_t i = 0; i + 1 < sizeof values / sizeof *values; ++i) {

@@ -252,6 +252,67 @@ TEST(GridPlan, CountsEveryEntryAndBoundsTheOccupiedCellsInAnyOrder) {
     }
 }
 
+TEST(GridPlan, PutsEveryTetOnItsSpheresLayerThoughSizingLeavesMostSpheresUncomputed) {
+    // Tets of sizes over six octaves, some flat or needles, sized on two threads as the pipeline does.
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    const std::uint32_t count = 20000;
+    std::vector<vec3> positions;
+    std::vector<TetIndices> tets;
+    for (std::uint32_t t = 0; t < count; ++t) {
+        const float size = std::exp2(6.0f * unit(rng));
+        const vec3 at{100.0f * unit(rng), 100.0f * unit(rng), 100.0f * unit(rng)};
+        for (int k = 0; k < 4; ++k) {
+            vec3 q{unit(rng), unit(rng), unit(rng)};
+            if (t % 7 == 1) q.z *= 0.01f;
+            if (t % 7 == 2) q.x *= 0.01f, q.y *= 0.01f;
+            positions.push_back(at + q * size);
+        }
+        tets.push_back(TetIndices{{4 * t, 4 * t + 1, 4 * t + 2, 4 * t + 3}});
+    }
+    std::vector<std::uint32_t> objects(count, 0u);
+    std::vector<TetInfo> infos(count);
+    std::vector<TetPlanes> planes(count);
+    const std::uint8_t self = 1;
+    const std::uint32_t checked = object_bit(0);
+    const Aabb everywhere_box{{-1e9f, -1e9f, -1e9f}, {1e9f, 1e9f, 1e9f}};
+    const SceneView scene{positions.data(), tets.data(), objects.data(), infos.data(), planes.data(), &self,
+                          &checked, &everywhere_box, count, 1};
+    DetectorOptions two_threads;
+    two_threads.threads = 2;
+    const CpuExec exec(two_threads);
+    exec.for_each(count, TetBoundsKernel{scene});
+    std::uint32_t min_size = float_to_ordered(INFINITY), max_size = float_to_ordered(0.0f);
+    std::uint32_t min_upper = float_to_ordered(INFINITY), max_lower = float_to_ordered(0.0f);
+    exec.for_each(count, TetSizeKernel{scene, &min_size, &max_size, &min_upper, &max_lower});
+    std::uint32_t left = 0;
+    float dmin = INFINITY, dmax = 0.0f;
+    for (std::uint32_t t = 0; t < count; ++t) {
+        left += infos[t].diameter < 0.0f ? 1u : 0u;
+        vec3 v[4];
+        load_tet(scene, t, v);
+        dmin = std::min(dmin, enclosing_sphere_diameter(v));
+        dmax = std::max(dmax, enclosing_sphere_diameter(v));
+    }
+    EXPECT_GT(left, count / 2) << "most spheres are left to the plan";
+    EXPECT_EQ(ordered_to_float(min_size), dmin); // the grid's geometry comes from the exact extremes
+    EXPECT_EQ(ordered_to_float(max_size), dmax);
+    const OrderedBox region{{float_to_ordered(0.0f), float_to_ordered(0.0f), float_to_ordered(0.0f)},
+                            {float_to_ordered(200.0f), float_to_ordered(200.0f), float_to_ordered(200.0f)}};
+    GridParams params{};
+    GridParamsKernel{&min_size, &max_size, &region, &params}(0);
+    EXPECT_EQ(params.cell_size0, dmin);
+    unsigned long long entries[max_grid_layers] = {}, cells[max_grid_layers] = {};
+    std::uint32_t mask = 0;
+    const std::uint32_t chunk = 64;
+    exec.for_each((count + chunk - 1) / chunk, GridPlanKernel{scene, &params, chunk, entries, cells, &mask});
+    for (std::uint32_t t = 0; t < count; ++t) {
+        vec3 v[4];
+        load_tet(scene, t, v);
+        ASSERT_EQ(infos[t].layer, layer_of(params, enclosing_sphere_diameter(v))) << "tet " << t;
+    }
+}
+
 TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {
     TestTable table(64, 4, 4096, 32, HashFunction::fnv1a);
     DetectorOptions two_threads;

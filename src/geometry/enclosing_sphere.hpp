@@ -33,17 +33,29 @@ KDET_HD inline void consider(const vec3 p[4], vec3 center, float radius_squared,
     best = Candidate{center, radius_squared, true};
 }
 
+/// @brief The points in a frame whose origin is the first of them: the formulas stay accurate far
+/// from the origin.
+KDET_HD inline void local_frame(const vec3 v[4], vec3 p[4]) {
+    p[0] = make_vec3(0.0f, 0.0f, 0.0f);
+    for (int k = 1; k < 4; ++k) p[k] = v[k] - v[0];
+}
+
+KDET_HD inline float longest_edge_squared(const vec3 p[4]) {
+    float longest = 0.0f;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) longest = max_f(longest, length_squared(p[i] - p[j]));
+    return longest;
+}
+
 } // namespace sphere_detail
 
 /// @brief Diameter of the smallest sphere enclosing the four points (never smaller than the true one
 /// by more than rounding, never larger than the longest-edge bound sqrt(3) * true diameter).
 KDET_HD inline float enclosing_sphere_diameter(const vec3 v[4]) {
     using sphere_detail::consider;
-    // A local frame keeps the formulas accurate far from the origin.
-    const vec3 p[4] = {make_vec3(0.0f, 0.0f, 0.0f), v[1] - v[0], v[2] - v[0], v[3] - v[0]};
-    float scale_squared = 0.0f;
-    for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) scale_squared = max_f(scale_squared, length_squared(p[i] - p[j]));
+    vec3 p[4];
+    sphere_detail::local_frame(v, p);
+    const float scale_squared = sphere_detail::longest_edge_squared(p);
 
     sphere_detail::Candidate best{make_vec3(0.0f, 0.0f, 0.0f), 3.4e38f, false};
     for (int i = 0; i < 4; ++i)
@@ -75,6 +87,24 @@ KDET_HD inline float enclosing_sphere_diameter(const vec3 v[4]) {
     if (!best.valid) center = (p[0] + p[1] + p[2] + p[3]) * 0.25f; // only for non-finite input
     const float radius = sqrtf(sphere_detail::farthest_squared(p, center));
     return 2.0f * radius * (1.0f + 4.0f * 1.1920929e-7f);
+}
+
+/// @brief The longest edge of the tet, in the frame enclosing_sphere_diameter computes in.
+KDET_HD inline float longest_edge(const vec3 v[4]) {
+    vec3 p[4];
+    sphere_detail::local_frame(v, p);
+    return sqrtf(sphere_detail::longest_edge_squared(p));
+}
+
+/// @brief Bounds on enclosing_sphere_diameter from the tet's longest edge D. The sphere holds both ends
+/// of every edge, so its diameter is at least D; by Jung's theorem a set of diameter D in space lies in
+/// a sphere of diameter sqrt(3/2) D (the regular tet needs all of it). Each bound is widened by a
+/// thousandth, far beyond the rounding of either computation.
+struct SphereDiameterBounds {
+    float lower, upper;
+};
+KDET_HD inline SphereDiameterBounds sphere_diameter_bounds(float longest_edge) {
+    return SphereDiameterBounds{longest_edge * 0.999f, longest_edge * 1.2260f};
 }
 
 } // namespace kdet

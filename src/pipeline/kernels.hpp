@@ -23,7 +23,10 @@ struct TetIndices {
 /// @brief Per-tet data recomputed every frame.
 struct TetInfo {
     Aabb box;
-    float diameter;     ///< of the minimum enclosing sphere; computed for relevant tets only (TetSizeKernel)
+    /// Of the minimum enclosing sphere, for relevant tets only (TetSizeKernel); a negative value is
+    /// minus the tet's longest edge instead, which bounds it (sphere_diameter_bounds), for a tet whose
+    /// sphere TetSizeKernel left to GridPlanKernel (tet_layer).
+    float diameter;
     std::int32_t layer; ///< grid layer, or -1 when the tet cannot collide with anything enabled
 };
 
@@ -203,10 +206,19 @@ struct ObjectCullingKernel {
 /// A tet is relevant when its object's self-collision is on, or when its box overlaps another object
 /// it is checked against (inter-object culling: only tets in the overlap region are sized and gridded).
 /// A relevant tet gets layer 0 until populate picks its layer; the others keep -1.
+///
+/// The minimum enclosing sphere (about as costly as the tet's face planes) is computed here only for
+/// the tets that may be the smallest or the largest, which the grid's geometry needs exactly: those
+/// whose longest-edge bounds (sphere_diameter_bounds) reach below every upper bound seen so far, or
+/// above every lower bound. The smallest tet always does, since its sphere is below every tet's upper
+/// bound, and likewise the largest. The others keep their longest edge, and GridPlanKernel computes
+/// the sphere only when the bounds fall on two layers (tet_layer).
 struct TetSizeKernel {
     SceneView scene;
-    std::uint32_t* min_size; ///< float_to_ordered
+    std::uint32_t* min_size; ///< float_to_ordered, of the spheres computed
     std::uint32_t* max_size;
+    std::uint32_t* min_upper_size; ///< float_to_ordered, of the relevant tets' upper bounds
+    std::uint32_t* max_lower_size;  ///< and of their lower bounds
 
     KDET_HD bool relevant(std::uint32_t object, const Aabb& box) const {
         if (pair_is_active(scene, object, object)) return true;
@@ -221,10 +233,19 @@ struct TetSizeKernel {
         if (!relevant(scene.tet_object[t], info.box)) return;
         vec3 v[4];
         load_tet(scene, static_cast<std::uint32_t>(t), v);
-        info.diameter = enclosing_sphere_diameter(v);
         info.layer = 0;
         scene.planes[t] = tet_planes(v);
-        // Reading first keeps the atomics few: after the first tets, almost none widens the range.
+        const float longest = longest_edge(v);
+        const SphereDiameterBounds bounds = sphere_diameter_bounds(longest);
+        // Reading first keeps the atomics few: after the first tets, almost none widens a range.
+        const std::uint32_t lower = float_to_ordered(bounds.lower), upper = float_to_ordered(bounds.upper);
+        if (upper < atomic_load_acquire(min_upper_size)) atomic_min(min_upper_size, upper);
+        if (lower > atomic_load_acquire(max_lower_size)) atomic_max(max_lower_size, lower);
+        if (lower > atomic_load_acquire(min_upper_size) && upper < atomic_load_acquire(max_lower_size)) {
+            info.diameter = -longest;
+            return;
+        }
+        info.diameter = enclosing_sphere_diameter(v);
         const std::uint32_t size = float_to_ordered(info.diameter);
         if (size < atomic_load_acquire(min_size)) atomic_min(min_size, size);
         if (size > atomic_load_acquire(max_size)) atomic_max(max_size, size);
@@ -257,6 +278,19 @@ struct GridParamsKernel {
         *params = GridParams{origin, c0, 1.0f / c0, layers};
     }
 };
+
+/// @brief The layer of relevant tet t, whose TetInfo::diameter is `size`: from its sphere where
+/// TetSizeKernel computed it; else from its longest-edge bounds where both fall on one layer (layers
+/// grow with the size, so the sphere's does too, up to rounding); else from its sphere, computed now.
+KDET_HD inline int tet_layer(const SceneView& scene, const GridParams& params, std::uint32_t t, float size) {
+    if (!(size < 0.0f)) return layer_of(params, size);
+    const SphereDiameterBounds bounds = sphere_diameter_bounds(-size);
+    const int low = layer_of(params, bounds.lower), high = layer_of(params, bounds.upper);
+    if (low == high) return low;
+    vec3 v[4];
+    load_tet(scene, t, v);
+    return layer_of(params, enclosing_sphere_diameter(v));
+}
 
 /// @brief Cells in a range.
 KDET_HD inline unsigned long long cell_count(const CellRange& r) {
@@ -302,7 +336,7 @@ struct GridPlanKernel {
         for (std::uint64_t t = begin; t < end; ++t) {
             TetInfo& info = scene.info[t];
             if (info.layer < 0) continue;
-            const int layer = layer_of(params, info.diameter);
+            const int layer = tet_layer(scene, params, static_cast<std::uint32_t>(t), info.diameter);
             info.layer = layer;
             const CellRange r = cell_range(params, info.box, layer);
             const unsigned long long cells = cell_count(r);

@@ -43,6 +43,8 @@ struct FrameCounters {
     std::uint32_t object_runs; ///< runs of tets of one object, i.e. non-empty objects
     std::uint32_t min_size; ///< float_to_ordered, over the relevant tets
     std::uint32_t max_size;
+    std::uint32_t min_upper_size; ///< float_to_ordered, of the relevant tets' upper bounds on their size (TetSizeKernel)
+    std::uint32_t max_lower_size; ///< and of their lower bounds
     OrderedBox region; ///< the gridded region: the boxes of the objects in a checked pair
     GridParams params; ///< GridParamsKernel's
     unsigned long long layer_entries[max_grid_layers]; ///< cell entries the relevant tets need, per layer
@@ -53,6 +55,8 @@ struct FrameCounters {
         FrameCounters c{};
         c.min_size = float_to_ordered(std::numeric_limits<float>::infinity());
         c.max_size = float_to_ordered(0.0f);
+        c.min_upper_size = float_to_ordered(std::numeric_limits<float>::infinity());
+        c.max_lower_size = float_to_ordered(0.0f);
         c.first_non_finite_vertex = no_vertex;
         for (int a = 0; a < 3; ++a) {
             c.region.lo[a] = float_to_ordered(std::numeric_limits<float>::infinity());
@@ -272,7 +276,7 @@ void Pipeline<Exec>::bounds_and_culling() {
 template <class Exec>
 void Pipeline<Exec>::grid_geometry() {
     FrameCounters* c = counters_.data();
-    exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size});
+    exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size, &c->min_upper_size, &c->max_lower_size});
     exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, &c->region, &c->params});
     constexpr std::uint32_t chunk = Exec::plan_chunk;
     exec_.for_each((tets_.size() + chunk - 1) / chunk,
