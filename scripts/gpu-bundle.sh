@@ -5,7 +5,10 @@
 # C/C++ runtimes, the models and the prepared meshes of the thesis scenes. The bundle is a git-ignored
 # folder that the device tool carries.
 #
-# usage: scripts/gpu-bundle.sh            builds build-gpu/ (preset cuda) and fills .gpu-bundle/
+# usage: scripts/gpu-bundle.sh [COMMIT ...]
+#   builds build-gpu/ (preset cuda) and fills .gpu-bundle/; each COMMIT's kdet is built too (from a
+#   worktree, into build-gpu-COMMIT/, kept for the next time) and bundled as kdet-COMMIT, which the
+#   session's `compare` part runs against the bundle's kdet
 # then, with the device tool, one call that runs the parts it needs, e.g.:
 #   run(command="KDET_GPU_DEADLINE=500 bash scripts/gpu-session.sh tests sanitizers r4 peer scaling",
 #       carry=[".gpu-bundle"])
@@ -32,6 +35,15 @@ cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bu
 for program in "$bundle/kdet" "$bundle/kdet_tests" "$bundle/kdet_gpu_vs_sweep"; do
   ldd "$program" | awk '/=> \//{print $3}' | grep -Ev '/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|libgomp|ld-linux[^/]*)\.so' |
     xargs -r cp -Ln -t "$bundle/lib/"
+done
+for commit in "$@"; do
+  short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"
+  worktree="$(mktemp -d)/kdet-$short"
+  git -C "$repo" worktree add --detach "$worktree" "$short" >/dev/null
+  (cd "$worktree" && cmake --preset cuda -B "$repo/build-gpu-$short" >/dev/null)
+  cmake --build "$repo/build-gpu-$short" -j"$(nproc)" --target kdet_cli
+  cp "$repo/build-gpu-$short/kdet" "$bundle/kdet-$short"
+  git -C "$repo" worktree remove --force "$worktree"
 done
 git -C "$repo" log -1 --format='built at commit %H %s' >"$bundle/commit.txt"
 git -C "$repo" status --short --untracked-files=no >>"$bundle/commit.txt"

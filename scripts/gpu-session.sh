@@ -9,8 +9,8 @@
 #   peer     kdet against a CUB sort-and-sweep + sat peer on the same frames (bench/gpu_vs_sweep.cu)
 #   profile  each kernel's GPU time in two frames of four cases (Nsight Compute), and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
-#   compare  the bundle's kdet against the other builds it holds as kdet-NAME (copied there by hand,
-#            e.g. kdet-before), two alternating rounds on three cases
+#   compare  the bundle's kdet against the other builds it holds as kdet-NAME (scripts/gpu-bundle.sh
+#            COMMIT ... puts them there), two alternating rounds on three cases
 #   matrix   the thesis benchmark matrix (scripts/run-thesis-matrix.sh) until the deadline
 # usage: scripts/gpu-session.sh PART [PART ...]   (e.g. tests r4 sanitizers scaling)
 # Settings: KDET_GPU_DEADLINE, seconds after which no step starts and running ones are stopped [500].
