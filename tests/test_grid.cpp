@@ -291,8 +291,9 @@ TEST(GridPlan, PutsEveryTetOnItsSpheresLayerThoughSizingLeavesMostSpheresUncompu
         left += infos[t].diameter < 0.0f ? 1u : 0u;
         vec3 v[4];
         load_tet(scene, t, v);
-        dmin = std::min(dmin, enclosing_sphere_diameter(v));
-        dmax = std::max(dmax, enclosing_sphere_diameter(v));
+        const float d = enclosing_sphere_diameter(v);
+        dmin = std::min(dmin, d);
+        dmax = std::max(dmax, d);
     }
     EXPECT_GT(left, count / 2) << "most spheres are left to the plan";
     EXPECT_EQ(ordered_to_float(min_size), dmin); // the grid's geometry comes from the exact extremes

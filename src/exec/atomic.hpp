@@ -98,6 +98,17 @@ KDET_HD inline void atomic_max(T* address, T value) {
 #endif
 }
 
+/// @brief atomic_min and atomic_max after a plain read, for a running extreme that few values move
+/// once the first have arrived: most threads then only read (a GPU's fetch_min writes either way).
+template <class T>
+KDET_HD inline void atomic_lower_to(T* address, T value) {
+    if (value < atomic_load_acquire(address)) atomic_min(address, value);
+}
+template <class T>
+KDET_HD inline void atomic_raise_to(T* address, T value) {
+    if (value > atomic_load_acquire(address)) atomic_max(address, value);
+}
+
 /// @brief Maps a float to an unsigned integer with the same order, so float min/max can use integer atomics.
 KDET_HD inline std::uint32_t float_to_ordered(float value) {
     std::uint32_t bits;

@@ -126,8 +126,8 @@ struct GridView {
     std::uint32_t* overflow_used;   ///< pool buckets handed out this frame
     std::uint32_t* failure;         ///< GridFailure bits
     std::uint32_t* cells_claimed;   ///< main buckets claimed this frame (occupied cells)
-    /// [slot_count] the main buckets in the order they were claimed this frame, or null: compacting
-    /// them in that order lays the lists out as the tets that claimed them lie (spatial order).
+    /// [slot_count] the main buckets in the order they were claimed this frame: compacting them in that
+    /// order lays the lists out as the tets that claimed them lie (spatial order).
     std::uint32_t* claimed_slots;
     std::uint32_t slot_count;       ///< 2^slot_bits
     std::uint32_t slot_bits;
@@ -155,7 +155,7 @@ KDET_HD inline std::uint32_t claim_bucket(const GridView& g, CellCoord cell) {
             h.tail = slot;
             atomic_store_release(&h.state, ready);
             const std::uint32_t order = atomic_fetch_add(g.cells_claimed, 1u);
-            if (g.claimed_slots) g.claimed_slots[order] = slot;
+            g.claimed_slots[order] = slot;
             return slot;
         }
         // Claimed this frame by someone (maybe just now): wait until its key is visible.

@@ -237,18 +237,16 @@ struct TetSizeKernel {
         scene.planes[t] = tet_planes(v);
         const float longest = longest_edge(v);
         const SphereDiameterBounds bounds = sphere_diameter_bounds(longest);
-        // Reading first keeps the atomics few: after the first tets, almost none widens a range.
         const std::uint32_t lower = float_to_ordered(bounds.lower), upper = float_to_ordered(bounds.upper);
-        if (upper < atomic_load_acquire(min_upper_size)) atomic_min(min_upper_size, upper);
-        if (lower > atomic_load_acquire(max_lower_size)) atomic_max(max_lower_size, lower);
+        atomic_lower_to(min_upper_size, upper);
+        atomic_raise_to(max_lower_size, lower);
         if (lower > atomic_load_acquire(min_upper_size) && upper < atomic_load_acquire(max_lower_size)) {
             info.diameter = -longest;
             return;
         }
         info.diameter = enclosing_sphere_diameter(v);
-        const std::uint32_t size = float_to_ordered(info.diameter);
-        if (size < atomic_load_acquire(min_size)) atomic_min(min_size, size);
-        if (size > atomic_load_acquire(max_size)) atomic_max(max_size, size);
+        atomic_lower_to(min_size, float_to_ordered(info.diameter));
+        atomic_raise_to(max_size, float_to_ordered(info.diameter));
     }
 };
 

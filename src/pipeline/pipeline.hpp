@@ -162,6 +162,13 @@ private:
     void fill(buffer<T>& b, T value) {
         exec_.for_each(b.size(), FillKernel<T>{b.data(), value});
     }
+    /// Makes `b` hold n elements, all `value` when it had to change size (kept as they are otherwise).
+    template <class T>
+    void resize_filled(buffer<T>& b, std::size_t n, T value) {
+        if (b.size() == n) return;
+        b.resize_discard(n);
+        fill(b, value);
+    }
     /// Reads the counters now: a host wait, paid only by a first frame (see start()).
     FrameCounters read_counters_now() {
         FrameCounters c;
@@ -461,10 +468,7 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     FrameCounters* c = counters_.data();
     // The whole window is copied out (the count is not known when the copy is enqueued): a new one is
     // filled once, so that no byte copied is undefined.
-    if (out_keys_.size() != pairs_window_) {
-        out_keys_.resize_discard(pairs_window_);
-        fill(out_keys_, no_pair_key);
-    }
+    resize_filled(out_keys_, pairs_window_, no_pair_key);
     const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
     with_narrow_phase(options_.narrow_phase, [&](auto test) {
         constexpr std::uint32_t per_item = Exec::keys_per_appending_item;
@@ -480,10 +484,7 @@ void Pipeline<Exec>::narrow_phase_and_results() {
                pair_key_bits(static_cast<std::uint32_t>(tets_.size())));
     clock_.mark(sorted);
     if (options_.contacts) {
-        if (out_contacts_.size() != pairs_window_) {
-            out_contacts_.resize_discard(pairs_window_);
-            fill(out_contacts_, Contact{});
-        }
+        resize_filled(out_contacts_, pairs_window_, Contact{});
         exec_.for_each_counted(&c->colliding_pairs, out_contacts_.size(),
                                ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), &c->colliding_pairs,
                                              out_keys_.size(), out_contacts_.data()});
