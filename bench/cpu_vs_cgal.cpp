@@ -14,7 +14,7 @@
 ///   --cases REGEX  only the cases whose names match (e.g. 'hand|soup 10k'); only those are built
 ///   --table FILE  also write the markdown table of medians and ratios to FILE
 /// The table (stdout, after the benchmark output) uses the median of the repetitions when
-/// --benchmark_repetitions is given, else the mean; a second table splits a one-off query by stage.
+/// --benchmark_repetitions is given, else the mean; a second table splits a one-off query and a reused Detector's frame by stage.
 
 #include "peer.hpp"
 #include "peer_cases.hpp"
@@ -128,25 +128,33 @@ void register_case(const PeerCase& c, int threads) {
     });
 }
 
-/// Where a one-off query's time goes: the first frame of a fresh Detector (what kdet::collide runs),
-/// the run with the median total of five, with its stage times, candidates and buffer regrowths.
+/// Where a frame's time goes, one-off and frame by frame: the first frame of a fresh Detector (what
+/// kdet::collide runs), and a frame of one Detector reused as in the frames benchmark; each the run with
+/// the median total of five, with its stage times, candidates and buffer regrowths.
 std::string stage_table(const std::vector<PeerCase>& cases, int threads) {
-    std::string out = "| case | total ms | boxes | populate | candidates | narrow | sort | candidates found | "
-                      "left by the pre-test | colliding | regrows |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    std::string out = "| case | mode | total ms | boxes | populate | candidates | narrow | sort | candidates found | "
+                      "left by the pre-test | colliding | regrows |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     char line[512];
-    for (const PeerCase& c : cases) {
-        std::vector<FrameResult> runs;
-        for (int r = 0; r < 5; ++r) runs.push_back(detect_frame(*make_detector(c, threads), c, 0));
+    const auto add_row = [&](const PeerCase& c, const char* mode, std::vector<FrameResult> runs) {
         std::sort(runs.begin(), runs.end(),
                   [](const FrameResult& a, const FrameResult& b) { return a.times.total < b.times.total; });
-        const StageTimes& t = runs[2].times;
-        const FrameCounts& n = runs[2].counts;
-        std::snprintf(line, sizeof line, "| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %llu | %llu | %llu | %u |\n",
-                      c.name.c_str(), t.total, t.bounding_boxes, t.populate_grid, t.find_candidates, t.narrow_phase,
+        const StageTimes& t = runs[runs.size() / 2].times;
+        const FrameCounts& n = runs[runs.size() / 2].counts;
+        std::snprintf(line, sizeof line, "| %s | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %llu | %llu | %llu | %u |\n",
+                      c.name.c_str(), mode, t.total, t.bounding_boxes, t.populate_grid, t.find_candidates, t.narrow_phase,
                       t.sort_unique, static_cast<unsigned long long>(n.candidates),
                       static_cast<unsigned long long>(n.unique_candidates),
                       static_cast<unsigned long long>(n.colliding_pairs), n.buffer_regrows);
         out += line;
+    };
+    for (const PeerCase& c : cases) {
+        std::vector<FrameResult> one_off, frames;
+        for (int r = 0; r < 5; ++r) one_off.push_back(detect_frame(*make_detector(c, threads), c, 0));
+        add_row(c, "one-off", std::move(one_off));
+        const auto detector = make_detector(c, threads);
+        detect_frame(*detector, c, c.frames.size() - 1); // buffers sized as in the frames benchmark
+        for (std::size_t r = 0; r < 5; ++r) frames.push_back(detect_frame(*detector, c, r % c.frames.size()));
+        add_row(c, "frames", std::move(frames));
     }
     return out;
 }
