@@ -252,13 +252,46 @@ TEST(GridPlan, CountsEveryEntryAndBoundsTheOccupiedCellsInAnyOrder) {
     }
 }
 
+/// One self-colliding object of tets, four consecutive corners each, sized on `threads` threads as the
+/// pipeline's first stage does (TetBoundsKernel, TetSizeKernel). Holds what its SceneView points to.
+struct SizedTets {
+    std::vector<vec3> positions;
+    std::vector<TetIndices> tets;
+    std::vector<std::uint32_t> objects;
+    std::vector<TetInfo> infos;
+    std::vector<TetPlanes> planes;
+    const std::uint8_t self = 1;
+    const std::uint32_t checked = object_bit(0);
+    const Aabb everywhere_box{{-1e9f, -1e9f, -1e9f}, {1e9f, 1e9f, 1e9f}};
+    std::uint32_t min_size = float_to_ordered(INFINITY), max_size = float_to_ordered(0.0f);
+    std::uint32_t min_upper = float_to_ordered(INFINITY), max_lower = float_to_ordered(0.0f);
+    std::vector<std::uint32_t> spacing = std::vector<std::uint32_t>(float_octaves, 0u);
+    std::uint32_t count;
+    SceneView scene;
+
+    SizedTets(std::vector<vec3> corners, int threads)
+        : positions(std::move(corners)), count(static_cast<std::uint32_t>(positions.size() / 4)) {
+        for (std::uint32_t t = 0; t < count; ++t) tets.push_back(TetIndices{{4 * t, 4 * t + 1, 4 * t + 2, 4 * t + 3}});
+        objects.assign(count, 0u);
+        infos.resize(count);
+        planes.resize(count);
+        scene = SceneView{positions.data(), tets.data(), objects.data(), infos.data(), planes.data(), &self,
+                          &checked, &everywhere_box, count, 1};
+        DetectorOptions options;
+        options.threads = threads;
+        const CpuExec exec(options);
+        exec.for_each(count, TetBoundsKernel{scene});
+        exec.for_each(count, TetSizeKernel{scene, &min_size, &max_size, &min_upper, &max_lower, spacing.data()});
+    }
+    SizedTets(const SizedTets&) = delete;
+};
+
 TEST(GridPlan, PutsEveryTetOnItsSpheresLayerThoughSizingLeavesMostSpheresUncomputed) {
     // Tets of sizes over six octaves, some flat or needles, sized on two threads as the pipeline does.
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     const std::uint32_t count = 20000;
     std::vector<vec3> positions;
-    std::vector<TetIndices> tets;
     for (std::uint32_t t = 0; t < count; ++t) {
         const float size = std::exp2(6.0f * unit(rng));
         const vec3 at{100.0f * unit(rng), 100.0f * unit(rng), 100.0f * unit(rng)};
@@ -268,23 +301,12 @@ TEST(GridPlan, PutsEveryTetOnItsSpheresLayerThoughSizingLeavesMostSpheresUncompu
             if (t % 7 == 2) q.x *= 0.01f, q.y *= 0.01f;
             positions.push_back(at + q * size);
         }
-        tets.push_back(TetIndices{{4 * t, 4 * t + 1, 4 * t + 2, 4 * t + 3}});
     }
-    std::vector<std::uint32_t> objects(count, 0u);
-    std::vector<TetInfo> infos(count);
-    std::vector<TetPlanes> planes(count);
-    const std::uint8_t self = 1;
-    const std::uint32_t checked = object_bit(0);
-    const Aabb everywhere_box{{-1e9f, -1e9f, -1e9f}, {1e9f, 1e9f, 1e9f}};
-    const SceneView scene{positions.data(), tets.data(), objects.data(), infos.data(), planes.data(), &self,
-                          &checked, &everywhere_box, count, 1};
-    DetectorOptions two_threads;
-    two_threads.threads = 2;
-    const CpuExec exec(two_threads);
-    exec.for_each(count, TetBoundsKernel{scene});
-    std::uint32_t min_size = float_to_ordered(INFINITY), max_size = float_to_ordered(0.0f);
-    std::uint32_t min_upper = float_to_ordered(INFINITY), max_lower = float_to_ordered(0.0f);
-    exec.for_each(count, TetSizeKernel{scene, &min_size, &max_size, &min_upper, &max_lower});
+    SizedTets sized(std::move(positions), 2);
+    const SceneView& scene = sized.scene;
+    const std::vector<TetInfo>& infos = sized.infos;
+    const std::uint32_t min_size = sized.min_size, max_size = sized.max_size;
+    EXPECT_EQ(std::accumulate(sized.spacing.begin(), sized.spacing.end(), 0u), count / spacing_sample); // tets 1, 9, 17, ...
     std::uint32_t left = 0;
     float dmin = INFINITY, dmax = 0.0f;
     for (std::uint32_t t = 0; t < count; ++t) {
@@ -301,17 +323,67 @@ TEST(GridPlan, PutsEveryTetOnItsSpheresLayerThoughSizingLeavesMostSpheresUncompu
     const OrderedBox region{{float_to_ordered(0.0f), float_to_ordered(0.0f), float_to_ordered(0.0f)},
                             {float_to_ordered(200.0f), float_to_ordered(200.0f), float_to_ordered(200.0f)}};
     GridParams params{};
-    GridParamsKernel{&min_size, &max_size, &region, &params}(0);
+    // No spacing counted: c0 is the smallest size (these tets lie far apart; see the spacing test).
+    const std::vector<std::uint32_t> no_spacing(float_octaves, 0u);
+    GridParamsKernel{&min_size, &max_size, no_spacing.data(), &region, &params}(0);
     EXPECT_EQ(params.cell_size0, dmin);
     unsigned long long entries[max_grid_layers] = {}, cells[max_grid_layers] = {};
     std::uint32_t mask = 0;
     const std::uint32_t chunk = 64;
+    DetectorOptions two_threads;
+    two_threads.threads = 2;
+    const CpuExec exec(two_threads);
     exec.for_each((count + chunk - 1) / chunk, GridPlanKernel{scene, &params, chunk, entries, cells, &mask});
     for (std::uint32_t t = 0; t < count; ++t) {
         vec3 v[4];
         load_tet(scene, t, v);
         ASSERT_EQ(infos[t].layer, layer_of(params, enclosing_sphere_diameter(v))) << "tet " << t;
     }
+}
+
+/// The grid's c0 for regular tets of edge `edge` on a row along x, one every `pitch`, as the
+/// pipeline's sizing kernels choose it.
+float cell_size0_of_row(float edge, float pitch, std::uint32_t count) {
+    std::vector<vec3> positions;
+    for (std::uint32_t t = 0; t < count; ++t) {
+        const vec3 at{pitch * static_cast<float>(t), 0.0f, 0.0f};
+        for (const vec3& corner : {vec3{0, 0, 0}, vec3{1, 0, 0}, vec3{0.5f, 0.866f, 0}, vec3{0.5f, 0.289f, 0.816f}})
+            positions.push_back(at + corner * edge);
+    }
+    const SizedTets sized(std::move(positions), 1);
+    const OrderedBox region{{float_to_ordered(0.0f), float_to_ordered(0.0f), float_to_ordered(0.0f)},
+                            {float_to_ordered(pitch * static_cast<float>(count)), float_to_ordered(4 * edge), float_to_ordered(4 * edge)}};
+    GridParams params{};
+    GridParamsKernel{&sized.min_size, &sized.max_size, sized.spacing.data(), &region, &params}(0);
+    return params.cell_size0;
+}
+
+TEST(GridParams, CellsAreNeverSmallerThanTheTetsSpacing) {
+    // Tets far apart: c0 is their spacing rounded up to a power of two, and every tet shares layer 0.
+    EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000), 4.0f);
+    EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000), 0.5f);
+    // Tets overlapping their neighbours (as a mesh's touch theirs): c0 is the tets' sphere (0.0122),
+    // since a spacing of 0.004 counts as at most 0.0078.
+    const float regular_sphere = 0.01f * std::sqrt(1.5f);
+    EXPECT_NEAR(cell_size0_of_row(0.01f, 0.004f, 1000), regular_sphere, 1e-4f);
+    // A spacing of 0.009 counts as up to 0.0156, above the sphere: layer 0's cells grow to it.
+    EXPECT_EQ(cell_size0_of_row(0.01f, 0.009f, 1000), 0.015625f);
+    // Too few tets to sample a spacing: the smallest sphere.
+    EXPECT_NEAR(cell_size0_of_row(0.01f, 3.0f, 1), regular_sphere, 1e-4f);
+}
+
+TEST(GridParams, MedianSpacingIsTheMiddleSamplesBinsUpperEnd) {
+    std::vector<std::uint32_t> octaves(float_octaves, 0u);
+    EXPECT_EQ(median_spacing(octaves.data()), 0.0f);
+    octaves[float_octave(0.3f)] = 2; // [0.25, 0.5)
+    octaves[float_octave(3.0f)] = 3; // [2, 4)
+    EXPECT_EQ(median_spacing(octaves.data()), 4.0f);
+    octaves[float_octave(0.3f)] = 3;
+    EXPECT_EQ(median_spacing(octaves.data()), 0.5f);
+    // Infinite or overflowing spacings never make the median.
+    std::vector<std::uint32_t> unbounded(float_octaves, 0u);
+    unbounded[float_octave(INFINITY)] = 5;
+    EXPECT_EQ(median_spacing(unbounded.data()), 0.0f);
 }
 
 TEST(BucketTable, ConcurrentInsertsChainOverflowBucketsAndLoseNothing) {

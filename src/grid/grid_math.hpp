@@ -25,7 +25,7 @@ constexpr int cell_coordinate_bits = 19;
 /// @brief The frame's grid geometry, chosen from the scene (see choose_grid_params).
 struct GridParams {
     vec3 origin;        ///< lower corner of the region that is gridded
-    float cell_size0;   ///< c0: the smallest tet size among the gridded tets
+    float cell_size0;   ///< c0: the smallest tet size among the gridded tets, or their spacing (GridParamsKernel)
     float inv_cell_size0;
     int layer_count;    ///< layers 0 .. layer_count-1
 };
@@ -39,6 +39,25 @@ KDET_HD inline int layer_of(const GridParams& grid, float diameter) {
         ++layer;
     }
     return layer;
+}
+
+/// @brief Bins of a histogram of positive floats by their binary exponent (float_octave).
+constexpr int float_octaves = 256;
+
+/// @brief The bin of x >= 0 in such a histogram: its biased binary exponent, so that bin e holds
+/// [2^(e-127), 2^(e-126)) (0 for zero and subnormals, 255 for infinity).
+KDET_HD inline std::uint32_t float_octave(float x) {
+    std::uint32_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    return (bits >> 23) & 0xffu;
+}
+
+/// @brief The upper end of bin e < 254 of float_octave: 2^(e-126).
+KDET_HD inline float float_octave_end(std::uint32_t e) {
+    const std::uint32_t bits = (e + 1u) << 23;
+    float end;
+    memcpy(&end, &bits, sizeof end);
+    return end;
 }
 
 /// @brief 2^-layer as a float, built from its bits (exact for 0 <= layer < 127).

@@ -202,6 +202,29 @@ struct ObjectCullingKernel {
     }
 };
 
+/// @brief Every how many tets TetSizeKernel samples the spacing.
+constexpr std::uint64_t spacing_sample = 8;
+
+/// @brief How far apart two tets lie, for the grid's spacing: the largest coordinate difference of
+/// their boxes' centres.
+KDET_HD inline float tet_spacing(const Aabb& a, const Aabb& b) {
+    const vec3 d = (a.lo + a.hi) - (b.lo + b.hi);
+    return 0.5f * max_f(max_f(fabsf(d.x), fabsf(d.y)), fabsf(d.z));
+}
+
+/// @brief The median of the spacings counted in `octaves` (float_octave bins), as its bin's upper
+/// end; 0 when none was counted.
+KDET_HD inline float median_spacing(const std::uint32_t* octaves) {
+    unsigned long long total = 0;
+    for (int e = 0; e < float_octaves; ++e) total += octaves[e];
+    unsigned long long below = 0;
+    for (int e = 0; e < float_octaves - 2; ++e) {
+        below += octaves[e];
+        if (total && 2 * below >= total) return float_octave_end(static_cast<std::uint32_t>(e));
+    }
+    return 0.0f;
+}
+
 /// @brief Stage 1, grid methods only: sizes the relevant tets and keeps the range of their sizes.
 /// A tet is relevant when its object's self-collision is on, or when its box overlaps another object
 /// it is checked against (inter-object culling: only tets in the overlap region are sized and gridded).
@@ -213,12 +236,17 @@ struct ObjectCullingKernel {
 /// above every lower bound. The smallest tet always does, since its sphere is below every tet's upper
 /// bound, and likewise the largest. The others keep their longest edge, and GridPlanKernel computes
 /// the sphere only when the bounds fall on two layers (tet_layer).
+///
+/// It also counts, by binary exponent, how far every spacing_sample-th relevant tet lies from the one
+/// stored before it (tet_spacing), which GridParamsKernel takes as the spacing of the tets: a sample
+/// gives the same median, and the GPU's threads then seldom add to one bin at once.
 struct TetSizeKernel {
     SceneView scene;
     std::uint32_t* min_size; ///< float_to_ordered, of the spheres computed
     std::uint32_t* max_size;
     std::uint32_t* min_upper_size; ///< float_to_ordered, of the relevant tets' upper bounds
     std::uint32_t* max_lower_size;  ///< and of their lower bounds
+    std::uint32_t* spacing_octaves; ///< [float_octaves] the sampled relevant tets by float_octave(tet_spacing)
 
     KDET_HD bool relevant(std::uint32_t object, const Aabb& box) const {
         if (pair_is_active(scene, object, object)) return true;
@@ -234,6 +262,8 @@ struct TetSizeKernel {
         vec3 v[4];
         load_tet(scene, static_cast<std::uint32_t>(t), v);
         info.layer = 0;
+        if (t % spacing_sample == 1 && scene.tet_object[t - 1] == scene.tet_object[t])
+            atomic_fetch_add(&spacing_octaves[float_octave(tet_spacing(info.box, scene.info[t - 1].box))], 1u);
         scene.planes[t] = tet_planes(v);
         const float longest = longest_edge(v);
         const SphereDiameterBounds bounds = sphere_diameter_bounds(longest);
@@ -251,12 +281,20 @@ struct TetSizeKernel {
 };
 
 /// @brief Stage 1, grid methods only, one work item: the grid's geometry from the relevant tets' sizes
-/// (TetSizeKernel) and the region (ObjectCullingKernel), written where the later kernels read it.
-/// c0 is the smallest size, so the smallest tets sit on layer 0; enough layers to hold the largest,
-/// capped at max_grid_layers. No relevant tet: no layer, nothing is gridded.
+/// and spacings (TetSizeKernel) and the region (ObjectCullingKernel), written where the later kernels
+/// read it. c0 is the smallest size, so the smallest tets sit on layer 0, unless the tets lie farther
+/// apart than that: then c0 is their median spacing (rounded up to a power of two), and every smaller
+/// tet shares layer 0. Cells smaller than the spacing each hold about one tet (a sparse soup of small
+/// tets), and every such tet costs inserts into cells of its own and lookups of empty cells on each
+/// of the many layers above it; in a mesh, whose tets touch, the spacing is about the typical tet's
+/// size, and only the layers of its few smallest tets merge. The spacing is measured along the
+/// storage order, which is spatial (SceneTopology): a tet's predecessor is one of its neighbours.
+/// Enough layers to hold the largest, capped at max_grid_layers. No relevant tet: no layer, nothing
+/// is gridded.
 struct GridParamsKernel {
     const std::uint32_t* min_size; ///< float_to_ordered
     const std::uint32_t* max_size;
+    const std::uint32_t* spacing_octaves; ///< TetSizeKernel's
     const OrderedBox* region;
     GridParams* params;
 
@@ -268,7 +306,7 @@ struct GridParamsKernel {
         const float dmin = ordered_to_float(*min_size), dmax = ordered_to_float(*max_size);
         // Zero-size tets (allowed only when the caller asked for degenerate input) must not make c0 zero.
         const float floor_size = max_f(dmax * 1e-6f, FLT_MIN * 1e6f);
-        const float c0 = max_f(dmin, floor_size);
+        const float c0 = max_f(max_f(dmin, floor_size), median_spacing(spacing_octaves));
         int layers = 1;
         for (float top = c0; layers < max_grid_layers && top < dmax; top *= 2.0f) ++layers;
         const vec3 origin{ordered_to_float(region->lo[0]), ordered_to_float(region->lo[1]),

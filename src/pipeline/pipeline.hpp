@@ -47,6 +47,7 @@ struct FrameCounters {
     std::uint32_t max_lower_size; ///< and of their lower bounds
     OrderedBox region; ///< the gridded region: the boxes of the objects in a checked pair
     GridParams params; ///< GridParamsKernel's
+    std::uint32_t spacing_octaves[float_octaves]; ///< TetSizeKernel's histogram of the tets' spacings
     unsigned long long layer_entries[max_grid_layers]; ///< cell entries the relevant tets need, per layer
     unsigned long long layer_cells[max_grid_layers];   ///< bound on the cells they occupy, per layer
 
@@ -283,8 +284,9 @@ void Pipeline<Exec>::bounds_and_culling() {
 template <class Exec>
 void Pipeline<Exec>::grid_geometry() {
     FrameCounters* c = counters_.data();
-    exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size, &c->min_upper_size, &c->max_lower_size});
-    exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, &c->region, &c->params});
+    exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size, &c->min_upper_size, &c->max_lower_size,
+                                                 c->spacing_octaves});
+    exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, c->spacing_octaves, &c->region, &c->params});
     constexpr std::uint32_t chunk = Exec::plan_chunk;
     exec_.for_each((tets_.size() + chunk - 1) / chunk,
                    GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask});
