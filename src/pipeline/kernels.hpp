@@ -213,7 +213,7 @@ KDET_HD inline float tet_spacing(const Aabb& a, const Aabb& b) {
 }
 
 /// @brief The median of the spacings counted in `octaves` (float_octave bins), as its bin's upper
-/// end; 0 when none was counted.
+/// end; 0 when none was counted or the median lies past 2^127 (no float ends its bin).
 KDET_HD inline float median_spacing(const std::uint32_t* octaves) {
     unsigned long long total = 0;
     for (int e = 0; e < float_octaves; ++e) total += octaves[e];
