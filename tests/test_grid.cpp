@@ -362,7 +362,7 @@ TEST(GridParams, CellsAreNeverSmallerThanTheTetsSpacing) {
     // Tets far apart: c0 is their spacing rounded up to a power of two, and every tet shares layer 0.
     EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000), 4.0f);
     EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000), 0.5f);
-    // Tets overlapping their neighbours (as a mesh's touch theirs): c0 is the tets' sphere (0.0122),
+    // Tets overlapping their neighbours (as a mesh's tets touch theirs): c0 is the tets' sphere (0.0122),
     // since a spacing of 0.004 counts as at most 0.0078.
     const float regular_sphere = 0.01f * std::sqrt(1.5f);
     EXPECT_NEAR(cell_size0_of_row(0.01f, 0.004f, 1000), regular_sphere, 1e-4f);
