@@ -4,7 +4,6 @@
 #include "exec/cpu_exec.hpp"
 #include "near_touching.hpp"
 #include "pipeline/pipeline.hpp"
-#include "pipeline/spatial_order.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -205,26 +204,17 @@ struct GpuShapedExec : CpuExec {
 };
 
 /// One frame of `pipeline` over `meshes`, every object against the others and, with `self`, itself;
-/// the tets stored in spatial order, as Detector stores them.
+/// the tets stored in spatial order as Detector stores them (SceneTopology::add_object).
 FrameResult run_pipeline(PipelineBase& pipeline, const std::vector<TetMesh>& meshes, bool self) {
     SceneTopology topology;
     std::vector<vec3> positions;
-    for (std::uint32_t o = 0; o < meshes.size(); ++o) {
-        const std::uint32_t first_tet = static_cast<std::uint32_t>(topology.tets.size());
-        topology.object_tet_begin.push_back(first_tet);
+    for (const TetMesh& mesh : meshes) {
         const std::uint32_t first_vertex = static_cast<std::uint32_t>(positions.size());
-        for (std::size_t v = 0; v < meshes[o].num_vertices(); ++v)
-            positions.push_back(vec3{static_cast<float>(meshes[o].positions[3 * v]), static_cast<float>(meshes[o].positions[3 * v + 1]),
-                                     static_cast<float>(meshes[o].positions[3 * v + 2])});
-        for (const std::uint32_t t : spatial_tet_order(positions.data() + first_vertex, meshes[o].tets.data(), meshes[o].num_tets())) {
-            TetIndices tet;
-            for (int k = 0; k < 4; ++k) tet.v[k] = first_vertex + meshes[o].tets[4 * t + k];
-            topology.tet_user_id.push_back(first_tet + t);
-            topology.tets.push_back(tet);
-            topology.tet_object.push_back(o);
-        }
+        for (std::size_t v = 0; v < mesh.num_vertices(); ++v)
+            positions.push_back(vec3{static_cast<float>(mesh.positions[3 * v]), static_cast<float>(mesh.positions[3 * v + 1]),
+                                     static_cast<float>(mesh.positions[3 * v + 2])});
+        topology.add_object(first_vertex, positions.data() + first_vertex, mesh.tets.data(), mesh.num_tets());
     }
-    topology.object_tet_begin.push_back(static_cast<std::uint32_t>(topology.tets.size()));
     topology.vertex_count = static_cast<std::uint32_t>(positions.size());
     pipeline.set_topology(topology);
     std::vector<std::uint8_t> pair_enabled(meshes.size() * meshes.size(), 1);

@@ -41,6 +41,14 @@ KDET_HD inline int layer_of(const GridParams& grid, float diameter) {
     return layer;
 }
 
+/// @brief 2^exponent as a float, built from its bits (exact for -126 <= exponent <= 127).
+KDET_HD inline float power_of_two(int exponent) {
+    const std::uint32_t bits = static_cast<std::uint32_t>(exponent + 127) << 23;
+    float value;
+    memcpy(&value, &bits, sizeof value);
+    return value;
+}
+
 /// @brief Bins of a histogram of positive floats by their binary exponent (float_octave).
 constexpr int float_octaves = 256;
 
@@ -53,20 +61,10 @@ KDET_HD inline std::uint32_t float_octave(float x) {
 }
 
 /// @brief The upper end of bin e < 254 of float_octave: 2^(e-126).
-KDET_HD inline float float_octave_end(std::uint32_t e) {
-    const std::uint32_t bits = (e + 1u) << 23;
-    float end;
-    memcpy(&end, &bits, sizeof end);
-    return end;
-}
+KDET_HD inline float float_octave_end(std::uint32_t e) { return power_of_two(static_cast<int>(e) - 126); }
 
-/// @brief 2^-layer as a float, built from its bits (exact for 0 <= layer < 127).
-KDET_HD inline float layer_scale(int layer) {
-    const std::uint32_t bits = static_cast<std::uint32_t>(127 - layer) << 23;
-    float scale;
-    memcpy(&scale, &bits, sizeof scale);
-    return scale;
-}
+/// @brief 2^-layer as a float (exact for 0 <= layer < 127).
+KDET_HD inline float layer_scale(int layer) { return power_of_two(-layer); }
 
 /// @brief Cell index along one axis on `layer`; monotone in x, clamped, and safe for NaN.
 KDET_HD inline std::uint32_t cell_index(const GridParams& grid, float x, float origin, int layer) {

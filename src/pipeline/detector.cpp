@@ -1,6 +1,5 @@
 #include "grid/bucket_table.hpp"
 #include "pipeline/pipeline_base.hpp"
-#include "pipeline/spatial_order.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
@@ -123,16 +122,7 @@ struct Detector::Impl {
 
         // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
-        const std::uint32_t first_tet = static_cast<std::uint32_t>(topology.tets.size());
-        for (const std::uint32_t t : spatial_tet_order(converted.data(), tets, tet_count)) {
-            TetIndices tet;
-            for (int k = 0; k < 4; ++k) tet.v[k] = base + tets[4 * t + k];
-            topology.tets.push_back(tet);
-            topology.tet_object.push_back(id);
-            topology.tet_user_id.push_back(first_tet + t);
-        }
-        if (topology.object_tet_begin.empty()) topology.object_tet_begin.push_back(0);
-        topology.object_tet_begin.push_back(static_cast<std::uint32_t>(topology.tets.size()));
+        topology.add_object(base, converted.data(), tets, tet_count);
         object_vertex_begin.push_back(base + static_cast<std::uint32_t>(vertex_count));
         topology.vertex_count = object_vertex_begin.back();
         positions.insert(positions.end(), converted.begin(), converted.end());

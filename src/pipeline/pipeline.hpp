@@ -358,12 +358,9 @@ GridView Pipeline<Exec>::populate() {
     std::uint32_t slot_bits = 0;
     while ((1u << slot_bits) < slot_count_) ++slot_bits;
     const std::uint32_t blocks = (entry_capacity_ + entry_block - 1) / entry_block;
-    if (entry_blocks_.size() != blocks) {
-        entry_blocks_.resize_discard(blocks);
-        block_bounds_.resize_discard(blocks);
-        // The lanes of the last block past the lists are read (and masked out) by every query there.
-        fill(entry_blocks_, EntryBlock{});
-    }
+    // The lanes of the last block past the lists are read (and masked out) by every query there.
+    resize_filled(entry_blocks_, blocks, EntryBlock{});
+    block_bounds_.resize_discard(blocks);
     own_cells_.resize_discard(tets_.size());
     claimed_slots_.resize_discard(slot_count_);
     const GridView grid{headers_.data(), ids_.data(), entry_blocks_.data(), block_bounds_.data(), own_cells_.data(), &c->grid_entries, entry_capacity_,

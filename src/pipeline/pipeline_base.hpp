@@ -21,6 +21,11 @@ struct SceneTopology {
     /// (spatial_order.hpp) and reported under the caller's numbering.
     std::vector<std::uint32_t> tet_user_id;
     std::uint32_t vertex_count = 0;
+
+    /// @brief Appends an object: its `tet_count` tets (four vertex indices each, into its own
+    /// `positions`) stored in spatial order, its vertices numbered from `first_vertex` on. The
+    /// caller keeps vertex_count.
+    void add_object(std::uint32_t first_vertex, const vec3* positions, const std::uint32_t* tets, std::size_t tet_count);
 };
 
 /// @brief Positions of `count` vertices from global vertex `first` on, copied in at the start of a frame.

@@ -1,6 +1,7 @@
 #include "pipeline/spatial_order.hpp"
 
 #include "exec/radix_sort.hpp"
+#include "pipeline/pipeline_base.hpp"
 #include "grid/hash.hpp"
 
 #include <algorithm>
@@ -35,6 +36,21 @@ std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::u
     std::vector<std::uint32_t> order(tet_count);
     for (std::size_t i = 0; i < tet_count; ++i) order[i] = static_cast<std::uint32_t>(keys[i] & 0xffffffffu);
     return order;
+}
+
+void SceneTopology::add_object(std::uint32_t first_vertex, const vec3* positions, const std::uint32_t* object_tets,
+                               std::size_t tet_count) {
+    if (object_tet_begin.empty()) object_tet_begin.push_back(0);
+    const auto object = static_cast<std::uint32_t>(object_tet_begin.size() - 1);
+    const auto first_tet = static_cast<std::uint32_t>(tets.size());
+    for (const std::uint32_t t : spatial_tet_order(positions, object_tets, tet_count)) {
+        TetIndices tet;
+        for (int k = 0; k < 4; ++k) tet.v[k] = first_vertex + object_tets[4 * t + k];
+        tets.push_back(tet);
+        tet_object.push_back(object);
+        tet_user_id.push_back(first_tet + t);
+    }
+    object_tet_begin.push_back(static_cast<std::uint32_t>(tets.size()));
 }
 
 } // namespace kdet
