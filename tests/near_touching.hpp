@@ -30,9 +30,11 @@ struct NearTouchingPairs {
 /// @brief Pairs of a random tet A (shortest edge at least a tenth of its longest) and a tet B with one
 /// vertex at the centroid of a face of A moved by a signed depth d along that face's inward normal, its
 /// other vertices beyond the face. d < 0 separates the pair by -d along the face normal; d > 0 puts the
-/// vertex inside A (by d while d is below its depth under the other faces). Half the pairs take d
-/// within three times the pre-test's margin 2^-9 L^2 / l (L: the pair's longest edge, l: A's shortest),
-/// half within 1e-7 L to 3e-4 L of touching, where the float tests' tolerance lies. `per_size` pairs
+/// vertex inside A (by d while d is below its depth under the other faces). A third of the pairs take d
+/// within three times the pre-test's separation margin of that face, (2^-15 / s + 2^-16) L^2 / l_f
+/// (L: the pair's longest edge; s, l_f: the sine and the shorter of the face's two edges at its largest
+/// angle), a third within three times 2^-9 L^2 / l (l: A's shortest edge), the scale of its inside
+/// margin, and a third within 1e-7 L to 3e-4 L of touching, where the float tests' tolerance lies. `per_size` pairs
 /// (rounded up to a cube) for each of four sizes a decade apart, each size on its own lattice at most
 /// 60 sizes from the origin, so that the float coordinates keep the depths (relative rounding below 4e-6).
 inline NearTouchingPairs near_touching_pairs(std::size_t per_size, unsigned seed) {
@@ -82,10 +84,20 @@ inline NearTouchingPairs near_touching_pairs(std::size_t per_size, unsigned seed
             double b_shortest = 0.0, pair_longest = 0.0;
             edges(b, b_shortest, pair_longest);
             pair_longest = std::max(longest, pair_longest);
-            const double margin = std::ldexp(1.0, -9) * pair_longest * pair_longest / shortest;
-            const double depth = unit(rng) < 0.5 ? margin * (6.0 * unit(rng) - 3.0)
-                                                   : (unit(rng) < 0.5 ? -1.0 : 1.0) * pair_longest *
-                                                         std::pow(10.0, -7.0 + 3.5 * unit(rng));
+            // The face's two edges at its largest angle, the one opposite its longest edge.
+            P f = sub(f1, f0), g = sub(f2, f0);
+            const double l01 = norm(f), l02 = norm(g), l12 = norm(sub(f2, f1));
+            if (l01 >= l02 && l01 >= l12) f = sub(f2, f1); // the angle at f2: edges f2-f0 and f2-f1
+            else if (l02 >= l12) g = sub(f2, f1);          // the angle at f1: edges f1-f0 and f2-f1
+            const double sine = norm(cross(f, g)) / (norm(f) * norm(g));
+            const double separation_margin = (std::ldexp(1.0, -15) / sine + std::ldexp(1.0, -16)) * pair_longest *
+                                             pair_longest / std::min(norm(f), norm(g));
+            const double inside_scale = std::ldexp(1.0, -9) * pair_longest * pair_longest / shortest;
+            const double which = unit(rng);
+            const double depth = which < 1.0 / 3.0   ? separation_margin * (6.0 * unit(rng) - 3.0)
+                                 : which < 2.0 / 3.0 ? inside_scale * (6.0 * unit(rng) - 3.0)
+                                                     : (unit(rng) < 0.5 ? -1.0 : 1.0) * pair_longest *
+                                                           std::pow(10.0, -7.0 + 3.5 * unit(rng));
             b[0] = sub(centroid, mul(n, depth));
             std::rotate(b, b + rng() % 4, b + 4); // the inner vertex at any index
             for (int v = 0; v < 4; ++v)

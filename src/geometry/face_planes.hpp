@@ -5,29 +5,32 @@
 /// or an edge point of one tet lies inside the other), each only by a margin far above every rounding
 /// involved, and leaves all other pairs to the narrow-phase test. So it never changes what a test reports.
 ///
-/// Bounds, with u = 2^-24, L the pair's longest edge, l the plane owner's shortest edge, s = 1/64 the
-/// smallest sine between the two edges a used face normal is built from, and pairs whose boxes overlap
-/// (the pipeline runs the pre-test on no other), so every vertex lies within 2 sqrt(3) L of the owner's
-/// vertex 0, the origin of its planes:
+/// Bounds, with u = 2^-24, L the pair's longest edge, l the plane owner's shortest edge, and for face k
+/// l_k the shorter and s_k the sine of the angle of the two edges its normal is built from (s_k >= 1/64
+/// for a used face, and l <= l_k <= L), and pairs whose boxes overlap (the pipeline runs the pre-test
+/// on no other), so every vertex lies within 2 sqrt(3) L of the owner's vertex 0, the origin of its planes:
 /// - Rounding of the pre-test. A signed distance dot(n, w - origin) - offset, with |n| = 1 within 2u,
 ///   is off by at most 4u |w - origin| + 4u L + u |d| < 23u L (1.4e-6 L) from the exact distance to
 ///   the stored plane (n, offset), and the stored offset is the owner's highest projection within 4u L.
 /// - Its normals against the true face normals. An owner edge is one rounded difference (error below
-///   3u L), so a normal is within (6u L / l + 3u) / s of the face's (below 2.3e-5 L / l + 1.2e-5).
-///   Over the 4.5 L that the projections of the pair span, that moves a distance by 1.1e-4 L^2 / l
-///   + 0.6e-4 L at most.
+///   3u L), so normal k is within (6u L / l_k + 3u) / s_k of the face's (below 2.3e-5 L / l + 1.2e-5
+///   at worst). Over the 4.5 L that the projections of the pair span, that moves a distance by
+///   (27u L^2 / l_k + 14u L) / s_k at most (1.1e-4 L^2 / l + 0.6e-4 L at worst).
 /// - The float tests' own face axes. They build the same normal from the same two edges in the pair's
 ///   frame (origin at the first tet's vertex 0, unit longest edge), where an edge of the other tet
-///   carries up to 14u L of rounding; their normal is within (34u L / l + 8u) / s of the pre-test's
-///   (1.3e-4 L / l + 3.1e-5), which moves a gap by 5.8e-4 L^2 / l + 1.4e-4 L at most.
-/// - The float tests' tolerance: a separation needs a gap above 32 eps L (3.8e-6 L).
-/// A face's margin is k_plane_margin L^2 / l, k_plane_margin = 2^-9 (1.95e-3), more than 2.5 times
-/// what the first, third and fourth add up to (7.3e-4 L^2 / l at most, as l <= L), so a pair the
-/// pre-test separates shows a gap above 1.2e-3 L^2 / l
-/// along a face axis that sat, sat_no_edges and sat_mtv compute and report as separating.
+///   carries up to 14u L of rounding; their normal is within (34u L / l_k + 8u) / s_k of the pre-test's,
+///   which moves a gap by (153u L^2 / l_k + 36u L) / s_k at most (5.8e-4 L^2 / l + 1.4e-4 L at worst).
+/// - The float tests' tolerance: a separation needs a gap above 32 eps L (64u L, 3.8e-6 L).
+/// Face k's separation margin is (2^-15 / s_k + 2^-16) L^2 / l_k (`TetPlanes::separation_scale`), more
+/// than 2.7 times what the first, third and fourth add up to ((189u / s_k + 87u) L^2 / l_k at most, as
+/// s_k <= 1 and l_k <= L), so a pair the pre-test separates shows a gap above (1.9e-5 / s_k + 1.0e-5)
+/// L^2 / l_k (at least 2.9e-5 L) along a face axis that sat, sat_no_edges and sat_mtv compute and
+/// report as separating, and with the first two bounds a true gap above 4e-5 L. Taken face by face,
+/// the margin is below 2^-12 L^2 / l_k for a face whose angle has a sine above 1/4, an eighth of what
+/// the smallest sine allowed (1/64) needs, so that most pairs a face axis separates are decided here.
 /// An intersection needs no agreement with the float tests' axes, only a point truly inside: a point
 /// of the other tet found inside all four planes, by k_plane_inside_margin L^2 / l = 2^-11 L^2 / l
-/// (4.9e-4), of a tet whose opposite vertices lie below their faces by the face margin (`solid`) lies
+/// (4.9e-4), of a tet whose opposite vertices lie below their faces by k_plane_margin L^2 / l (`solid`) lies
 /// inside the true tet by more than 3e-4 L^2 / l (the first two bounds add up to 1.8e-4 L^2 / l at
 /// most), so the tets overlap by that much along every axis; the point is a vertex, or a point of an
 /// edge whose distances are interpolated from those of its ends (under 40u L more rounding). Both
@@ -48,8 +51,14 @@
 
 namespace kdet {
 
-/// @brief Margin of the pre-test in units of L^2 / l_min (see the file comment).
+/// @brief How far below its faces each vertex of a `solid` tet lies, in units of L^2 / l_min (see the
+/// file comment).
 constexpr float k_plane_margin = 1.0f / 512.0f;
+
+/// @brief Face k's separation margin is (k_plane_sine_margin / s_k + k_plane_edge_margin) L^2 / l_k
+/// (see the file comment).
+constexpr float k_plane_sine_margin = 0x1p-15f;
+constexpr float k_plane_edge_margin = 0x1p-16f;
 
 /// @brief How far inside the other tet's planes a point must lie to prove an intersection, in the
 /// same units: smaller, since it need not agree with the float tests' own axes (file comment).
@@ -72,7 +81,9 @@ struct TetPlanes {
     float offset[4];           ///< the tet's highest projection onto normal k, relative to origin
     vec3 origin;               ///< the tet's vertex 0
     float longest;             ///< longest edge
-    float margin_scale;        ///< k_plane_margin / shortest edge: a face's margin is margin_scale * L^2;
+    float separation_scale[4]; ///< face k's separation margin is separation_scale[k] * L^2; infinite for an
+                               ///< unused face
+    float margin_scale;        ///< k_plane_margin / shortest edge: the solidity margin is margin_scale * L^2;
                                ///< infinite for a tet the pre-test does not use
     std::uint32_t solid;       ///< 1 when all four faces are used and each opposite vertex lies clearly below
                                ///< its face: only then can the pre-test prove a vertex inside
@@ -123,9 +134,14 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
         const float n2 = length_squared(n);
         if (!used || !(n2 > k_plane_min_sine * k_plane_min_sine * lf * lg)) {
             p.nx[k] = p.ny[k] = p.nz[k] = p.offset[k] = 0.0f;
+            p.separation_scale[k] = INFINITY;
             p.solid = 0u;
             continue;
         }
+        // The sine from the rounded cross product is within 2e-5 of the edges' (relative: the product
+        // cancels to no less than 1/64 of |f| |g|); taken a thousandth smaller, it cannot shrink the margin.
+        const float sine = sqrtf(n2 / (lf * lg)) * (1.0f - 0x1p-10f);
+        p.separation_scale[k] = (k_plane_sine_margin / sine + k_plane_edge_margin) / ldexpf(sqrtf(min_f(lf, lg)), exponent);
         n = n * (1.0f / sqrtf(n2));
         if (dot(n, e[k] - a) > 0.0f) n = -n;
         float offset = 0.0f; // q[0] projects to 0
@@ -146,8 +162,9 @@ KDET_HD inline void plane_distances(const TetPlanes& p, vec3 w, float distance[4
     for (int k = 0; k < 4; ++k) distance[k] = p.nx[k] * r.x + p.ny[k] * r.y + p.nz[k] * r.z - p.offset[k];
 }
 
-/// @brief What the four face planes of p show about the four vertices w: whether all of w lies beyond
-/// one face plane by more than `margin` (`separated`), and whether some vertex lies inside all four by
+/// @brief What the four face planes of p show about the four vertices w of a tet paired with p's:
+/// whether all of w lies beyond one face plane by more than its separation margin, for a pair whose
+/// longest edge squared is `longest2` (`separated`), and whether some vertex lies inside all four by
 /// more than `inside_margin` (`inside`). The four faces are evaluated side by side (vector
 /// instructions on the CPU).
 struct PlaneSides {
@@ -155,7 +172,7 @@ struct PlaneSides {
     bool inside;
 };
 
-KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float margin, float inside_margin) {
+KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float longest2, float inside_margin) {
     float nearest[4] = {3.4e38f, 3.4e38f, 3.4e38f, 3.4e38f};
     int inside = 0;
     for (int j = 0; j < 4; ++j) {
@@ -167,7 +184,7 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
         inside |= farthest < -inside_margin ? 1 : 0;
     }
     int separated = 0;
-    for (int k = 0; k < 4; ++k) separated |= nearest[k] > margin ? 1 : 0;
+    for (int k = 0; k < 4; ++k) separated |= nearest[k] > p.separation_scale[k] * longest2 ? 1 : 0;
     return PlaneSides{separated != 0, inside != 0 && p.solid != 0};
 }
 
@@ -230,13 +247,12 @@ enum class PlaneVerdict { unsure, separated, intersecting };
 /// `separation_only`, an intersection is not looked for (the caller only rejects).
 KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
                                                const vec3 b[4], bool separation_only) {
-    const float longest = max_f(pa.longest, pb.longest);
-    const float margin_a = pa.margin_scale * longest * longest, margin_b = pb.margin_scale * longest * longest;
+    const float longest = max_f(pa.longest, pb.longest), longest2 = longest * longest;
     constexpr float inside_share = k_plane_inside_margin / k_plane_margin;
-    const float inside_a = inside_share * margin_a, inside_b = inside_share * margin_b;
-    const PlaneSides b_by_a = plane_sides(pa, b, margin_a, inside_a);
+    const float inside_a = inside_share * pa.margin_scale * longest2, inside_b = inside_share * pb.margin_scale * longest2;
+    const PlaneSides b_by_a = plane_sides(pa, b, longest2, inside_a);
     if (b_by_a.separated) return PlaneVerdict::separated;
-    const PlaneSides a_by_b = plane_sides(pb, a, margin_b, inside_b);
+    const PlaneSides a_by_b = plane_sides(pb, a, longest2, inside_b);
     if (a_by_b.separated) return PlaneVerdict::separated;
     if (separation_only) return PlaneVerdict::unsure;
     if (b_by_a.inside || a_by_b.inside || edges_pass_inside(pa, b, inside_a) || edges_pass_inside(pb, a, inside_b))

@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -91,10 +92,58 @@ TEST(FacePlanesCgal, NearItsMarginItDecidesOnlyWhatEveryTestDecides) {
     std::printf("near-touching pairs %lld: pre-test separated %lld, intersecting %lld\n", check.pairs,
                 check.separated, check.intersecting);
     EXPECT_EQ(check.wrong, 0);
-    EXPECT_GT(check.separated, check.pairs / 8);
-    // A point inside by the inside margin (a quarter of the face margin) proves 22 % of them
-    // intersecting; with the face margin it proved 15 %.
-    EXPECT_GT(check.intersecting, check.pairs / 5);
+    EXPECT_GT(check.separated, check.pairs / 4);
+    // A point inside by the inside margin (a quarter of the solidity margin) proves 14 % of them
+    // intersecting (a third of the pairs lie around that margin).
+    EXPECT_GT(check.intersecting, check.pairs / 10);
+}
+
+/// A tet and its mirror image across one face, moved apart along that face's normal: the pre-test
+/// separates them once the gap exceeds that face's own margin, (2^-15 / s + 2^-16) L^2 / l_f, which for
+/// a well-shaped face is a small part of the owner's worst case 2^-9 L^2 / l, and not below it.
+TEST(FacePlanesCgal, EachFaceSeparatesByItsOwnMargin) {
+    const kdet::vec3 a[4] = {kdet::make_vec3(1.0f, 1.0f, 1.0f), kdet::make_vec3(2.0f, 1.1f, 1.0f),
+                             kdet::make_vec3(1.2f, 2.0f, 1.1f), kdet::make_vec3(1.3f, 1.2f, 2.0f)};
+    d3 ad[4];
+    widen(a, ad);
+    auto length = [](d3 v) { return std::sqrt(dot(v, v)); };
+    double longest = 0.0, shortest = 1e300;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+            longest = std::max(longest, length(ad[j] - ad[i]));
+            shortest = std::min(shortest, length(ad[j] - ad[i]));
+        }
+    VerdictCheck check;
+    for (int k = 0; k < 4; ++k) {
+        const d3 f0 = ad[(k + 1) % 4], f1 = ad[(k + 2) % 4], f2 = ad[(k + 3) % 4];
+        d3 n = normalized(cross(f1 - f0, f2 - f0));
+        if (dot(n, ad[k] - f0) > 0.0) n = n * -1.0; // outward
+        // The two edges at the face's largest angle (opposite its longest edge) build its normal.
+        const double l01 = length(f1 - f0), l02 = length(f2 - f0), l12 = length(f2 - f1);
+        const double top = std::max({l01, l02, l12});
+        const double first = top == l01 ? l02 : l01, second = top == l12 ? l02 : l12;
+        const double sine = length(cross(f1 - f0, f2 - f0)) / (first * second);
+        const double margin =
+            (std::ldexp(1.0, -15) / sine + std::ldexp(1.0, -16)) * longest * longest / std::min(first, second);
+        ASSERT_LT(8.0 * margin, std::ldexp(1.0, -9) * longest * longest / shortest) << "face " << k;
+        for (const double gap : {0.5 * margin, 2.0 * margin}) {
+            // The mirror image across the face, moved out by the gap: its copy of the face lies parallel
+            // to the original, `gap` away, and only that pair of faces can separate the two.
+            kdet::vec3 b[4];
+            for (int v = 0; v < 4; ++v) {
+                const double beyond = v == k ? -2.0 * dot(n, ad[v] - f0) : 0.0;
+                b[v] = to_vec3(ad[v] + n * (beyond + gap));
+            }
+            d3 bd[4];
+            widen(b, bd);
+            ASSERT_FALSE(cgal_intersect(ad, bd)) << "face " << k << ", gap " << gap;
+            const kdet::TetPlanes pa = kdet::tet_planes(a), pb = kdet::tet_planes(b);
+            const bool separated = kdet::face_plane_pretest(pa, a, pb, b, false) == PlaneVerdict::separated;
+            EXPECT_EQ(separated, gap > margin) << "face " << k << ", gap " << gap << ", margin " << margin;
+            check.check(a, b, false, "mirror image");
+        }
+    }
+    EXPECT_EQ(check.wrong, 0);
 }
 
 /// A pair whose only contact is an edge of one tet passing through the other (no vertex of either lies
