@@ -29,11 +29,13 @@
 /// the margin is below 2^-12 L^2 / l_k for a face whose angle has a sine above 1/4, an eighth of what
 /// the smallest sine allowed (1/64) needs, so that most pairs a face axis separates are decided here.
 /// An intersection needs no agreement with the float tests' axes, only a point truly inside: a point
-/// of the other tet found inside all four planes, by k_plane_inside_margin L^2 / l = 2^-11 L^2 / l
-/// (4.9e-4), of a tet whose opposite vertices lie below their faces by k_plane_margin L^2 / l (`solid`) lies
-/// inside the true tet by more than 3e-4 L^2 / l (the first two bounds add up to 1.8e-4 L^2 / l at
-/// most), so the tets overlap by that much along every axis; the point is a vertex, or a point of an
-/// edge whose distances are interpolated from those of its ends (under 40u L more rounding). Both
+/// of the other tet found inside all four planes of a tet whose opposite vertices lie below their faces
+/// by k_plane_margin L^2 / l = 2^-9 L^2 / l (`solid`), inside plane k by twice face k's separation
+/// margin, (2^-14 / s_k + 2^-15) L^2 / l_k, lies inside the true tet by more than (5.8e-5 / s_k +
+/// 2.6e-5) L^2 / l_k (at least 8.4e-5 L) behind every face: the first two bounds add up to
+/// (41u / s_k + 23u) L^2 / l_k at most, and the point is a vertex, or a point of an edge whose distances
+/// are interpolated from those of its ends (under 40u L more rounding). So the tets overlap by that
+/// much along every axis. Both
 /// decisions are therefore true for the exact float input (the `exact` test agrees) and lie far
 /// inside the clear band (beyond 1e-5 L) where gjk and fast agree with CGAL
 /// (tests/cgal/test_narrow_phase_cgal.cpp), and no test misses an intersecting pair.
@@ -41,8 +43,9 @@
 /// The bounds need every intermediate value normal: a tet is used only when its coordinates relative
 /// to its vertex 0 lie within [2^-60, 2^60] in magnitude and its shortest edge is at least 2^-20 of
 /// its longest (a thinner tet's margin exceeds what any pair could show anyway). Its normals are built
-/// from the edges scaled by a power of two (exact), so no square underflows or overflows. An unused
-/// tet gets an infinite margin scale: every margin involving it is infinite or NaN, and decides nothing.
+/// from the edges scaled by a power of two (exact), so no square underflows or overflows. Every face of
+/// an unused tet, and every face too thin to give a normal, gets an infinite separation scale: every
+/// margin involving it is infinite or NaN, and decides nothing.
 
 #include "geometry/tet_pair.hpp"
 #include "geometry/vec3.hpp"
@@ -60,9 +63,9 @@ constexpr float k_plane_margin = 1.0f / 512.0f;
 constexpr float k_plane_sine_margin = 0x1p-15f;
 constexpr float k_plane_edge_margin = 0x1p-16f;
 
-/// @brief How far inside the other tet's planes a point must lie to prove an intersection, in the
-/// same units: smaller, since it need not agree with the float tests' own axes (file comment).
-constexpr float k_plane_inside_margin = 1.0f / 2048.0f;
+/// @brief How far inside plane k of the other tet a point must lie to prove an intersection, in units
+/// of face k's separation margin (file comment).
+constexpr float k_plane_inside_share = 2.0f;
 
 /// @brief Faces whose two normal-building edges meet at an angle with a smaller sine are not used.
 constexpr float k_plane_min_sine = 1.0f / 64.0f;
@@ -83,8 +86,6 @@ struct TetPlanes {
     float longest;             ///< longest edge
     float separation_scale[4]; ///< face k's separation margin is separation_scale[k] * L^2; infinite for an
                                ///< unused face
-    float margin_scale;        ///< k_plane_margin / shortest edge: the solidity margin is margin_scale * L^2;
-                               ///< infinite for a tet the pre-test does not use
     std::uint32_t solid;       ///< 1 when all four faces are used and each opposite vertex lies clearly below
                                ///< its face: only then can the pre-test prove a vertex inside
 };
@@ -112,7 +113,7 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     p.longest = ldexpf(sqrtf(longest2), exponent);
     const bool used = largest >= 0x1p-60f && largest <= 0x1p60f &&
                       shortest2 >= k_plane_min_edge_ratio * k_plane_min_edge_ratio * longest2;
-    p.margin_scale = used ? k_plane_margin / ldexpf(sqrtf(shortest2), exponent) : INFINITY;
+    const float solidity_margin = k_plane_margin / ldexpf(sqrtf(shortest2), exponent) * p.longest * p.longest;
     p.solid = used ? 1u : 0u;
     for (int k = 0; k < 4; ++k) {
         const vec3 a = e[(k + 1) & 3], b = e[(k + 2) & 3], c = e[(k + 3) & 3];
@@ -150,7 +151,7 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
         p.ny[k] = n.y;
         p.nz[k] = n.z;
         p.offset[k] = offset;
-        if (!(offset - dot(n, q[k]) > p.margin_scale * p.longest * p.longest)) p.solid = 0u;
+        if (!(offset - dot(n, q[k]) > solidity_margin)) p.solid = 0u;
     }
     return p;
 }
@@ -164,24 +165,34 @@ KDET_HD inline void plane_distances(const TetPlanes& p, vec3 w, float distance[4
 
 /// @brief What the four face planes of p show about the four vertices w of a tet paired with p's:
 /// whether all of w lies beyond one face plane by more than its separation margin, for a pair whose
-/// longest edge squared is `longest2` (`separated`), and whether some vertex lies inside all four by
-/// more than `inside_margin` (`inside`). The four faces are evaluated side by side (vector
+/// longest edge squared is `longest2` (`separated`), and whether some vertex lies inside each of the
+/// four by more than its inside margin (`inside`). The four faces are evaluated side by side (vector
 /// instructions on the CPU).
 struct PlaneSides {
     bool separated;
     bool inside;
 };
 
-KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float longest2, float inside_margin) {
+/// @brief Face k's inside margin for a pair whose longest edge squared is longest2, in `margin[k]`.
+KDET_HD inline void inside_margins(const TetPlanes& p, float longest2, float margin[4]) {
+    KDET_VECTOR_LOOP
+    for (int k = 0; k < 4; ++k) margin[k] = k_plane_inside_share * p.separation_scale[k] * longest2;
+}
+
+KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float longest2) {
     float nearest[4] = {3.4e38f, 3.4e38f, 3.4e38f, 3.4e38f};
+    float inside_margin[4];
+    inside_margins(p, longest2, inside_margin);
     int inside = 0;
     for (int j = 0; j < 4; ++j) {
         float distance[4];
         plane_distances(p, w[j], distance);
         KDET_VECTOR_LOOP
-        for (int k = 0; k < 4; ++k) nearest[k] = min_f(nearest[k], distance[k]);
-        const float farthest = max_f(max_f(distance[0], distance[1]), max_f(distance[2], distance[3]));
-        inside |= farthest < -inside_margin ? 1 : 0;
+        for (int k = 0; k < 4; ++k) {
+            nearest[k] = min_f(nearest[k], distance[k]);
+            distance[k] += inside_margin[k];
+        }
+        inside |= max_f(max_f(distance[0], distance[1]), max_f(distance[2], distance[3])) < 0.0f ? 1 : 0;
     }
     int separated = 0;
     for (int k = 0; k < 4; ++k) separated |= nearest[k] > p.separation_scale[k] * longest2 ? 1 : 0;
@@ -191,15 +202,18 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
 /// @brief A distance beyond any that a used tet's planes give along the other tet's edges.
 constexpr float k_plane_far = 3.0e38f;
 
-/// @brief Whether a point of some edge of tet w lies inside all four face planes of a solid tet p by
-/// more than `margin`: where no vertex lies inside the other tet, two intersecting tets still have an
+/// @brief Whether a point of some edge of tet w lies inside each of the four face planes of a solid tet
+/// p by more than its inside margin (for a pair whose longest edge squared is longest2): where no
+/// vertex lies inside the other tet, two intersecting tets still have an
 /// edge of one passing through the other. The distances vary linearly along an edge, so the part of
 /// it inside every plane is clipped from those at its ends (each face keeps the parameters between
-/// where its distance reaches -margin and where it would reach -k_plane_far, with min and max
+/// where its distance reaches minus its margin and where it would reach -k_plane_far, with min and max
 /// only: a branch per edge and face would be a coin flip). The middle of that part, clamped onto
 /// the edge whatever the rounding, is then checked as a vertex is, from the interpolated distances.
-KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float margin) {
+KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float longest2) {
     if (!p.solid) return false;
+    float margin[4];
+    inside_margins(p, longest2, margin);
     // plane_sides computed these distances too; they are computed again so that plane_sides, which
     // every candidate runs, keeps nothing for the few pairs that get this far.
     float distance[4][4];
@@ -216,7 +230,7 @@ KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float
     KDET_NO_UNROLL
     for (int i = 0; i < 24; ++i) {
         const float inverse_slope = 1.0f / slope[i];
-        const float at_margin = -(from[i] + margin) * inverse_slope;
+        const float at_margin = -(from[i] + margin[i & 3]) * inverse_slope;
         const float at_far = -(from[i] + k_plane_far) * inverse_slope;
         enter[i] = min_f(at_margin, at_far);
         leave[i] = max_f(at_margin, at_far);
@@ -230,12 +244,12 @@ KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float
         s[e] = min_f(max_f(0.5f * (first + last), 0.0f), 1.0f);
     }
     KDET_NO_UNROLL
-    for (int i = 0; i < 24; ++i) at_s[i] = from[i] + s[i / 4] * slope[i];
+    for (int i = 0; i < 24; ++i) at_s[i] = from[i] + s[i / 4] * slope[i] + margin[i & 3];
     int found = 0;
     KDET_NO_UNROLL
     for (int e = 0; e < 6; ++e) {
         const float* d = at_s + 4 * e;
-        found |= max_f(max_f(d[0], d[1]), max_f(d[2], d[3])) < -margin ? 1 : 0;
+        found |= max_f(max_f(d[0], d[1]), max_f(d[2], d[3])) < 0.0f ? 1 : 0;
     }
     return found != 0;
 }
@@ -248,14 +262,12 @@ enum class PlaneVerdict { unsure, separated, intersecting };
 KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
                                                const vec3 b[4], bool separation_only) {
     const float longest = max_f(pa.longest, pb.longest), longest2 = longest * longest;
-    constexpr float inside_share = k_plane_inside_margin / k_plane_margin;
-    const float inside_a = inside_share * pa.margin_scale * longest2, inside_b = inside_share * pb.margin_scale * longest2;
-    const PlaneSides b_by_a = plane_sides(pa, b, longest2, inside_a);
+    const PlaneSides b_by_a = plane_sides(pa, b, longest2);
     if (b_by_a.separated) return PlaneVerdict::separated;
-    const PlaneSides a_by_b = plane_sides(pb, a, longest2, inside_b);
+    const PlaneSides a_by_b = plane_sides(pb, a, longest2);
     if (a_by_b.separated) return PlaneVerdict::separated;
     if (separation_only) return PlaneVerdict::unsure;
-    if (b_by_a.inside || a_by_b.inside || edges_pass_inside(pa, b, inside_a) || edges_pass_inside(pb, a, inside_b))
+    if (b_by_a.inside || a_by_b.inside || edges_pass_inside(pa, b, longest2) || edges_pass_inside(pb, a, longest2))
         return PlaneVerdict::intersecting;
     return PlaneVerdict::unsure;
 }

@@ -93,54 +93,107 @@ TEST(FacePlanesCgal, NearItsMarginItDecidesOnlyWhatEveryTestDecides) {
                 check.separated, check.intersecting);
     EXPECT_EQ(check.wrong, 0);
     EXPECT_GT(check.separated, check.pairs / 4);
-    // A point inside by the inside margin (a quarter of the solidity margin) proves 14 % of them
-    // intersecting (a third of the pairs lie around that margin).
-    EXPECT_GT(check.intersecting, check.pairs / 10);
+    // A point inside each face by twice its separation margin proves 21 % of them intersecting.
+    EXPECT_GT(check.intersecting, check.pairs / 6);
 }
+
+/// Face k of a tet, in double: its outward unit normal, a point on it, its centroid, and its
+/// separation margin (2^-15 / s + 2^-16) L^2 / l_f for a pair whose longest edge is `longest` (s, l_f:
+/// the sine and the shorter of the two edges at its largest angle, which build the pre-test's normal).
+struct FaceOf {
+    d3 normal, point, centroid;
+    double margin;
+};
+
+FaceOf face_of(const d3 v[4], int k, double longest) {
+    const d3 f0 = v[(k + 1) % 4], f1 = v[(k + 2) % 4], f2 = v[(k + 3) % 4];
+    auto length = [](d3 e) { return std::sqrt(dot(e, e)); };
+    FaceOf face;
+    face.normal = normalized(cross(f1 - f0, f2 - f0));
+    if (dot(face.normal, v[k] - f0) > 0.0) face.normal = face.normal * -1.0;
+    face.point = f0;
+    face.centroid = (f0 + f1 + f2) * (1.0 / 3.0);
+    const double l01 = length(f1 - f0), l02 = length(f2 - f0), l12 = length(f2 - f1);
+    const double top = std::max({l01, l02, l12});
+    const double first = top == l01 ? l02 : l01, second = top == l12 ? l02 : l12;
+    const double sine = length(cross(f1 - f0, f2 - f0)) / (first * second);
+    face.margin = (std::ldexp(1.0, -15) / sine + std::ldexp(1.0, -16)) * longest * longest / std::min(first, second);
+    return face;
+}
+
+/// A well-shaped tet, away from the origin, and its longest and shortest edges.
+struct ShapedTet {
+    kdet::vec3 v[4] = {kdet::make_vec3(1.0f, 1.0f, 1.0f), kdet::make_vec3(2.0f, 1.1f, 1.0f),
+                       kdet::make_vec3(1.2f, 2.0f, 1.1f), kdet::make_vec3(1.3f, 1.2f, 2.0f)};
+    d3 wide[4];
+    double longest = 0.0, shortest = 1e300;
+    ShapedTet() {
+        widen(v, wide);
+        for (int i = 0; i < 4; ++i)
+            for (int j = i + 1; j < 4; ++j) {
+                const double l = std::sqrt(dot(wide[j] - wide[i], wide[j] - wide[i]));
+                longest = std::max(longest, l);
+                shortest = std::min(shortest, l);
+            }
+    }
+};
 
 /// A tet and its mirror image across one face, moved apart along that face's normal: the pre-test
 /// separates them once the gap exceeds that face's own margin, (2^-15 / s + 2^-16) L^2 / l_f, which for
 /// a well-shaped face is a small part of the owner's worst case 2^-9 L^2 / l, and not below it.
 TEST(FacePlanesCgal, EachFaceSeparatesByItsOwnMargin) {
-    const kdet::vec3 a[4] = {kdet::make_vec3(1.0f, 1.0f, 1.0f), kdet::make_vec3(2.0f, 1.1f, 1.0f),
-                             kdet::make_vec3(1.2f, 2.0f, 1.1f), kdet::make_vec3(1.3f, 1.2f, 2.0f)};
-    d3 ad[4];
-    widen(a, ad);
-    auto length = [](d3 v) { return std::sqrt(dot(v, v)); };
-    double longest = 0.0, shortest = 1e300;
-    for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) {
-            longest = std::max(longest, length(ad[j] - ad[i]));
-            shortest = std::min(shortest, length(ad[j] - ad[i]));
-        }
+    const ShapedTet a;
     VerdictCheck check;
     for (int k = 0; k < 4; ++k) {
-        const d3 f0 = ad[(k + 1) % 4], f1 = ad[(k + 2) % 4], f2 = ad[(k + 3) % 4];
-        d3 n = normalized(cross(f1 - f0, f2 - f0));
-        if (dot(n, ad[k] - f0) > 0.0) n = n * -1.0; // outward
-        // The two edges at the face's largest angle (opposite its longest edge) build its normal.
-        const double l01 = length(f1 - f0), l02 = length(f2 - f0), l12 = length(f2 - f1);
-        const double top = std::max({l01, l02, l12});
-        const double first = top == l01 ? l02 : l01, second = top == l12 ? l02 : l12;
-        const double sine = length(cross(f1 - f0, f2 - f0)) / (first * second);
-        const double margin =
-            (std::ldexp(1.0, -15) / sine + std::ldexp(1.0, -16)) * longest * longest / std::min(first, second);
-        ASSERT_LT(8.0 * margin, std::ldexp(1.0, -9) * longest * longest / shortest) << "face " << k;
-        for (const double gap : {0.5 * margin, 2.0 * margin}) {
+        const FaceOf face = face_of(a.wide, k, a.longest);
+        ASSERT_LT(8.0 * face.margin, std::ldexp(1.0, -9) * a.longest * a.longest / a.shortest) << "face " << k;
+        for (const double gap : {0.5 * face.margin, 2.0 * face.margin}) {
             // The mirror image across the face, moved out by the gap: its copy of the face lies parallel
             // to the original, `gap` away, and only that pair of faces can separate the two.
             kdet::vec3 b[4];
             for (int v = 0; v < 4; ++v) {
-                const double beyond = v == k ? -2.0 * dot(n, ad[v] - f0) : 0.0;
-                b[v] = to_vec3(ad[v] + n * (beyond + gap));
+                const double beyond = v == k ? -2.0 * dot(face.normal, a.wide[v] - face.point) : 0.0;
+                b[v] = to_vec3(a.wide[v] + face.normal * (beyond + gap));
             }
             d3 bd[4];
             widen(b, bd);
-            ASSERT_FALSE(cgal_intersect(ad, bd)) << "face " << k << ", gap " << gap;
-            const kdet::TetPlanes pa = kdet::tet_planes(a), pb = kdet::tet_planes(b);
-            const bool separated = kdet::face_plane_pretest(pa, a, pb, b, false) == PlaneVerdict::separated;
-            EXPECT_EQ(separated, gap > margin) << "face " << k << ", gap " << gap << ", margin " << margin;
-            check.check(a, b, false, "mirror image");
+            ASSERT_FALSE(cgal_intersect(a.wide, bd)) << "face " << k << ", gap " << gap;
+            const kdet::TetPlanes pa = kdet::tet_planes(a.v), pb = kdet::tet_planes(b);
+            const bool separated = kdet::face_plane_pretest(pa, a.v, pb, b, false) == PlaneVerdict::separated;
+            EXPECT_EQ(separated, gap > face.margin) << "face " << k << ", gap " << gap << ", margin " << face.margin;
+            check.check(a.v, b, false, "mirror image");
+        }
+    }
+    EXPECT_EQ(check.wrong, 0);
+}
+
+/// A tet with one vertex pushed through a face of another, the rest beyond that face: the pre-test
+/// proves them intersecting once the vertex lies deeper than twice that face's separation margin (its
+/// inside margin; the vertex is far inside the other three faces), and not before.
+TEST(FacePlanesCgal, EachFaceProvesAnIntersectionByTwiceItsMargin) {
+    const ShapedTet a;
+    VerdictCheck check;
+    for (int k = 0; k < 4; ++k) {
+        const FaceOf face = face_of(a.wide, k, a.longest);
+        // Far below 2^-11 L^2 / l, a margin for the whole tet from its shortest edge: only the face's own
+        // margin proves these pairs.
+        ASSERT_LT(8.0 * face.margin, std::ldexp(1.0, -11) * a.longest * a.longest / a.shortest) << "face " << k;
+        for (const double depth : {1.5 * face.margin, 3.0 * face.margin}) {
+            const d3 out = face.normal * (0.5 * a.longest);
+            const d3 tip = face.centroid - face.normal * depth;
+            const d3 along = normalized(face.point - face.centroid) * (0.4 * a.longest);
+            const d3 across = normalized(cross(face.normal, along)) * (0.4 * a.longest);
+            const d3 bd_exact[4] = {tip, face.centroid + out + along, face.centroid + out - along + across,
+                                    face.centroid + out - along - across};
+            kdet::vec3 b[4];
+            for (int v = 0; v < 4; ++v) b[v] = to_vec3(bd_exact[v]);
+            d3 bd[4];
+            widen(b, bd);
+            ASSERT_TRUE(cgal_intersect(a.wide, bd)) << "face " << k << ", depth " << depth;
+            const kdet::TetPlanes pa = kdet::tet_planes(a.v), pb = kdet::tet_planes(b);
+            const bool proven = kdet::face_plane_pretest(pa, a.v, pb, b, false) == PlaneVerdict::intersecting;
+            EXPECT_EQ(proven, depth > 2.0 * face.margin) << "face " << k << ", depth " << depth;
+            check.check(a.v, b, true, "vertex through a face");
         }
     }
     EXPECT_EQ(check.wrong, 0);
