@@ -113,7 +113,10 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     p.longest = ldexpf(sqrtf(longest2), exponent);
     const bool used = largest >= 0x1p-60f && largest <= 0x1p60f &&
                       shortest2 >= k_plane_min_edge_ratio * k_plane_min_edge_ratio * longest2;
-    const float solidity_margin = k_plane_margin / ldexpf(sqrtf(shortest2), exponent) * p.longest * p.longest;
+    // Undoes the scaling exactly for the lengths of a used tet (its exponent and lengths keep every
+    // product normal).
+    const float unscale = ldexpf(1.0f, exponent);
+    const float solidity_margin = k_plane_margin / (sqrtf(shortest2) * unscale) * p.longest * p.longest;
     p.solid = used ? 1u : 0u;
     for (int k = 0; k < 4; ++k) {
         const vec3 a = e[(k + 1) & 3], b = e[(k + 2) & 3], c = e[(k + 3) & 3];
@@ -142,7 +145,7 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
         // The sine from the rounded cross product is within 2e-5 of the edges' (relative: the product
         // cancels to no less than 1/64 of |f| |g|); taken a thousandth smaller, it cannot shrink the margin.
         const float sine = sqrtf(n2 / (lf * lg)) * (1.0f - 0x1p-10f);
-        p.separation_scale[k] = (k_plane_sine_margin / sine + k_plane_edge_margin) / ldexpf(sqrtf(min_f(lf, lg)), exponent);
+        p.separation_scale[k] = (k_plane_sine_margin / sine + k_plane_edge_margin) / (sqrtf(min_f(lf, lg)) * unscale);
         n = n * (1.0f / sqrtf(n2));
         if (dot(n, e[k] - a) > 0.0f) n = -n;
         float offset = 0.0f; // q[0] projects to 0
