@@ -48,25 +48,28 @@ TEST(PairKeyBits, EveryKeyOfTheTetsFitsAndNoBitIsSpare) {
 
 TEST(CpuSort, SortsTheCountedKeysOfEveryWidthAndLeavesNoKeyOut) {
     std::mt19937_64 random(11);
-    DetectorOptions options;
-    options.threads = 2;
-    const CpuExec exec(options);
-    // Small counts take the comparison sort, larger ones the radix passes; pair keys leave bits
-    // 20-31 zero (a pass every key shares), 64 bits use every digit.
-    for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{100000}})
-        for (const int bits : {1, 11, 12, 33, 52, 64}) {
-            std::vector<std::uint64_t> keys(n + 5, 0x5555u); // 5 slots past the count, not sorted
-            for (std::size_t i = 0; i < n; ++i) {
-                std::uint64_t key = bits == 64 ? random() : random() & ((std::uint64_t{1} << bits) - 1);
-                if (bits == 52) key &= ~(std::uint64_t{0xfff} << 20);
-                keys[i] = key;
+    // Small counts take the comparison sort, larger ones the radix passes, on up to `threads` slices
+    // of at least 32k keys (100,003 keys: three slices of unequal size on three threads); pair keys
+    // leave bits 20-31 zero (a pass every key shares), 64 bits use every digit.
+    for (const int threads : {1, 2, 3})
+        for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{100003}})
+            for (const int bits : {1, 11, 12, 33, 52, 64}) {
+                DetectorOptions options;
+                options.threads = threads;
+                const CpuExec exec(options);
+                std::vector<std::uint64_t> keys(n + 5, 0x5555u); // 5 slots past the count, not sorted
+                for (std::size_t i = 0; i < n; ++i) {
+                    std::uint64_t key = bits == 64 ? random() : random() & ((std::uint64_t{1} << bits) - 1);
+                    if (bits == 52) key &= ~(std::uint64_t{0xfff} << 20);
+                    keys[i] = key;
+                }
+                std::vector<std::uint64_t> expected(keys.begin(), keys.begin() + static_cast<std::ptrdiff_t>(n));
+                std::sort(expected.begin(), expected.end());
+                const unsigned long long count = n;
+                exec.sort(keys.data(), keys.size(), &count, bits);
+                EXPECT_TRUE(std::equal(expected.begin(), expected.end(), keys.begin()))
+                    << n << " keys of " << bits << " bits, " << threads << " threads";
             }
-            std::vector<std::uint64_t> expected(keys.begin(), keys.begin() + static_cast<std::ptrdiff_t>(n));
-            std::sort(expected.begin(), expected.end());
-            const unsigned long long count = n;
-            exec.sort(keys.data(), keys.size(), &count, bits);
-            EXPECT_TRUE(std::equal(expected.begin(), expected.end(), keys.begin())) << n << " keys of " << bits << " bits";
-        }
 }
 
 TEST(ReduceRuns, MergesEachRunOfEqualKeysWhereverTheThreadsSplitTheItems) {

@@ -15,7 +15,7 @@ CpuExec::CpuExec(const DetectorOptions& options)
 void CpuExec::sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
     const std::size_t n = std::min<std::size_t>(capacity, *count);
     if (sort_scratch_.size() < n) sort_scratch_.resize_discard(n);
-    radix_sort(keys, n, bits, sort_scratch_.data());
+    radix_sort(keys, n, bits, sort_scratch_.data(), threads_);
 }
 
 void CpuExec::sum(const std::uint32_t* in, std::size_t n, unsigned long long* total) const {

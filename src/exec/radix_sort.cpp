@@ -6,7 +6,7 @@
 
 namespace kdet {
 
-void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch) {
+void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch, int threads) {
     if (n <= 1 << 14) {
         std::sort(keys, keys + n);
         return;
@@ -15,16 +15,38 @@ void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scr
     // mesh: 4 passes where a comparison sort makes log2(n) of them).
     constexpr int digit_bits = 11;
     constexpr std::size_t digits = std::size_t{1} << digit_bits;
-    std::vector<std::size_t> start(digits);
+    // Each thread counts and moves one slice of the keys, of 32k keys or more.
+    const int slices = std::max(1, std::min(threads, static_cast<int>(n >> 15)));
+    const std::size_t per_slice = (n + static_cast<std::size_t>(slices) - 1) / static_cast<std::size_t>(slices);
+    std::vector<std::size_t> start(digits * static_cast<std::size_t>(slices)); // slice s, digit d at [s digits + d]
     std::uint64_t* from = keys;
     std::uint64_t* to = scratch;
     for (int shift = 0; shift < bits; shift += digit_bits) {
-        std::fill(start.begin(), start.end(), std::size_t{0});
-        for (std::size_t i = 0; i < n; ++i) ++start[(from[i] >> shift) & (digits - 1)];
-        if (std::find(start.begin(), start.end(), n) != start.end()) continue; // one digit: nothing moves
+        const auto digit = [shift](std::uint64_t key) { return (key >> shift) & (digits - 1); };
+#pragma omp parallel for num_threads(slices)
+        for (int s = 0; s < slices; ++s) {
+            std::size_t* count = &start[static_cast<std::size_t>(s) * digits];
+            std::fill(count, count + digits, std::size_t{0});
+            const std::size_t lo = std::min(n, static_cast<std::size_t>(s) * per_slice), hi = std::min(n, lo + per_slice);
+            for (std::size_t i = lo; i < hi; ++i) ++count[digit(from[i])];
+        }
+        bool one_digit = false; // then nothing moves
+        for (std::size_t d = 0; d < digits && !one_digit; ++d) {
+            std::size_t keys_with_d = 0;
+            for (int s = 0; s < slices; ++s) keys_with_d += start[static_cast<std::size_t>(s) * digits + d];
+            one_digit = keys_with_d == n;
+        }
+        if (one_digit) continue;
+        // A digit's keys from slice s go after those from slice s - 1: the sort stays stable.
         std::size_t sum = 0;
-        for (std::size_t& s : start) sum += std::exchange(s, sum);
-        for (std::size_t i = 0; i < n; ++i) to[start[(from[i] >> shift) & (digits - 1)]++] = from[i];
+        for (std::size_t d = 0; d < digits; ++d)
+            for (int s = 0; s < slices; ++s) sum += std::exchange(start[static_cast<std::size_t>(s) * digits + d], sum);
+#pragma omp parallel for num_threads(slices)
+        for (int s = 0; s < slices; ++s) {
+            std::size_t* next = &start[static_cast<std::size_t>(s) * digits];
+            const std::size_t lo = std::min(n, static_cast<std::size_t>(s) * per_slice), hi = std::min(n, lo + per_slice);
+            for (std::size_t i = lo; i < hi; ++i) to[next[digit(from[i])]++] = from[i];
+        }
         std::swap(from, to);
     }
     if (from != keys) std::copy(from, from + n, keys);

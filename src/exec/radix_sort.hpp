@@ -9,8 +9,8 @@
 namespace kdet {
 
 /// @brief Sorts keys[0, n) ascending, every key below 2^bits: least significant digit first, 11 bits
-/// a pass, a pass skipped where every key has the same digit; `scratch` holds n keys. Small inputs
-/// go to std::sort.
-void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch);
+/// a pass, a pass skipped where every key has the same digit; `scratch` holds n keys. Up to `threads`
+/// threads count and move a slice of the keys each. Small inputs go to std::sort.
+void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch, int threads);
 
 } // namespace kdet

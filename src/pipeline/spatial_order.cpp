@@ -32,7 +32,7 @@ std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::u
         keys[t] = (static_cast<std::uint64_t>(code) << 32) | t;
     }
     std::vector<std::uint64_t> scratch(tet_count);
-    radix_sort(keys.data(), tet_count, 62, scratch.data());
+    radix_sort(keys.data(), tet_count, 62, scratch.data(), 1);
     std::vector<std::uint32_t> order(tet_count);
     for (std::size_t i = 0; i < tet_count; ++i) order[i] = static_cast<std::uint32_t>(keys[i] & 0xffffffffu);
     return order;
