@@ -624,11 +624,18 @@ struct FindCandidatesKernel {
         unsigned long long rejected;
         KDET_HD void operator()(const GridEntry& e) {
             const std::uint32_t u = e.id();
-            const TetIndices other = scene->tets[u];
-            if (e.object == object && share_vertex(tet, other)) return;
-            vec3 w[4];
-            for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
-            const PlaneVerdict verdict = face_plane_pretest(planes, vertices, scene->planes[u], w, false);
+            const bool same_object = e.object == object;
+            TetIndices other{};
+            if (same_object) {
+                other = scene->tets[u];
+                if (share_vertex(tet, other)) return;
+            }
+            // u's indices and vertices are loaded only for the pairs that u's planes do not separate.
+            const auto load_u = [&](vec3 w[4]) {
+                if (!same_object) other = scene->tets[u];
+                for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
+            };
+            const PlaneVerdict verdict = face_plane_pretest_loading(planes, vertices, scene->planes[u], load_u, false);
             if (verdict == PlaneVerdict::separated) {
                 ++rejected;
                 return;
