@@ -18,6 +18,7 @@ void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scr
     // Each thread counts and moves one slice of the keys, of 32k keys or more.
     const int slices = std::max(1, std::min(threads, static_cast<int>(n >> 15)));
     const std::size_t per_slice = (n + static_cast<std::size_t>(slices) - 1) / static_cast<std::size_t>(slices);
+    const auto slice_begin = [n, per_slice](int s) { return std::min(n, static_cast<std::size_t>(s) * per_slice); };
     std::vector<std::size_t> start(digits * static_cast<std::size_t>(slices)); // slice s, digit d at [s digits + d]
     std::uint64_t* from = keys;
     std::uint64_t* to = scratch;
@@ -27,8 +28,7 @@ void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scr
         for (int s = 0; s < slices; ++s) {
             std::size_t* count = &start[static_cast<std::size_t>(s) * digits];
             std::fill(count, count + digits, std::size_t{0});
-            const std::size_t lo = std::min(n, static_cast<std::size_t>(s) * per_slice), hi = std::min(n, lo + per_slice);
-            for (std::size_t i = lo; i < hi; ++i) ++count[digit(from[i])];
+            for (std::size_t i = slice_begin(s); i < slice_begin(s + 1); ++i) ++count[digit(from[i])];
         }
         bool one_digit = false; // then nothing moves
         for (std::size_t d = 0; d < digits && !one_digit; ++d) {
@@ -44,8 +44,7 @@ void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scr
 #pragma omp parallel for num_threads(slices)
         for (int s = 0; s < slices; ++s) {
             std::size_t* next = &start[static_cast<std::size_t>(s) * digits];
-            const std::size_t lo = std::min(n, static_cast<std::size_t>(s) * per_slice), hi = std::min(n, lo + per_slice);
-            for (std::size_t i = lo; i < hi; ++i) to[next[digit(from[i])]++] = from[i];
+            for (std::size_t i = slice_begin(s); i < slice_begin(s + 1); ++i) to[next[digit(from[i])]++] = from[i];
         }
         std::swap(from, to);
     }
