@@ -5,6 +5,10 @@
 #include <kdet/config.hpp>
 
 #include <cmath>
+#include <cstdint>
+#if defined(__SSE2__) && !defined(__CUDA_ARCH__)
+#include <emmintrin.h>
+#endif
 
 /// @brief Keeps a rarely taken function out of its callers (KDET_NOINLINE), with its loops rolled on
 /// the GPU (KDET_NO_UNROLL): a kernel holds as many registers per thread as the hungriest function it
@@ -38,6 +42,24 @@
 #endif
 
 namespace kdet {
+
+/// @brief Bit i set for each lane i of `lanes` that is ~0u, every lane being 0 or ~0u: how a vector
+/// loop's per-lane verdicts become one mask. On the host one instruction per four lanes (the
+/// compiler would otherwise mask each lane with its bit and OR them across the vector).
+template <int Lanes>
+KDET_HD KDET_ALWAYS_INLINE std::uint32_t lane_bits(const std::uint32_t (&lanes)[Lanes]) {
+    static_assert(Lanes % 4 == 0 && Lanes <= 32, "whole groups of four lanes, at most 32");
+    std::uint32_t bits = 0;
+#if defined(__SSE2__) && !defined(__CUDA_ARCH__)
+    for (int i = 0; i < Lanes; i += 4)
+        bits |= static_cast<std::uint32_t>(
+                    _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(lanes + i)))))
+                << i;
+#else
+    for (int i = 0; i < Lanes; ++i) bits |= (lanes[i] & 1u) << i;
+#endif
+    return bits;
+}
 
 struct vec3 {
     float x, y, z;

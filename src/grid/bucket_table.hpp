@@ -331,16 +331,15 @@ KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, st
 /// turns the loop into a few vector instructions per block where a branch per entry mispredicts about
 /// as often as a box overlaps; the caller masks the lanes outside its list.
 KDET_HD KDET_ALWAYS_INLINE std::uint32_t matching_lanes(const EntryBlock& b, const Aabb& box, std::uint32_t required_starts) {
-    const std::uint32_t lane_bit[entry_block] = {1u, 2u, 4u, 8u, 16u, 32u, 64u, 128u};
-    std::uint32_t mask = 0;
+    std::uint32_t lanes[entry_block];
     KDET_VECTOR_LOOP
     for (std::uint32_t i = 0; i < entry_block; ++i) {
         const bool overlaps = (b.lo[0][i] <= box.hi.x) & (box.lo.x <= b.hi[0][i]) & (b.lo[1][i] <= box.hi.y) &
                               (box.lo.y <= b.hi[1][i]) & (b.lo[2][i] <= box.hi.z) & (box.lo.z <= b.hi[2][i]);
         const bool starts = ((b.id_and_starts[i] >> grid_id_bits) & required_starts) == required_starts;
-        mask |= overlaps & starts ? lane_bit[i] : 0u;
+        lanes[i] = overlaps & starts ? ~0u : 0u;
     }
-    return mask;
+    return lane_bits(lanes);
 }
 
 /// @brief Index of the lowest set bit of a non-zero mask.
@@ -358,9 +357,14 @@ KDET_HD inline std::uint32_t lowest_bit(std::uint32_t mask) {
 template <class Visitor>
 KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t begin, std::uint32_t end, const Aabb& box,
                                              std::uint32_t required_starts, Visitor& visit) {
+    // Copies: the visitor's stores might alias them for all the compiler knows, which would have
+    // every block reload the box and spread it over the vector lanes again.
+    const Aabb query = box;
+    const EntryBlock* const blocks = g.entry_blocks;
+    const Aabb* const bounds = g.block_bounds;
     for (std::uint32_t block = begin / entry_block, last = (end - 1) / entry_block; block <= last; ++block) {
-        if (!boxes_overlap(box, g.block_bounds[block])) continue;
-        std::uint32_t mask = matching_lanes(g.entry_blocks[block], box, required_starts);
+        if (!boxes_overlap(query, bounds[block])) continue;
+        std::uint32_t mask = matching_lanes(blocks[block], query, required_starts);
         const std::uint32_t base = block * entry_block;
         if (base < begin) mask &= ~0u << (begin - base);
         if (end - base < entry_block) mask &= (1u << (end - base)) - 1u;

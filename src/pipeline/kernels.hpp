@@ -44,10 +44,11 @@ struct SceneView {
     std::uint32_t object_count;
 };
 
-KDET_HD inline void load_tet(const SceneView& s, std::uint32_t t, vec3 out[4]) {
-    const TetIndices tet = s.tets[t];
+KDET_HD inline void load_vertices(const SceneView& s, const TetIndices& tet, vec3 out[4]) {
     for (int k = 0; k < 4; ++k) out[k] = s.positions[tet.v[k]];
 }
+
+KDET_HD inline void load_tet(const SceneView& s, std::uint32_t t, vec3 out[4]) { load_vertices(s, s.tets[t], out); }
 
 /// @brief Whether two tets share a vertex: all 16 comparisons without a branch each (about half the
 /// pairs tested share one, so early exits mispredict); on the CPU a's four vertices are compared with
@@ -58,7 +59,7 @@ KDET_HD inline bool share_vertex(const TetIndices& a, const TetIndices& b) {
     for (int i = 0; i < 4; ++i)
         lane[i] = (a.v[i] == b.v[0] ? ~0u : 0u) | (a.v[i] == b.v[1] ? ~0u : 0u) | (a.v[i] == b.v[2] ? ~0u : 0u) |
                   (a.v[i] == b.v[3] ? ~0u : 0u);
-    return ((lane[0] | lane[1]) | (lane[2] | lane[3])) != 0;
+    return lane_bits(lane) != 0;
 }
 
 KDET_HD inline bool pair_is_active(const SceneView& s, std::uint32_t object_a, std::uint32_t object_b) {
@@ -624,17 +625,19 @@ struct FindCandidatesKernel {
         unsigned long long rejected;
         KDET_HD void operator()(const GridEntry& e) {
             const std::uint32_t u = e.id();
-            const bool same_object = e.object == object;
-            TetIndices other{};
-            if (same_object) {
-                other = scene->tets[u];
-                if (share_vertex(tet, other)) return;
+            // u's vertices (and, from another object, its indices) are loaded only for the pairs that
+            // u's planes do not separate. The indices are a local that the loader only reads: one
+            // it wrote too stayed on the stack, and every pair stored and reloaded it.
+            if (e.object == object) {
+                const TetIndices other = scene->tets[u];
+                if (!share_vertex(tet, other)) pretest(u, [&](vec3 w[4]) { load_vertices(*scene, other, w); });
+            } else {
+                pretest(u, [&](vec3 w[4]) { load_tet(*scene, u, w); });
             }
-            // u's indices and vertices are loaded only for the pairs that u's planes do not separate.
-            const auto load_u = [&](vec3 w[4]) {
-                if (!same_object) other = scene->tets[u];
-                for (int k = 0; k < 4; ++k) w[k] = scene->positions[other.v[k]];
-            };
+        }
+        /// The face-plane pre-test of (t, u); writes the pair unless it is proven separated.
+        template <class LoadU>
+        KDET_HD void pretest(std::uint32_t u, const LoadU& load_u) {
             const PlaneVerdict verdict = face_plane_pretest_loading(planes, vertices, scene->planes[u], load_u, false);
             if (verdict == PlaneVerdict::separated) {
                 ++rejected;
