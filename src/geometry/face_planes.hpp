@@ -117,45 +117,50 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     // product normal).
     const float unscale = ldexpf(1.0f, exponent);
     const float solidity_margin = k_plane_margin / (sqrtf(shortest2) * unscale) * p.longest * p.longest;
-    p.solid = used ? 1u : 0u;
+    // Face k (opposite vertex k) has the corners a, b, c = e[k+1], e[k+2], e[k+3] (mod 4); as rows, so
+    // that the four faces are computed side by side, each lane without a branch.
+    float ax[4], ay[4], az[4], bx[4], by[4], bz[4], cx[4], cy[4], cz[4], dx[4], dy[4], dz[4], qx[4], qy[4], qz[4];
     for (int k = 0; k < 4; ++k) {
-        const vec3 a = e[(k + 1) & 3], b = e[(k + 2) & 3], c = e[(k + 3) & 3];
+        ax[k] = e[(k + 1) & 3].x, ay[k] = e[(k + 1) & 3].y, az[k] = e[(k + 1) & 3].z;
+        bx[k] = e[(k + 2) & 3].x, by[k] = e[(k + 2) & 3].y, bz[k] = e[(k + 2) & 3].z;
+        cx[k] = e[(k + 3) & 3].x, cy[k] = e[(k + 3) & 3].y, cz[k] = e[(k + 3) & 3].z;
+        dx[k] = e[k].x, dy[k] = e[k].y, dz[k] = e[k].z;
+        qx[k] = q[k].x, qy[k] = q[k].y, qz[k] = q[k].z;
+    }
+    std::uint32_t solid_faces[4];
+    KDET_VECTOR_LOOP
+    for (int k = 0; k < 4; ++k) {
+        const vec3 a{ax[k], ay[k], az[k]}, b{bx[k], by[k], bz[k]}, c{cx[k], cy[k], cz[k]};
         // The normal comes from the two edges at the face's largest angle (opposite its longest edge).
         const vec3 ab = b - a, ac = c - a, bc = c - b;
         const float lab = length_squared(ab), lac = length_squared(ac), lbc = length_squared(bc);
-        vec3 f = ab, g = ac;
-        float lf = lab, lg = lac;
-        if (lab >= lbc && lab >= lac) {
-            f = ac;
-            g = bc;
-            lf = lac;
-            lg = lbc;
-        } else if (lac >= lbc) {
-            g = bc;
-            lg = lbc;
-        }
+        const bool ab_longest = (lab >= lbc) & (lab >= lac);
+        const bool g_is_bc = ab_longest | (lac >= lbc);
+        const vec3 f{ab_longest ? ac.x : ab.x, ab_longest ? ac.y : ab.y, ab_longest ? ac.z : ab.z};
+        const vec3 g{g_is_bc ? bc.x : ac.x, g_is_bc ? bc.y : ac.y, g_is_bc ? bc.z : ac.z};
+        const float lf = ab_longest ? lac : lab, lg = g_is_bc ? lbc : lac;
         vec3 n = cross(f, g);
         const float n2 = length_squared(n);
-        if (!used || !(n2 > k_plane_min_sine * k_plane_min_sine * lf * lg)) {
-            p.nx[k] = p.ny[k] = p.nz[k] = p.offset[k] = 0.0f;
-            p.separation_scale[k] = INFINITY;
-            p.solid = 0u;
-            continue;
-        }
+        const bool face_used = used & (n2 > k_plane_min_sine * k_plane_min_sine * lf * lg);
         // The sine from the rounded cross product is within 2e-5 of the edges' (relative: the product
-        // cancels to no less than 1/64 of |f| |g|); taken a thousandth smaller, it cannot shrink the margin.
+        // cancels to no less than 1/64 of |f| |g|); taken a thousandth smaller, it cannot shrink the
+        // margin. An unused face's values (maybe infinite or NaN) are replaced below.
         const float sine = sqrtf(n2 / (lf * lg)) * (1.0f - 0x1p-10f);
-        p.separation_scale[k] = (k_plane_sine_margin / sine + k_plane_edge_margin) / (sqrtf(min_f(lf, lg)) * unscale);
+        const float separation_scale = (k_plane_sine_margin / sine + k_plane_edge_margin) / (sqrtf(min_f(lf, lg)) * unscale);
         n = n * (1.0f / sqrtf(n2));
-        if (dot(n, e[k] - a) > 0.0f) n = -n;
-        float offset = 0.0f; // q[0] projects to 0
-        for (int i = 1; i < 4; ++i) offset = max_f(offset, dot(n, q[i]));
-        p.nx[k] = n.x;
-        p.ny[k] = n.y;
-        p.nz[k] = n.z;
-        p.offset[k] = offset;
-        if (!(offset - dot(n, q[k]) > solidity_margin)) p.solid = 0u;
+        const vec3 d{dx[k], dy[k], dz[k]};
+        const bool flip = dot(n, d - a) > 0.0f;
+        n = vec3{flip ? -n.x : n.x, flip ? -n.y : n.y, flip ? -n.z : n.z};
+        // q[0] projects to 0.
+        const float offset = max_f(max_f(max_f(0.0f, dot(n, q[1])), dot(n, q[2])), dot(n, q[3]));
+        p.nx[k] = face_used ? n.x : 0.0f;
+        p.ny[k] = face_used ? n.y : 0.0f;
+        p.nz[k] = face_used ? n.z : 0.0f;
+        p.offset[k] = face_used ? offset : 0.0f;
+        p.separation_scale[k] = face_used ? separation_scale : INFINITY;
+        solid_faces[k] = face_used & (offset - dot(n, vec3{qx[k], qy[k], qz[k]}) > solidity_margin) ? 1u : 0u;
     }
+    p.solid = solid_faces[0] & solid_faces[1] & solid_faces[2] & solid_faces[3];
     return p;
 }
 
