@@ -163,7 +163,8 @@ struct TestTable {
     struct Compacted {
         std::vector<BucketHeader> headers;
         std::vector<EntryBlock> entry_blocks;
-        std::vector<Aabb> block_bounds;
+        std::vector<BlockBoundGroup> block_bounds;
+        std::uint32_t blocks = 0;
         std::uint32_t used = 0, failure = 0;
         GridView view;
     };
@@ -173,7 +174,9 @@ struct TestTable {
     template <class EntryOf>
     Compacted compacted(std::size_t room, const EntryOf& entry_of) const {
         const std::size_t blocks = (room + entry_block - 1) / entry_block;
-        Compacted c{headers, std::vector<EntryBlock>(blocks), std::vector<Aabb>(blocks), 0, 0, view};
+        Compacted c{headers, std::vector<EntryBlock>(blocks),
+                    std::vector<BlockBoundGroup>((blocks + bound_group - 1) / bound_group), static_cast<std::uint32_t>(blocks),
+                    0, 0, view};
         c.view.headers = c.headers.data();
         c.view.entry_blocks = c.entry_blocks.data();
         c.view.block_bounds = c.block_bounds.data();
@@ -182,7 +185,7 @@ struct TestTable {
         c.view.failure = &c.failure;
         for (std::uint32_t slot = 0; slot < view.slot_count; ++slot)
             compact_cell(c.view, slot, entry_of);
-        for (std::uint32_t block = 0; block < c.block_bounds.size(); ++block) bound_entry_block(c.view, block, c.used);
+        for (std::uint32_t block = 0; block < c.blocks; ++block) bound_entry_block(c.view, block, c.used);
         return c;
     }
     void next_frame() {
@@ -493,16 +496,17 @@ TEST(BucketTable, QueriesVisitExactlyTheEntriesWhoseBoxesOverlapTheirsAndBlocksB
     });
     ASSERT_EQ(c.failure, 0u);
     // Each block's bound is the union of its entries' boxes (what lets a query skip it unread).
-    for (std::uint32_t block = 0; block < c.block_bounds.size(); ++block) {
+    for (std::uint32_t block = 0; block < c.blocks; ++block) {
         Aabb expected{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
         for (std::uint32_t k = block * entry_block; k < std::min(c.used, (block + 1) * entry_block); ++k) {
             const GridEntry e = load_entry(c.view, k);
             expected.lo = min_v(expected.lo, e.box.lo);
             expected.hi = max_v(expected.hi, e.box.hi);
         }
-        EXPECT_EQ(c.block_bounds[block].lo.x, expected.lo.x) << block;
-        EXPECT_EQ(c.block_bounds[block].hi.x, expected.hi.x) << block;
-        EXPECT_EQ(c.block_bounds[block].hi.y, expected.hi.y) << block;
+        const Aabb bound = block_bound(c.view, block);
+        EXPECT_EQ(bound.lo.x, expected.lo.x) << block;
+        EXPECT_EQ(bound.hi.x, expected.hi.x) << block;
+        EXPECT_EQ(bound.hi.y, expected.hi.y) << block;
     }
     struct Seen {
         std::vector<std::uint32_t> ids;
@@ -527,6 +531,37 @@ TEST(BucketTable, QueriesVisitExactlyTheEntriesWhoseBoxesOverlapTheirsAndBlocksB
     Seen everything;
     grid_for_each_in_cell(c.view, row, 0u, any_object, everywhere, 0u, everything);
     EXPECT_EQ(everything.ids.size(), 60u);
+}
+
+TEST(BucketTable, AScanVisitsExactlyTheMatchingEntriesOfItsRangeWhereverTheRangeStartsAndEnds) {
+    // One list of 150 entries (19 blocks, three groups of block bounds); entry k is id k, its box x in
+    // [k, k + 0.5]. Ranges starting and ending inside a block, a group or at either edge.
+    constexpr std::uint32_t n = 150;
+    TestTable table(64, 4, 64, 32, HashFunction::djb2);
+    const CellCoord cell{2, 3, 4, 0};
+    for (std::uint32_t i = 0; i < n; ++i) ASSERT_NE(grid_insert(table.view, cell, i, 0u), no_bucket);
+    const auto c = table.compacted(n, [](std::uint32_t id) {
+        const float x = static_cast<float>(id);
+        return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
+    });
+    ASSERT_EQ(c.failure, 0u);
+    ASSERT_EQ(c.used, n);
+    struct Seen {
+        std::vector<std::uint32_t> ids;
+        void operator()(const GridEntry& e) { ids.push_back(e.id()); }
+    };
+    const float windows[][2] = {{-1.0f, 200.0f}, {10.2f, 21.7f}, {60.0f, 75.0f}, {130.6f, 140.4f}, {63.6f, 63.9f}};
+    for (const auto& window : windows)
+        for (std::uint32_t begin = 0; begin < n; begin += 3)
+            for (std::uint32_t end = begin + 1; end <= n; end += 5) {
+                const Aabb query{{window[0], 0.5f, 0.5f}, {window[1], 0.6f, 0.6f}};
+                Seen seen;
+                grid_for_each_in_entries(c.view, begin, end, query, 0u, seen);
+                std::vector<std::uint32_t> expected;
+                for (std::uint32_t k = begin; k < end; ++k)
+                    if (static_cast<float>(k) + 0.5f >= window[0] && static_cast<float>(k) <= window[1]) expected.push_back(k);
+                ASSERT_EQ(seen.ids, expected) << "window " << window[0] << " entries " << begin << "-" << end;
+            }
 }
 
 TEST(BucketTable, QueriesPassOnlyTheEntriesWhoseBoxesStartAlongTheRequiredAxes) {

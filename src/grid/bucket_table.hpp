@@ -92,6 +92,18 @@ struct EntryBlock {
     std::uint32_t object[entry_block];
 };
 
+/// @brief Blocks of entries per group of their bounds: a query gathers a group's matches into one
+/// 64-bit mask.
+constexpr std::uint32_t bound_group = 64 / entry_block;
+
+/// @brief The bounds of bound_group consecutive blocks of entries (group g: blocks [g * bound_group,
+/// (g + 1) * bound_group)), each field a row with a lane per block, so that a query tests the bounds
+/// of a whole group at once (see grid_for_each_in_entries).
+struct BlockBoundGroup {
+    float lo[3][bound_group];
+    float hi[3][bound_group];
+};
+
 /// @brief Where a tet sits in the cells of its own layer, so that its queries there need neither a
 /// hash lookup nor a binary search: for cell lo + d of its range there (d.x + 2 d.y + 4 d.z, see
 /// own_cell_index), the cell's main bucket, written while populating, and the position just after the
@@ -119,7 +131,7 @@ struct GridView {
     BucketHeader* headers;          ///< slot_count main buckets, then overflow_capacity pool buckets
     std::uint32_t* ids;             ///< bucket_capacity ids per bucket
     EntryBlock* entry_blocks;       ///< the compacted cells' lists, [entry_capacity / entry_block rounded up]
-    Aabb* block_bounds;             ///< the bound of each block of entries
+    BlockBoundGroup* block_bounds;  ///< the bound of each block of entries, [blocks / bound_group rounded up]
     OwnCells* own_cells;            ///< [tets] for the pipeline's queries; null where none use them (the table's own tests)
     std::uint32_t* entries_used;
     std::uint32_t entry_capacity;
@@ -323,7 +335,35 @@ KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, st
         bound.lo = min_v(bound.lo, box.lo);
         bound.hi = max_v(bound.hi, box.hi);
     }
-    g.block_bounds[block] = bound;
+    BlockBoundGroup& group = g.block_bounds[block / bound_group];
+    const std::uint32_t lane = block % bound_group;
+    group.lo[0][lane] = bound.lo.x;
+    group.lo[1][lane] = bound.lo.y;
+    group.lo[2][lane] = bound.lo.z;
+    group.hi[0][lane] = bound.hi.x;
+    group.hi[1][lane] = bound.hi.y;
+    group.hi[2][lane] = bound.hi.z;
+}
+
+/// @brief The bound of block `block`, as bound_entry_block stored it.
+KDET_HD inline Aabb block_bound(const GridView& g, std::uint32_t block) {
+    const BlockBoundGroup& group = g.block_bounds[block / bound_group];
+    const std::uint32_t lane = block % bound_group;
+    return Aabb{{group.lo[0][lane], group.lo[1][lane], group.lo[2][lane]},
+                {group.hi[0][lane], group.hi[1][lane], group.hi[2][lane]}};
+}
+
+/// @brief The blocks of a group whose bounds overlap `box`, as a mask (bit i for lane i), every lane
+/// computed without a branch (see matching_lanes); the caller masks the blocks outside its list.
+KDET_HD KDET_ALWAYS_INLINE std::uint32_t overlapping_blocks(const BlockBoundGroup& g, const Aabb& box) {
+    std::uint32_t lanes[bound_group];
+    KDET_VECTOR_LOOP
+    for (std::uint32_t i = 0; i < bound_group; ++i) {
+        const bool overlaps = (g.lo[0][i] <= box.hi.x) & (box.lo.x <= g.hi[0][i]) & (g.lo[1][i] <= box.hi.y) &
+                              (box.lo.y <= g.hi[1][i]) & (g.lo[2][i] <= box.hi.z) & (box.lo.z <= g.hi[2][i]);
+        lanes[i] = overlaps ? ~0u : 0u;
+    }
+    return lane_bits(lanes);
 }
 
 /// @brief The lanes of a block whose boxes overlap `box` and whose start bits include `required_starts`,
@@ -342,6 +382,15 @@ KDET_HD KDET_ALWAYS_INLINE std::uint32_t matching_lanes(const EntryBlock& b, con
     return lane_bits(lanes);
 }
 
+/// @brief Index of the lowest set bit of a non-zero 64-bit mask.
+KDET_HD inline std::uint32_t lowest_bit64(std::uint64_t mask) {
+#if defined(__CUDA_ARCH__)
+    return static_cast<std::uint32_t>(__ffsll(static_cast<long long>(mask)) - 1);
+#else
+    return static_cast<std::uint32_t>(__builtin_ctzll(mask));
+#endif
+}
+
 /// @brief Index of the lowest set bit of a non-zero mask.
 KDET_HD inline std::uint32_t lowest_bit(std::uint32_t mask) {
 #if defined(__CUDA_ARCH__)
@@ -353,7 +402,9 @@ KDET_HD inline std::uint32_t lowest_bit(std::uint32_t mask) {
 
 /// @brief Calls visit(entry) for every entry k in [begin, end) of the compacted lists (begin < end) whose
 /// box overlaps `box` and whose start bits include `required_starts` (see GridEntry::starts); the
-/// entries of a block whose bound misses `box` are not read.
+/// entries of a block whose bound misses `box` are not read. A group of blocks at a time: its bounds
+/// tested at once, its matches gathered into one mask and visited in one loop, where a branch per
+/// block on its bound and a loop per block over its matches each mispredicted about once a block.
 template <class Visitor>
 KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t begin, std::uint32_t end, const Aabb& box,
                                              std::uint32_t required_starts, Visitor& visit) {
@@ -361,16 +412,26 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
     // every block reload the box and spread it over the vector lanes again.
     const Aabb query = box;
     const EntryBlock* const blocks = g.entry_blocks;
-    const Aabb* const bounds = g.block_bounds;
-    for (std::uint32_t block = begin / entry_block, last = (end - 1) / entry_block; block <= last; ++block) {
-        if (!boxes_overlap(query, bounds[block])) continue;
-        std::uint32_t mask = matching_lanes(blocks[block], query, required_starts);
-        const std::uint32_t base = block * entry_block;
-        if (base < begin) mask &= ~0u << (begin - base);
-        if (end - base < entry_block) mask &= (1u << (end - base)) - 1u;
-        while (mask) {
-            visit(load_entry(g, base + lowest_bit(mask)));
-            mask &= mask - 1u;
+    const BlockBoundGroup* const bounds = g.block_bounds;
+    const std::uint32_t first_block = begin / entry_block, last_block = (end - 1) / entry_block;
+    for (std::uint32_t group = first_block / bound_group; group <= last_block / bound_group; ++group) {
+        const std::uint32_t group_block = group * bound_group;
+        std::uint32_t passing = overlapping_blocks(bounds[group], query);
+        if (group_block < first_block) passing &= ~0u << (first_block - group_block);
+        if (last_block - group_block < bound_group - 1) passing &= (2u << (last_block - group_block)) - 1u;
+        std::uint64_t matches = 0;
+        while (passing) {
+            const std::uint32_t k = lowest_bit(passing);
+            passing &= passing - 1u;
+            matches |= static_cast<std::uint64_t>(matching_lanes(blocks[group_block + k], query, required_starts))
+                       << (k * entry_block);
+        }
+        const std::uint32_t base = group_block * entry_block;
+        if (base < begin) matches &= ~0ull << (begin - base);
+        if (end - base < bound_group * entry_block) matches &= (1ull << (end - base)) - 1ull;
+        while (matches) {
+            visit(load_entry(g, base + lowest_bit64(matches)));
+            matches &= matches - 1ull;
         }
     }
 }

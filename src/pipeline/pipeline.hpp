@@ -230,7 +230,7 @@ private:
     buffer<BucketHeader> headers_;
     buffer<std::uint32_t> ids_;
     buffer<EntryBlock> entry_blocks_; ///< the compacted cells' lists
-    buffer<Aabb> block_bounds_; ///< the bound of each block of entry_block entries
+    buffer<BlockBoundGroup> block_bounds_; ///< the bound of each block of entry_block entries
     buffer<OwnCells> own_cells_; ///< per stored tet, where it sits in its own layer's cells
     buffer<std::uint32_t> claimed_slots_; ///< the main buckets in the order they were claimed
     buffer<FrameCounters> counters_;
@@ -360,7 +360,8 @@ GridView Pipeline<Exec>::populate() {
     const std::uint32_t blocks = (entry_capacity_ + entry_block - 1) / entry_block;
     // The lanes of the last block past the lists are read (and masked out) by every query there.
     resize_filled(entry_blocks_, blocks, EntryBlock{});
-    block_bounds_.resize_discard(blocks);
+    // Likewise the bounds of the last group's blocks past the lists.
+    resize_filled(block_bounds_, (blocks + bound_group - 1) / bound_group, BlockBoundGroup{});
     own_cells_.resize_discard(tets_.size());
     claimed_slots_.resize_discard(slot_count_);
     const GridView grid{headers_.data(), ids_.data(), entry_blocks_.data(), block_bounds_.data(), own_cells_.data(), &c->grid_entries, entry_capacity_,
@@ -368,7 +369,7 @@ GridView Pipeline<Exec>::populate() {
                         overflow_capacity_, stamp_, 64u, options_.hash};
     exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, &c->params});
     exec_.for_each(slot_count_, CompactCellsKernel{scene_view(), grid});
-    exec_.for_each(block_bounds_.size(), BoundEntryBlocksKernel{grid});
+    exec_.for_each(blocks, BoundEntryBlocksKernel{grid});
     return grid;
 }
 
