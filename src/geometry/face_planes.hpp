@@ -191,20 +191,22 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
     float nearest[4] = {3.4e38f, 3.4e38f, 3.4e38f, 3.4e38f};
     float inside_margin[4];
     inside_margins(p, longest2, inside_margin);
-    int inside = 0;
+    bool inside = false;
     for (int j = 0; j < 4; ++j) {
         float distance[4];
         plane_distances(p, w[j], distance);
+        std::uint32_t behind[4];
         KDET_VECTOR_LOOP
         for (int k = 0; k < 4; ++k) {
             nearest[k] = min_f(nearest[k], distance[k]);
-            distance[k] += inside_margin[k];
+            behind[k] = distance[k] + inside_margin[k] < 0.0f ? ~0u : 0u;
         }
-        inside |= max_f(max_f(distance[0], distance[1]), max_f(distance[2], distance[3])) < 0.0f ? 1 : 0;
+        inside |= lane_bits(behind) == 15u;
     }
-    int separated = 0;
-    for (int k = 0; k < 4; ++k) separated |= nearest[k] > p.separation_scale[k] * longest2 ? 1 : 0;
-    return PlaneSides{separated != 0, inside != 0 && p.solid != 0};
+    std::uint32_t beyond[4];
+    KDET_VECTOR_LOOP
+    for (int k = 0; k < 4; ++k) beyond[k] = nearest[k] > p.separation_scale[k] * longest2 ? ~0u : 0u;
+    return PlaneSides{lane_bits(beyond) != 0, inside && p.solid != 0};
 }
 
 /// @brief A distance beyond any that a used tet's planes give along the other tet's edges.
