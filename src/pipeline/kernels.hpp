@@ -626,8 +626,8 @@ struct FindCandidatesKernel {
         KDET_HD void operator()(const GridEntry& e) {
             const std::uint32_t u = e.id();
             // u's vertices (and, from another object, its indices) are loaded only for the pairs that
-            // u's planes do not separate. The indices are a local that the loader only reads: one
-            // it wrote too stayed on the stack, and every pair stored and reloaded it.
+            // u's planes do not separate. The loader only reads the indices: when it also wrote them,
+            // they lived on the stack, stored and reloaded for every pair.
             if (e.object == object) {
                 const TetIndices other = scene->tets[u];
                 if (!share_vertex(tet, other)) pretest(u, [&](vec3 w[4]) { load_vertices(*scene, other, w); });
