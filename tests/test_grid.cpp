@@ -135,6 +135,12 @@ TEST(CellRange, ClampsNonFiniteAndFarCoordinates) {
 /// A query box that overlaps every entry's.
 const Aabb everywhere{{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
 
+/// @brief A query's visitor that records the ids it is given, in order.
+struct SeenIds {
+    std::vector<std::uint32_t> ids;
+    void operator()(const GridEntry& e) { ids.push_back(e.id()); }
+};
+
 /// A table on the CPU execution layer with the given geometry.
 /// Visits every entry of a cell.
 struct EveryEntry {
@@ -508,13 +514,9 @@ TEST(BucketTable, QueriesVisitExactlyTheEntriesWhoseBoxesOverlapTheirsAndBlocksB
         EXPECT_EQ(bound.hi.x, expected.hi.x) << block;
         EXPECT_EQ(bound.hi.y, expected.hi.y) << block;
     }
-    struct Seen {
-        std::vector<std::uint32_t> ids;
-        void operator()(const GridEntry& e) { ids.push_back(e.id()); }
-    };
     for (std::uint32_t first_id : {0u, 11u, 30u}) {
         const Aabb query{{10.2f, 0.5f, 0.5f}, {21.7f, 0.6f, 0.6f}};
-        Seen seen;
+        SeenIds seen;
         grid_for_each_in_cell(c.view, row, first_id, any_object, query, 0u, seen);
         std::vector<std::uint32_t> expected;
         for (std::uint32_t i = std::max(first_id, 10u); i <= 21; ++i) expected.push_back(i);
@@ -524,11 +526,11 @@ TEST(BucketTable, QueriesVisitExactlyTheEntriesWhoseBoxesOverlapTheirsAndBlocksB
     for (std::uint32_t i = 0; i < 60; ++i) {
         const float x = static_cast<float>(i);
         const Aabb touching{{x + 0.5f, 1.0f, 1.0f}, {x + 0.75f, 2.0f, 2.0f}};
-        Seen seen;
+        SeenIds seen;
         grid_for_each_in_cell(c.view, row, 0u, any_object, touching, 0u, seen);
         EXPECT_EQ(seen.ids, std::vector<std::uint32_t>{i}) << i;
     }
-    Seen everything;
+    SeenIds everything;
     grid_for_each_in_cell(c.view, row, 0u, any_object, everywhere, 0u, everything);
     EXPECT_EQ(everything.ids.size(), 60u);
 }
@@ -546,16 +548,12 @@ TEST(BucketTable, AScanVisitsExactlyTheMatchingEntriesOfItsRangeWhereverTheRange
     });
     ASSERT_EQ(c.failure, 0u);
     ASSERT_EQ(c.used, n);
-    struct Seen {
-        std::vector<std::uint32_t> ids;
-        void operator()(const GridEntry& e) { ids.push_back(e.id()); }
-    };
     const float windows[][2] = {{-1.0f, 200.0f}, {10.2f, 21.7f}, {60.0f, 75.0f}, {130.6f, 140.4f}, {63.6f, 63.9f}};
     for (const auto& window : windows)
         for (std::uint32_t begin = 0; begin < n; begin += 3)
             for (std::uint32_t end = begin + 1; end <= n; end += 5) {
                 const Aabb query{{window[0], 0.5f, 0.5f}, {window[1], 0.6f, 0.6f}};
-                Seen seen;
+                SeenIds seen;
                 grid_for_each_in_entries(c.view, begin, end, query, 0u, seen);
                 std::vector<std::uint32_t> expected;
                 for (std::uint32_t k = begin; k < end; ++k)
@@ -571,13 +569,9 @@ TEST(BucketTable, QueriesPassOnlyTheEntriesWhoseBoxesStartAlongTheRequiredAxes) 
     for (std::uint32_t i = 0; i < 70; ++i) ASSERT_NE(grid_insert(table.view, cell, 5 * i, i % 8u), no_bucket);
     const auto c = table.compacted(70);
     ASSERT_EQ(c.failure, 0u);
-    struct Seen {
-        std::vector<std::uint32_t> ids;
-        void operator()(const GridEntry& e) { ids.push_back(e.id()); }
-    };
     for (std::uint32_t required = 0; required < 8; ++required)
         for (std::uint32_t first_id : {0u, 7u, 100u}) {
-            Seen seen;
+            SeenIds seen;
             grid_for_each_in_cell(c.view, cell, first_id, any_object, everywhere, required, seen);
             std::vector<std::uint32_t> expected;
             for (std::uint32_t i = 0; i < 70; ++i)
@@ -630,17 +624,13 @@ TEST(BucketTable, OwnCellRowsStartWhereTheLookupAndBinarySearchAfterTheTetDo) {
     }
     const auto c = table.compacted(160);
     ASSERT_EQ(c.failure, 0u);
-    struct Seen {
-        std::vector<std::uint32_t> ids;
-        void operator()(const GridEntry& e) { ids.push_back(e.id()); }
-    };
     std::size_t visited = 0;
     for (std::uint32_t id = 0; id < 40; ++id) {
         const CellRange r = range_of(id);
         for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
             for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x)
                 for (std::uint32_t required : {0u, 1u, 3u, 7u}) {
-                    Seen by_row, by_lookup;
+                    SeenIds by_row, by_lookup;
                     grid_for_each_after_own_entry(c.view, id, own_cell_index(r, x, y, 5), any_object, everywhere, required, by_row);
                     grid_for_each_in_cell(c.view, make_cell(x, y, 5, 0), id + 1, any_object, everywhere, required, by_lookup);
                     EXPECT_EQ(by_row.ids, by_lookup.ids) << "tet " << id << " cell " << x << " " << y << " required " << required;
@@ -654,7 +644,7 @@ TEST(BucketTable, OwnCellRowsStartWhereTheLookupAndBinarySearchAfterTheTetDo) {
     ++later.stamp;
     for (std::uint32_t id = 0; id < 40; ++id)
         for (std::uint32_t index = 0; index < 4; ++index) {
-            Seen stale;
+            SeenIds stale;
             grid_for_each_after_own_entry(later, id, index, any_object, everywhere, 0u, stale);
             EXPECT_TRUE(stale.ids.empty()) << id << " " << index;
         }

@@ -92,6 +92,29 @@ struct EntryBlock {
     std::uint32_t object[entry_block];
 };
 
+/// @brief Boxes stored as rows with a lane per box (EntryBlock's entries, BlockBoundGroup's blocks):
+/// box i read, box i written, and whether box i overlaps `box` (closed boxes, without a branch, so
+/// that a loop over the lanes becomes vector instructions on the host).
+template <std::uint32_t Lanes>
+KDET_HD KDET_ALWAYS_INLINE Aabb lane_box(const float (&lo)[3][Lanes], const float (&hi)[3][Lanes], std::uint32_t i) {
+    return Aabb{{lo[0][i], lo[1][i], lo[2][i]}, {hi[0][i], hi[1][i], hi[2][i]}};
+}
+template <std::uint32_t Lanes>
+KDET_HD KDET_ALWAYS_INLINE void set_lane_box(float (&lo)[3][Lanes], float (&hi)[3][Lanes], std::uint32_t i, const Aabb& box) {
+    lo[0][i] = box.lo.x;
+    lo[1][i] = box.lo.y;
+    lo[2][i] = box.lo.z;
+    hi[0][i] = box.hi.x;
+    hi[1][i] = box.hi.y;
+    hi[2][i] = box.hi.z;
+}
+template <std::uint32_t Lanes>
+KDET_HD KDET_ALWAYS_INLINE bool lane_overlaps(const float (&lo)[3][Lanes], const float (&hi)[3][Lanes], std::uint32_t i,
+                                              const Aabb& box) {
+    return (lo[0][i] <= box.hi.x) & (box.lo.x <= hi[0][i]) & (lo[1][i] <= box.hi.y) & (box.lo.y <= hi[1][i]) &
+           (lo[2][i] <= box.hi.z) & (box.lo.z <= hi[2][i]);
+}
+
 /// @brief Blocks of entries per group of their bounds: a query gathers a group's matches into one
 /// 64-bit mask.
 constexpr std::uint32_t bound_group = 64 / entry_block;
@@ -247,8 +270,7 @@ KDET_HD inline std::uint32_t& entry_id_and_starts(const GridView& g, std::uint32
 KDET_HD KDET_ALWAYS_INLINE GridEntry load_entry(const GridView& g, std::uint32_t k) {
     const EntryBlock& b = g.entry_blocks[k / entry_block];
     const std::uint32_t i = k % entry_block;
-    return GridEntry{Aabb{{b.lo[0][i], b.lo[1][i], b.lo[2][i]}, {b.hi[0][i], b.hi[1][i], b.hi[2][i]}},
-                     b.id_and_starts[i], b.object[i]};
+    return GridEntry{lane_box(b.lo, b.hi, i), b.id_and_starts[i], b.object[i]};
 }
 
 /// @brief Copies the ids of the cell whose main bucket is `slot` (if it is occupied this frame) into
@@ -301,12 +323,7 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
         EntryBlock& block = g.entry_blocks[k / entry_block];
         const std::uint32_t i = k % entry_block;
         const GridEntry e = entry_of(block.id_and_starts[i] & grid_id_mask);
-        block.lo[0][i] = e.box.lo.x;
-        block.lo[1][i] = e.box.lo.y;
-        block.lo[2][i] = e.box.lo.z;
-        block.hi[0][i] = e.box.hi.x;
-        block.hi[1][i] = e.box.hi.y;
-        block.hi[2][i] = e.box.hi.z;
+        set_lane_box(block.lo, block.hi, i, e.box);
         block.object[i] = e.object;
         objects |= object_bit(e.object);
         if (g.own_cells) {
@@ -336,21 +353,13 @@ KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, st
         bound.hi = max_v(bound.hi, box.hi);
     }
     BlockBoundGroup& group = g.block_bounds[block / bound_group];
-    const std::uint32_t lane = block % bound_group;
-    group.lo[0][lane] = bound.lo.x;
-    group.lo[1][lane] = bound.lo.y;
-    group.lo[2][lane] = bound.lo.z;
-    group.hi[0][lane] = bound.hi.x;
-    group.hi[1][lane] = bound.hi.y;
-    group.hi[2][lane] = bound.hi.z;
+    set_lane_box(group.lo, group.hi, block % bound_group, bound);
 }
 
 /// @brief The bound of block `block`, as bound_entry_block stored it.
 KDET_HD inline Aabb block_bound(const GridView& g, std::uint32_t block) {
     const BlockBoundGroup& group = g.block_bounds[block / bound_group];
-    const std::uint32_t lane = block % bound_group;
-    return Aabb{{group.lo[0][lane], group.lo[1][lane], group.lo[2][lane]},
-                {group.hi[0][lane], group.hi[1][lane], group.hi[2][lane]}};
+    return lane_box(group.lo, group.hi, block % bound_group);
 }
 
 /// @brief The blocks of a group whose bounds overlap `box`, as a mask (bit i for lane i), every lane
@@ -358,11 +367,7 @@ KDET_HD inline Aabb block_bound(const GridView& g, std::uint32_t block) {
 KDET_HD KDET_ALWAYS_INLINE std::uint32_t overlapping_blocks(const BlockBoundGroup& g, const Aabb& box) {
     std::uint32_t lanes[bound_group];
     KDET_VECTOR_LOOP
-    for (std::uint32_t i = 0; i < bound_group; ++i) {
-        const bool overlaps = (g.lo[0][i] <= box.hi.x) & (box.lo.x <= g.hi[0][i]) & (g.lo[1][i] <= box.hi.y) &
-                              (box.lo.y <= g.hi[1][i]) & (g.lo[2][i] <= box.hi.z) & (box.lo.z <= g.hi[2][i]);
-        lanes[i] = overlaps ? ~0u : 0u;
-    }
+    for (std::uint32_t i = 0; i < bound_group; ++i) lanes[i] = lane_overlaps(g.lo, g.hi, i, box) ? ~0u : 0u;
     return lane_bits(lanes);
 }
 
@@ -374,8 +379,7 @@ KDET_HD KDET_ALWAYS_INLINE std::uint32_t matching_lanes(const EntryBlock& b, con
     std::uint32_t lanes[entry_block];
     KDET_VECTOR_LOOP
     for (std::uint32_t i = 0; i < entry_block; ++i) {
-        const bool overlaps = (b.lo[0][i] <= box.hi.x) & (box.lo.x <= b.hi[0][i]) & (b.lo[1][i] <= box.hi.y) &
-                              (box.lo.y <= b.hi[1][i]) & (b.lo[2][i] <= box.hi.z) & (box.lo.z <= b.hi[2][i]);
+        const bool overlaps = lane_overlaps(b.lo, b.hi, i, box);
         const bool starts = ((b.id_and_starts[i] >> grid_id_bits) & required_starts) == required_starts;
         lanes[i] = overlaps & starts ? ~0u : 0u;
     }
