@@ -100,7 +100,7 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     int exponent = 0;
     frexpf(largest, &exponent);
     // Scaled by a power of two, edges keep their exact directions and ratios, and their squares stay normal.
-    const float scale = ldexpf(1.0f, -exponent);
+    const float scale = times_power_of_two(1.0f, -exponent);
     vec3 e[4];
     for (int i = 0; i < 4; ++i) e[i] = q[i] * scale;
     float longest2 = 0.0f, shortest2 = 3.4e38f;
@@ -110,12 +110,12 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
             longest2 = max_f(longest2, l2);
             shortest2 = min_f(shortest2, l2);
         }
-    p.longest = ldexpf(sqrtf(longest2), exponent);
+    p.longest = times_power_of_two(sqrtf(longest2), exponent);
     const bool used = largest >= 0x1p-60f && largest <= 0x1p60f &&
                       shortest2 >= k_plane_min_edge_ratio * k_plane_min_edge_ratio * longest2;
     // Undoes the scaling exactly for the lengths of a used tet (its exponent and lengths keep every
     // product normal).
-    const float unscale = ldexpf(1.0f, exponent);
+    const float unscale = times_power_of_two(1.0f, exponent);
     const float solidity_margin = k_plane_margin / (sqrtf(shortest2) * unscale) * p.longest * p.longest;
     // Face k (opposite vertex k) has the corners a, b, c = e[k+1], e[k+2], e[k+3] (mod 4); as rows, so
     // that the four faces are computed side by side, each lane without a branch.

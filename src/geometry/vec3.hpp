@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #if defined(__SSE2__) && !defined(__CUDA_ARCH__)
 #include <emmintrin.h>
 #endif
@@ -64,6 +65,21 @@ KDET_HD KDET_ALWAYS_INLINE std::uint32_t lane_bits(const std::uint32_t (&lanes)[
 struct vec3 {
     float x, y, z;
 };
+
+/// @brief 2^exponent as a float, built from its bits (exact for -126 <= exponent <= 127).
+KDET_HD inline float power_of_two(int exponent) {
+    const std::uint32_t bits = static_cast<std::uint32_t>(exponent + 127) << 23;
+    float value;
+    memcpy(&value, &bits, sizeof value);
+    return value;
+}
+
+/// @brief x * 2^exponent for |exponent| <= 252 without a library call: rounded once, as ldexpf rounds
+/// it, wherever x * 2^(exponent / 2) is a normal float or 0 (the first product is then exact).
+KDET_HD inline float times_power_of_two(float x, int exponent) {
+    const int half = exponent / 2;
+    return x * power_of_two(half) * power_of_two(exponent - half);
+}
 
 KDET_HD inline vec3 make_vec3(float x, float y, float z) { return vec3{x, y, z}; }
 KDET_HD inline vec3 operator+(vec3 a, vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }

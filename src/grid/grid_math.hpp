@@ -41,14 +41,6 @@ KDET_HD inline int layer_of(const GridParams& grid, float diameter) {
     return layer;
 }
 
-/// @brief 2^exponent as a float, built from its bits (exact for -126 <= exponent <= 127).
-KDET_HD inline float power_of_two(int exponent) {
-    const std::uint32_t bits = static_cast<std::uint32_t>(exponent + 127) << 23;
-    float value;
-    memcpy(&value, &bits, sizeof value);
-    return value;
-}
-
 /// @brief Bins of a histogram of positive floats by their binary exponent (float_octave).
 constexpr int float_octaves = 256;
 
