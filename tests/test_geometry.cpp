@@ -1,4 +1,5 @@
-// Minimum enclosing sphere against an independent iterative solver, and ordered-float atomics.
+// Minimum enclosing sphere against an independent iterative solver, ordered-float atomics, and exact
+// scaling by powers of two.
 
 #include "exec/atomic.hpp"
 #include "geometry/enclosing_sphere.hpp"
@@ -6,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 namespace kdet {
@@ -111,4 +114,18 @@ TEST(OrderedFloat, PreservesOrderAndRoundTrips) {
 }
 
 } // namespace
+
+TEST(PowerOfTwo, ScalesAsLdexpfRoundsWhereTheFirstHalfStepIsExact) {
+    const float values[] = {0.0f, 1.0f, -1.0f, 0.75f, 1.5f, 3.4641016f, 0.5f + 0x1p-24f, 1.9999999f, 0x1p-60f, 0x1p60f};
+    for (const float x : values)
+        for (int exponent = -252; exponent <= 252; ++exponent) {
+            // The documented range: x * 2^(exponent / 2) a normal float or 0, and finite.
+            const float half = std::ldexp(x, exponent / 2);
+            if (x != 0.0f && (std::fabs(half) < FLT_MIN || !std::isfinite(half))) continue;
+            const float expected = std::ldexp(x, exponent), got = times_power_of_two(x, exponent);
+            ASSERT_EQ(std::memcmp(&expected, &got, sizeof got), 0) << x << " * 2^" << exponent << ": " << got;
+        }
+    for (int exponent = -126; exponent <= 127; ++exponent) ASSERT_EQ(power_of_two(exponent), std::ldexp(1.0f, exponent));
+}
+
 } // namespace kdet
