@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -130,6 +131,28 @@ TEST(CellRange, ClampsNonFiniteAndFarCoordinates) {
     EXPECT_EQ(cell_index(g, -5.0f, 0.0f, 0), 0u);
     EXPECT_EQ(cell_index(g, 1e30f, 0.0f, 0), 1u << 30);
     EXPECT_EQ(cell_index(g, 2.5f, 0.0f, 1), 1250u);
+}
+
+TEST(CellRange, ForEachCellVisitsEveryCellOnceXFastestAndStopsWhenAsked) {
+    for (std::uint32_t nx = 1; nx <= 3; ++nx)
+        for (std::uint32_t ny = 1; ny <= 3; ++ny)
+            for (std::uint32_t nz = 1; nz <= 3; ++nz) {
+                const CellRange r{{5, 7, 1u << 30}, {5 + nx - 1, 7 + ny - 1, (1u << 30) + nz - 1}};
+                std::vector<std::array<std::uint32_t, 3>> expected, seen;
+                for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+                    for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+                        for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) expected.push_back({x, y, z});
+                for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+                    seen.push_back({x, y, z});
+                    return true;
+                });
+                ASSERT_EQ(seen, expected) << nx << " x " << ny << " x " << nz;
+                for (std::size_t stop = 1; stop <= expected.size(); ++stop) {
+                    std::size_t calls = 0;
+                    for_each_cell(r, [&](std::uint32_t, std::uint32_t, std::uint32_t) { return ++calls < stop; });
+                    ASSERT_EQ(calls, stop);
+                }
+            }
 }
 
 /// A query box that overlaps every entry's.

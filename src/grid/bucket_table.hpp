@@ -118,6 +118,7 @@ KDET_HD KDET_ALWAYS_INLINE bool lane_overlaps(const float (&lo)[3][Lanes], const
 /// @brief Blocks of entries per group of their bounds: a query gathers a group's matches into one
 /// 64-bit mask.
 constexpr std::uint32_t bound_group = 64 / entry_block;
+static_assert(bound_group * entry_block == 64 && bound_group <= 32, "a group's entries fill one 64-bit mask, its blocks a 32-bit one");
 
 /// @brief The bounds of bound_group consecutive blocks of entries (group g: blocks [g * bound_group,
 /// (g + 1) * bound_group)), each field a row with a lane per block, so that a query tests the bounds
@@ -420,9 +421,11 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
     const std::uint32_t first_block = begin / entry_block, last_block = (end - 1) / entry_block;
     for (std::uint32_t group = first_block / bound_group; group <= last_block / bound_group; ++group) {
         const std::uint32_t group_block = group * bound_group;
-        std::uint32_t passing = overlapping_blocks(bounds[group], query);
-        if (group_block < first_block) passing &= ~0u << (first_block - group_block);
-        if (last_block - group_block < bound_group - 1) passing &= (2u << (last_block - group_block)) - 1u;
+        // The blocks and lanes outside the range masked without a branch (which mispredicted about once
+        // per query): selects, then shifts by at most the group's width.
+        const std::uint32_t blocks_before = first_block > group_block ? first_block - group_block : 0u;
+        const std::uint32_t last_in_group = last_block - group_block < bound_group - 1 ? last_block - group_block : bound_group - 1;
+        std::uint32_t passing = overlapping_blocks(bounds[group], query) & (~0u << blocks_before) & ((2u << last_in_group) - 1u);
         std::uint64_t matches = 0;
         while (passing) {
             const std::uint32_t k = lowest_bit(passing);
@@ -430,9 +433,10 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
             matches |= static_cast<std::uint64_t>(matching_lanes(blocks[group_block + k], query, required_starts))
                        << (k * entry_block);
         }
-        const std::uint32_t base = group_block * entry_block;
-        if (base < begin) matches &= ~0ull << (begin - base);
-        if (end - base < bound_group * entry_block) matches &= (1ull << (end - base)) - 1ull;
+        const std::uint32_t base = group_block * entry_block, group_entries = bound_group * entry_block;
+        const std::uint32_t entries_before = begin > base ? begin - base : 0u;
+        const std::uint32_t entries_in_range = end - base < group_entries ? end - base : group_entries;
+        matches &= (~0ull << entries_before) & (~0ull >> (group_entries - entries_in_range));
         while (matches) {
             visit(load_entry(g, base + lowest_bit64(matches)));
             matches &= matches - 1ull;

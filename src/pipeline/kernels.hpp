@@ -50,17 +50,32 @@ KDET_HD inline void load_vertices(const SceneView& s, const TetIndices& tet, vec
 
 KDET_HD inline void load_tet(const SceneView& s, std::uint32_t t, vec3 out[4]) { load_vertices(s, s.tets[t], out); }
 
+/// @brief A tet's four vertex indices, each repeated over four lanes (row k holds vertex k): made once
+/// for a tet compared with many, so that each comparison reads the other tet's indices as one vector.
+struct SpreadIndices {
+    std::uint32_t v[4][4];
+};
+
+KDET_HD inline SpreadIndices spread_indices(const TetIndices& a) {
+    SpreadIndices s;
+    for (int k = 0; k < 4; ++k)
+        for (int i = 0; i < 4; ++i) s.v[k][i] = a.v[k];
+    return s;
+}
+
 /// @brief Whether two tets share a vertex: all 16 comparisons without a branch each (about half the
-/// pairs tested share one, so early exits mispredict); on the CPU a's four vertices are compared with
-/// each of b's in one vector compare.
-KDET_HD inline bool share_vertex(const TetIndices& a, const TetIndices& b) {
+/// pairs tested share one, so early exits mispredict); on the CPU b's four vertices are compared with
+/// each of a's in one vector compare.
+KDET_HD inline bool share_vertex(const SpreadIndices& a, const TetIndices& b) {
     std::uint32_t lane[4];
     KDET_VECTOR_LOOP
     for (int i = 0; i < 4; ++i)
-        lane[i] = (a.v[i] == b.v[0] ? ~0u : 0u) | (a.v[i] == b.v[1] ? ~0u : 0u) | (a.v[i] == b.v[2] ? ~0u : 0u) |
-                  (a.v[i] == b.v[3] ? ~0u : 0u);
+        lane[i] = (b.v[i] == a.v[0][i] ? ~0u : 0u) | (b.v[i] == a.v[1][i] ? ~0u : 0u) |
+                  (b.v[i] == a.v[2][i] ? ~0u : 0u) | (b.v[i] == a.v[3][i] ? ~0u : 0u);
     return lane_bits(lane) != 0;
 }
+
+KDET_HD inline bool share_vertex(const TetIndices& a, const TetIndices& b) { return share_vertex(spread_indices(a), b); }
 
 KDET_HD inline bool pair_is_active(const SceneView& s, std::uint32_t object_a, std::uint32_t object_b) {
     return s.pair_active[static_cast<std::uint64_t>(object_a) * s.object_count + object_b] != 0;
@@ -411,14 +426,13 @@ struct PopulateKernel {
         if (info.layer < 0 || atomic_load_acquire(grid.failure)) return;
         const CellRange r = cell_range(*params, info.box, info.layer);
         const bool own_cells = has_own_cells(r);
-        for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
-            for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
-                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    const std::uint32_t bucket = grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t),
-                                                             first_cell_axes(r, x, y, z));
-                    if (bucket == no_bucket) return;
-                    if (own_cells) grid.own_cells[t].bucket[own_cell_index(r, x, y, z)] = bucket;
-                }
+        for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+            const std::uint32_t bucket =
+                grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t), first_cell_axes(r, x, y, z));
+            if (bucket == no_bucket) return false;
+            if (own_cells) grid.own_cells[t].bucket[own_cell_index(r, x, y, z)] = bucket;
+            return true;
+        });
     }
 };
 
@@ -500,19 +514,18 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
         const bool own_layer = layer == self.layer;
         const CellRange r = cell_range(params, self.box, layer);
         const bool own_cells = own_layer && has_own_cells(r);
-        for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
-            for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
-                for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) {
-                    // Along an axis where this is not t's first cell, u's box must start here.
-                    const std::uint32_t required_starts = ~first_cell_axes(r, x, y, z) & 7u;
-                    if (own_cells)
-                        grid_for_each_after_own_entry(grid, t, own_cell_index(r, x, y, z), checked_objects, self.box,
-                                                      required_starts, filter);
-                    else
-                        grid_for_each_in_cell(grid, make_cell(x, y, z, layer), own_layer ? t + 1 : 0u, checked_objects,
-                                              self.box, required_starts, filter);
-                    if (visit.finished()) return;
-                }
+        for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+            // Along an axis where this is not t's first cell, u's box must start here.
+            const std::uint32_t required_starts = ~first_cell_axes(r, x, y, z) & 7u;
+            if (own_cells)
+                grid_for_each_after_own_entry(grid, t, own_cell_index(r, x, y, z), checked_objects, self.box,
+                                              required_starts, filter);
+            else
+                grid_for_each_in_cell(grid, make_cell(x, y, z, layer), own_layer ? t + 1 : 0u, checked_objects, self.box,
+                                      required_starts, filter);
+            return !visit.finished();
+        });
+        if (visit.finished()) return;
     }
 }
 
@@ -618,7 +631,7 @@ struct FindCandidatesKernel {
         KeyBatch* batch;
         bool stop_when_full;
         std::uint32_t t;
-        TetIndices tet;
+        SpreadIndices tet;
         std::uint32_t object;
         vec3 vertices[4];
         TetPlanes planes;
@@ -661,7 +674,7 @@ struct FindCandidatesKernel {
             return;
         }
         KeyBatch batch(&out, already_stored);
-        Emit emit{&scene, &batch, stop_when_full, t, scene.tets[t], scene.tet_object[t], {}, scene.planes[t], 0};
+        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], {}, scene.planes[t], 0};
         load_tet(scene, t, emit.vertices);
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part, layer_parts);
