@@ -76,7 +76,8 @@ struct CellRange {
 
 /// @brief Calls go_on(x, y, z) for each cell of r, x fastest, until it returns false: one loop whose
 /// steps wrap x and y through masks, so that only its end mispredicts (three nested loops of one or
-/// two steps each mispredicted at each of their ends; selects became branches again).
+/// two steps each mispredicted at each of their ends; selects became branches again). r must not be
+/// empty along any axis, as cell_range's ranges never are (cell_index is monotone).
 template <class GoOn>
 KDET_HD KDET_ALWAYS_INLINE void for_each_cell(const CellRange& r, GoOn&& go_on) {
     std::uint32_t x = r.lo[0], y = r.lo[1], z = r.lo[2];
