@@ -142,15 +142,16 @@ TEST(CellRange, ForEachCellVisitsEveryCellOnceXFastestAndStopsWhenAsked) {
                 for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
                     for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y)
                         for (std::uint32_t x = r.lo[0]; x <= r.hi[0]; ++x) expected.push_back({x, y, z});
-                for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+                EXPECT_TRUE(for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
                     seen.push_back({x, y, z});
                     return true;
-                });
+                }));
                 ASSERT_EQ(seen, expected) << nx << " x " << ny << " x " << nz;
                 for (std::size_t stop = 1; stop <= expected.size(); ++stop) {
                     std::size_t calls = 0;
-                    for_each_cell(r, [&](std::uint32_t, std::uint32_t, std::uint32_t) { return ++calls < stop; });
+                    const bool all = for_each_cell(r, [&](std::uint32_t, std::uint32_t, std::uint32_t) { return ++calls < stop; });
                     ASSERT_EQ(calls, stop);
+                    ASSERT_FALSE(all);
                 }
             }
 }

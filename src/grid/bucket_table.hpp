@@ -387,6 +387,11 @@ KDET_HD KDET_ALWAYS_INLINE std::uint32_t matching_lanes(const EntryBlock& b, con
     return lane_bits(lanes);
 }
 
+/// @brief Bits [first, end) of a 64-bit mask, 0 <= first < end <= 64, without a branch.
+KDET_HD KDET_ALWAYS_INLINE std::uint64_t bit_range(std::uint32_t first, std::uint32_t end) {
+    return (~0ull << first) & (~0ull >> (64u - end));
+}
+
 /// @brief Index of the lowest set bit of a non-zero 64-bit mask.
 KDET_HD inline std::uint32_t lowest_bit64(std::uint64_t mask) {
 #if defined(__CUDA_ARCH__)
@@ -422,10 +427,11 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
     for (std::uint32_t group = first_block / bound_group; group <= last_block / bound_group; ++group) {
         const std::uint32_t group_block = group * bound_group;
         // The blocks and lanes outside the range masked without a branch (which mispredicted about once
-        // per query): selects, then shifts by at most the group's width.
+        // per query): the range's ends within the group by selects, then bit_range.
         const std::uint32_t blocks_before = first_block > group_block ? first_block - group_block : 0u;
-        const std::uint32_t last_in_group = last_block - group_block < bound_group - 1 ? last_block - group_block : bound_group - 1;
-        std::uint32_t passing = overlapping_blocks(bounds[group], query) & (~0u << blocks_before) & ((2u << last_in_group) - 1u);
+        const std::uint32_t blocks_in_range = last_block - group_block < bound_group ? last_block - group_block + 1 : bound_group;
+        std::uint32_t passing =
+            overlapping_blocks(bounds[group], query) & static_cast<std::uint32_t>(bit_range(blocks_before, blocks_in_range));
         std::uint64_t matches = 0;
         while (passing) {
             const std::uint32_t k = lowest_bit(passing);
@@ -436,7 +442,7 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
         const std::uint32_t base = group_block * entry_block, group_entries = bound_group * entry_block;
         const std::uint32_t entries_before = begin > base ? begin - base : 0u;
         const std::uint32_t entries_in_range = end - base < group_entries ? end - base : group_entries;
-        matches &= (~0ull << entries_before) & (~0ull >> (group_entries - entries_in_range));
+        matches &= bit_range(entries_before, entries_in_range);
         while (matches) {
             visit(load_entry(g, base + lowest_bit64(matches)));
             matches &= matches - 1ull;

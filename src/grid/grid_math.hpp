@@ -74,15 +74,16 @@ struct CellRange {
     std::uint32_t hi[3];
 };
 
-/// @brief Calls go_on(x, y, z) for each cell of r, x fastest, until it returns false: one loop whose
+/// @brief Calls go_on(x, y, z) for each cell of r, x fastest, until it returns false (then returns
+/// false itself; true once every cell was visited): one loop whose
 /// steps wrap x and y through masks, so that only its end mispredicts (three nested loops of one or
 /// two steps each mispredicted at each of their ends; selects became branches again). r must not be
 /// empty along any axis, as cell_range's ranges never are (cell_index is monotone).
 template <class GoOn>
-KDET_HD KDET_ALWAYS_INLINE void for_each_cell(const CellRange& r, GoOn&& go_on) {
+KDET_HD KDET_ALWAYS_INLINE bool for_each_cell(const CellRange& r, GoOn&& go_on) {
     std::uint32_t x = r.lo[0], y = r.lo[1], z = r.lo[2];
     do {
-        if (!go_on(x, y, z)) return;
+        if (!go_on(x, y, z)) return false;
         // All ones where x (and then y) is at its range's end and wraps.
         const std::uint32_t next_row = 0u - static_cast<std::uint32_t>(x == r.hi[0]);
         const std::uint32_t next_slice = next_row & (0u - static_cast<std::uint32_t>(y == r.hi[1]));
@@ -90,6 +91,7 @@ KDET_HD KDET_ALWAYS_INLINE void for_each_cell(const CellRange& r, GoOn&& go_on) 
         y = ((y - next_row) & ~next_slice) | (r.lo[1] & next_slice);
         z -= next_slice;
     } while (z <= r.hi[2]);
+    return true;
 }
 
 /// @brief The axes along which cell (x, y, z) of range r is the range's first (bit a for axis a):

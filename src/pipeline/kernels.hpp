@@ -514,7 +514,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
         const bool own_layer = layer == self.layer;
         const CellRange r = cell_range(params, self.box, layer);
         const bool own_cells = own_layer && has_own_cells(r);
-        for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+        const bool searched_all = for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
             // Along an axis where this is not t's first cell, u's box must start here.
             const std::uint32_t required_starts = ~first_cell_axes(r, x, y, z) & 7u;
             if (own_cells)
@@ -525,7 +525,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
                                       required_starts, filter);
             return !visit.finished();
         });
-        if (visit.finished()) return;
+        if (!searched_all) return;
     }
 }
 
