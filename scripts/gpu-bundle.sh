@@ -31,11 +31,6 @@ KDET_DATA_DIR="$data_dir" KDET_CACHE_DIR="$cache_dir" "$build/kdet" prepare >/de
 rm -rf "$bundle"
 mkdir -p "$bundle/lib"
 cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bundle/"
-# Libraries beyond glibc (and its libdl, libpthread, librt), libstdc++, libgcc and libgomp, which the device image has.
-for program in "$bundle/kdet" "$bundle/kdet_tests" "$bundle/kdet_gpu_vs_sweep"; do
-  ldd "$program" | awk '/=> \//{print $3}' | grep -Ev '/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|libgomp|ld-linux[^/]*)\.so' |
-    xargs -r cp -Ln -t "$bundle/lib/"
-done
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"
   worktree="$(mktemp -d)/kdet-$short"
@@ -44,6 +39,12 @@ for commit in "$@"; do
   cmake --build "$repo/build-gpu-$short" -j"$(nproc)" --target kdet_cli
   cp "$repo/build-gpu-$short/kdet" "$bundle/kdet-$short"
   git -C "$repo" worktree remove --force "$worktree"
+done
+# Libraries beyond glibc (and its libdl, libpthread, librt), libstdc++, libgcc and libgomp, which the
+# device image has; older builds of kdet linked the viewer's too.
+for program in "$bundle"/kdet*; do
+  ldd "$program" | awk '/=> \//{print $3}' | grep -Ev '/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|libgomp|ld-linux[^/]*)\.so' |
+    xargs -r cp -Ln -t "$bundle/lib/"
 done
 git -C "$repo" log -1 --format='built at commit %H %s' >"$bundle/commit.txt"
 git -C "$repo" status --short --untracked-files=no >>"$bundle/commit.txt"

@@ -7,10 +7,11 @@
 #            brute force on armadillos r4 at the frames where they touch
 #   scaling  the procedural scene from 100k to 4M tets (and 8M), frames around the deepest one (60)
 #   peer     kdet against a CUB sort-and-sweep + sat peer on the same frames (bench/gpu_vs_sweep.cu)
-#   profile  each kernel's GPU time in two frames of four cases (Nsight Compute), and the bucket
+#   profile  each kernel's GPU time in two frames of four cases (Nsight Compute), the heaviest case's
+#            occupancy, divergence and cache hits, and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
 #   compare  the bundle's kdet against the other builds it holds as kdet-NAME (scripts/gpu-bundle.sh
-#            COMMIT ... puts them there), two alternating rounds on three cases
+#            COMMIT ... puts them there), two alternating rounds on five cases
 #   matrix   the thesis benchmark matrix (scripts/run-thesis-matrix.sh) until the deadline
 # usage: scripts/gpu-session.sh PART [PART ...]   (e.g. tests r4 sanitizers scaling)
 # Settings: KDET_GPU_DEADLINE, seconds after which no step starts and running ones are stopped [500].
@@ -112,6 +113,12 @@ for part in "$@"; do
       step "ncu-$name" 90 "${nsight_compute:-ncu}" --clock-control none --metrics gpu__time_duration.sum --csv \
         --log-file "$work/ncu-$name.csv" "$kdet" bench $arguments -n 1 --backend cuda --quiet -d "$work/ncu-bench"
     done
+    # Why the longest kernels take their time: occupancy, divergence, cache hits and memory throughput
+    # of the heaviest frame's kernels (each metric group replays the kernel).
+    step ncu-detail-armadillos-r4-self-yes 90 "${nsight_compute:-ncu}" --clock-control none --csv \
+      --metrics gpu__time_duration.sum,launch__registers_per_thread,launch__occupancy_limit_registers,sm__warps_active.avg.pct_of_peak_sustained_active,smsp__thread_inst_executed_per_inst_executed.ratio,l1tex__t_sector_hit_rate.pct,lts__t_sector_hit_rate.pct,dram__throughput.avg.pct_of_peak_sustained_elapsed,sm__throughput.avg.pct_of_peak_sustained_elapsed \
+      --log-file "$work/ncu-detail-armadillos-r4-self-yes.csv" "$kdet" bench armadillos -r 4 -s yes --frames 80:81 -n 1 \
+      --backend cuda --quiet -d "$work/ncu-bench"
     # The bench files do not name the bucket capacity: one folder per variant.
     for variant in "automatic" "buckets-8 --bucket-capacity 8" "buckets-32 --bucket-capacity 32" "block-64 -g 64" \
       "block-256 -g 256"; do
@@ -126,7 +133,9 @@ for part in "$@"; do
       for program in $others kdet; do
         for case in "procedural-100k procedural --tets 100000 -s no --frames 55:65" \
           "armadillos-r4-self armadillos -r 4 -s yes --frames 70:99" \
-          "pass_through-r2 pass_through_armadillos -r 2 -s no --frames 20:59"; do
+          "pass_through-r2 pass_through_armadillos -r 2 -s no --frames 20:59" \
+          "procedural-1m procedural --tets 1000000 -s no --frames 59:61" \
+          "procedural-4m procedural --tets 4000000 -s no --frames 59:61"; do
           read -r name arguments <<<"$case"
           step "compare-$round-$program-$name" 30 "$bundle/$program" bench $arguments -n 3 --backend cuda --quiet \
             -d "$work/compare/$program-$round"
