@@ -586,6 +586,39 @@ TEST(BucketTable, AScanVisitsExactlyTheMatchingEntriesOfItsRangeWhereverTheRange
             }
 }
 
+TEST(BucketTable, AScanSharedByPartsReadsEachBlockInExactlyOnePart) {
+    // One list of 150 entries (19 blocks, three groups), entry k is id k with its box x in [k, k + 0.5];
+    // the scans of a range by 1, 2, 4 and 8 parts (group_blocks_of_part) together visit what the whole
+    // scan visits, each entry once, and part p only entries of the blocks i of a group with i % parts == p.
+    EXPECT_EQ(group_blocks_of_part(0, 1), all_group_blocks);
+    EXPECT_EQ(group_blocks_of_part(1, 4), 0x22u);
+    constexpr std::uint32_t n = 150;
+    TestTable table(64, 4, 64, 32, HashFunction::djb2);
+    const CellCoord cell{2, 3, 4, 0};
+    for (std::uint32_t i = 0; i < n; ++i) ASSERT_NE(grid_insert(table.view, cell, i, 0u), no_bucket);
+    const auto c = table.compacted(n, [](std::uint32_t id) {
+        const float x = static_cast<float>(id);
+        return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
+    });
+    ASSERT_EQ(c.failure, 0u);
+    const Aabb query{{10.2f, 0.5f, 0.5f}, {141.7f, 0.6f, 0.6f}};
+    for (const auto& [begin, end] : {std::pair{0u, n}, std::pair{5u, 71u}, std::pair{63u, 66u}, std::pair{17u, 140u}}) {
+        SeenIds whole;
+        grid_for_each_in_entries(c.view, begin, end, query, 0u, whole);
+        for (std::uint32_t parts : {1u, 2u, 4u, 8u}) {
+            std::vector<std::uint32_t> together;
+            for (std::uint32_t part = 0; part < parts; ++part) {
+                SeenIds seen;
+                grid_for_each_in_entries(c.view, begin, end, query, 0u, seen, group_blocks_of_part(part, parts));
+                for (std::uint32_t id : seen.ids) EXPECT_EQ(id / entry_block % parts, part) << id;
+                together.insert(together.end(), seen.ids.begin(), seen.ids.end());
+            }
+            std::sort(together.begin(), together.end());
+            EXPECT_EQ(together, whole.ids) << parts << " parts, entries " << begin << "-" << end;
+        }
+    }
+}
+
 TEST(BucketTable, QueriesPassOnlyTheEntriesWhoseBoxesStartAlongTheRequiredAxes) {
     // 70 ids across a chain of buckets, id i starting along the axes i % 8; every subset asked for.
     TestTable table(64, 4, 64, 32, HashFunction::morton);

@@ -194,12 +194,13 @@ TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
     EXPECT_EQ(run({a, b}, true, tiny_brute).pairs, reference.pairs);
 }
 
-/// The CPU backend with its work divided as the GPU's is: the candidate search split into parts
-/// (Exec::search_parts_per_tet) and the grid's plan in small chunks (Exec::plan_chunk).
-template <std::uint32_t Parts, std::uint32_t PlanChunk>
+/// The CPU backend with its work divided as the GPU's is: the candidate search split into parts by
+/// layers and by blocks of each list (SearchPart) and the grid's plan in small chunks (Exec::plan_chunk).
+template <std::uint32_t LayerParts, std::uint32_t BlockParts, std::uint32_t PlanChunk>
 struct GpuShapedExec : CpuExec {
     using CpuExec::CpuExec;
-    static constexpr std::uint32_t search_parts_per_tet = Parts;
+    static constexpr std::uint32_t search_layer_parts = LayerParts;
+    static constexpr std::uint32_t search_block_parts = BlockParts;
     static constexpr std::uint32_t plan_chunk = PlanChunk;
 };
 
@@ -234,11 +235,13 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
         for (const auto& [meshes, self] : {std::pair{std::vector<TetMesh>{a, b}, true},
                                            std::pair{std::vector<TetMesh>{folded, moved(folded, 0.4, 0.02, 0.01, 0.0)}, true}}) {
             Pipeline<CpuExec> whole(options);
-            Pipeline<GpuShapedExec<3, 1>> in_three(options);
-            Pipeline<GpuShapedExec<4, 16>> in_four(options); // CudaExec's
+            Pipeline<GpuShapedExec<3, 1, 1>> by_layers(options);
+            Pipeline<GpuShapedExec<1, 8, 256>> by_blocks(options);
+            Pipeline<GpuShapedExec<2, 4, 16>> like_cuda(options); // CudaExec's
             const FrameResult expected = run_pipeline(whole, meshes, self);
             ASSERT_GT(expected.pairs.size(), 20u);
-            for (PipelineBase* split : {static_cast<PipelineBase*>(&in_three), static_cast<PipelineBase*>(&in_four)}) {
+            for (PipelineBase* split : {static_cast<PipelineBase*>(&by_layers), static_cast<PipelineBase*>(&by_blocks),
+                                        static_cast<PipelineBase*>(&like_cuda)}) {
                 const FrameResult got = run_pipeline(*split, meshes, self);
                 EXPECT_EQ(got.pairs, expected.pairs) << "capacity " << capacity;
                 EXPECT_EQ(got.colliding, expected.colliding);

@@ -98,6 +98,32 @@ KDET_HD inline void atomic_max(T* address, T value) {
 #endif
 }
 
+/// @brief atomic_fetch_add on a counter that the threads of a warp often add to at once (the
+/// candidates' count, the rejected pairs): on the GPU the lanes that arrive together at one address add
+/// their sum through one atomic, the lowest lane's, and each gets what it would have got adding in
+/// lane order, since atomics on one address queue one after the other at the L2. The host adds plainly.
+template <class T>
+KDET_HD inline T atomic_fetch_add_gathered(T* address, T value) {
+#if defined(__CUDA_ARCH__)
+    const unsigned same = __match_any_sync(__activemask(), reinterpret_cast<unsigned long long>(address));
+    unsigned lane;
+    asm("mov.u32 %0, %%laneid;" : "=r"(lane));
+    T sum = 0, below = 0;
+    for (unsigned rest = same; rest; rest &= rest - 1u) {
+        const unsigned other = static_cast<unsigned>(__ffs(static_cast<int>(rest)) - 1);
+        const T v = __shfl_sync(same, value, static_cast<int>(other));
+        sum += v;
+        if (other < lane) below += v;
+    }
+    const int leader = __ffs(static_cast<int>(same)) - 1;
+    T first = 0;
+    if (static_cast<int>(lane) == leader) first = atomic_fetch_add(address, sum);
+    return __shfl_sync(same, first, leader) + below;
+#else
+    return atomic_fetch_add(address, value);
+#endif
+}
+
 /// @brief atomic_min and atomic_max after a plain read, for a running extreme that few values move
 /// once the first have arrived: most threads then only read (a GPU's fetch_min writes either way).
 template <class T>

@@ -410,14 +410,28 @@ KDET_HD inline std::uint32_t lowest_bit(std::uint32_t mask) {
 #endif
 }
 
+/// @brief Every block of a group (the scans' `group_blocks`).
+constexpr std::uint32_t all_group_blocks = (1u << bound_group) - 1u;
+
+/// @brief The blocks of each group that part `part` of a scan shared by `parts` work items reads:
+/// block i of a group where i % parts == part (parts divides bound_group), so that the parts together
+/// read every block once, neighbouring parts neighbouring blocks.
+KDET_HD constexpr std::uint32_t group_blocks_of_part(std::uint32_t part, std::uint32_t parts) {
+    std::uint32_t blocks = 0;
+    for (std::uint32_t i = part; i < bound_group; i += parts) blocks |= 1u << i;
+    return blocks;
+}
+
 /// @brief Calls visit(entry) for every entry k in [begin, end) of the compacted lists (begin < end) whose
-/// box overlaps `box` and whose start bits include `required_starts` (see GridEntry::starts); the
-/// entries of a block whose bound misses `box` are not read. A group of blocks at a time: its bounds
-/// tested at once, its matches gathered into one mask and visited in one loop, where a branch per
-/// block on its bound and a loop per block over its matches each mispredicted about once a block.
+/// box overlaps `box` and whose start bits include `required_starts` (see GridEntry::starts), in the
+/// blocks of each group that `group_blocks` names; the entries of a block whose bound misses `box` are
+/// not read. A group of blocks at a time: its bounds tested at once, its matches gathered into one mask
+/// and visited in one loop, where a branch per block on its bound and a loop per block over its matches
+/// each mispredicted about once a block.
 template <class Visitor>
 KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t begin, std::uint32_t end, const Aabb& box,
-                                             std::uint32_t required_starts, Visitor& visit) {
+                                             std::uint32_t required_starts, Visitor& visit,
+                                             std::uint32_t group_blocks = all_group_blocks) {
     // Copies: the visitor's stores might alias them for all the compiler knows, which would have
     // every block reload the box and spread it over the vector lanes again.
     const Aabb query = box;
@@ -430,8 +444,8 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
         // per query): the range's ends within the group by selects, then bit_range.
         const std::uint32_t blocks_before = first_block > group_block ? first_block - group_block : 0u;
         const std::uint32_t blocks_in_range = last_block - group_block < bound_group ? last_block - group_block + 1 : bound_group;
-        std::uint32_t passing =
-            overlapping_blocks(bounds[group], query) & static_cast<std::uint32_t>(bit_range(blocks_before, blocks_in_range));
+        std::uint32_t passing = overlapping_blocks(bounds[group], query) & group_blocks &
+                                static_cast<std::uint32_t>(bit_range(blocks_before, blocks_in_range));
         std::uint64_t matches = 0;
         while (passing) {
             const std::uint32_t k = lowest_bit(passing);
@@ -453,11 +467,12 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
 /// @brief Calls visit(entry) for every entry of `cell` whose id is at least `first_id`, whose box
 /// overlaps `box` and whose start bits include `required_starts`, once the table is compacted, unless
 /// the cell holds none of the `objects` (object_bit of each, or any_object): the smaller ids are
-/// skipped by a binary search (grid_for_each_in_entries for the rest). The visitor checks the entry's
-/// object itself.
+/// skipped by a binary search (grid_for_each_in_entries for the rest, in the blocks `group_blocks`
+/// names). The visitor checks the entry's object itself.
 template <class Visitor>
 KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std::uint32_t first_id, std::uint32_t objects,
-                                          const Aabb& box, std::uint32_t required_starts, Visitor& visit) {
+                                          const Aabb& box, std::uint32_t required_starts, Visitor& visit,
+                                          std::uint32_t group_blocks = all_group_blocks) {
     const std::uint32_t bucket = grid_find(g, cell);
     if (bucket == no_bucket || !(g.headers[bucket].objects & objects)) return;
     const std::uint32_t first = g.headers[bucket].first_entry;
@@ -471,7 +486,7 @@ KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std
         else
             high = middle;
     }
-    if (begin < end) grid_for_each_in_entries(g, begin, end, box, required_starts, visit);
+    if (begin < end) grid_for_each_in_entries(g, begin, end, box, required_starts, visit, group_blocks);
 }
 
 /// @brief grid_for_each_in_cell on cell `index` of tet `id`'s own cells (OwnCells) with first_id
@@ -480,7 +495,7 @@ KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std
 template <class Visitor>
 KDET_HD inline void grid_for_each_after_own_entry(const GridView& g, std::uint32_t id, std::uint32_t index,
                                                   std::uint32_t objects, const Aabb& box, std::uint32_t required_starts,
-                                                  Visitor& visit) {
+                                                  Visitor& visit, std::uint32_t group_blocks = all_group_blocks) {
     const OwnCells& row = g.own_cells[id];
     const std::uint32_t bucket = row.bucket[index];
     if (bucket >= g.slot_count) return;
@@ -488,7 +503,7 @@ KDET_HD inline void grid_for_each_after_own_entry(const GridView& g, std::uint32
     if ((h.state >> 1) != g.stamp || !(h.objects & objects)) return;
     const std::uint32_t first = h.first_entry, end = first + h.count;
     const std::uint32_t begin = row.after[index] > first ? row.after[index] : first;
-    if (begin < end) grid_for_each_in_entries(g, begin, end, box, required_starts, visit);
+    if (begin < end) grid_for_each_in_entries(g, begin, end, box, required_starts, visit, group_blocks);
 }
 
 } // namespace kdet

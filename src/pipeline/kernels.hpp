@@ -478,6 +478,16 @@ struct ObjectFilter {
     }
 };
 
+/// @brief The share of a tet's candidate search that one work item takes: the layers t's own + layer,
+/// + layer + layers, ..., and in each cell's list the blocks of each group that
+/// group_blocks_of_part(block, blocks) names. The GPU splits a search (Exec::search_layer_parts,
+/// Exec::search_block_parts) because a thread's search is a chain of dependent loads that occupancy
+/// cannot hide; the CPU searches a tet whole.
+struct SearchPart {
+    std::uint32_t layer = 0, layers = 1;
+    std::uint32_t block = 0, blocks = 1;
+};
+
 /// @brief Calls visit(entry) once for every tet u (entry.id) that tet t must test, with what the
 /// cell's list holds about u (box, object): u is stored in a cell that t's
 /// box overlaps on t's layer or a higher one, u is "larger" than t (higher layer, or same layer and
@@ -492,12 +502,12 @@ struct ObjectFilter {
 /// an axis where the cell is not t's first, it must be u's: the entry says so (GridEntry::starts),
 /// and the cell's scan passes only such entries.
 ///
-/// A search may be split into `layer_parts` parts, part p searching the layers t's own + p,
-/// + p + layer_parts, ...: the parts together visit what the whole search does, each pair once.
+/// A search may be split (SearchPart): the parts together visit what the whole search does, each
+/// pair once.
 template <class Visitor>
 KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const GridView& grid, const GridParams& params,
                                              std::uint32_t layer_mask, std::uint32_t t, Visitor& visit,
-                                             std::uint32_t part = 0, std::uint32_t layer_parts = 1) {
+                                             SearchPart part = SearchPart{}) {
     const TetInfo self = scene.info[t];
     // A grid that failed to fill runs again before anything reads its results; its rows and lists
     // are partly unwritten.
@@ -506,7 +516,9 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
     const std::uint32_t checked_objects = scene.checked_objects[object];
     ObjectFilter<Visitor> filter{checked_against, &visit};
-    for (int layer = self.layer + static_cast<int>(part); layer < params.layer_count; layer += static_cast<int>(layer_parts)) {
+    const std::uint32_t group_blocks = group_blocks_of_part(part.block, part.blocks);
+    for (int layer = self.layer + static_cast<int>(part.layer); layer < params.layer_count;
+         layer += static_cast<int>(part.layers)) {
         if (!((layer_mask >> layer) & 1u)) continue;
         // A cell holds only tets of its own layer: on t's, the larger tets are the higher ids, and the
         // sorted list skips the others unread (from t's own entry on, found through its row where it
@@ -519,10 +531,10 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
             const std::uint32_t required_starts = ~first_cell_axes(r, x, y, z) & 7u;
             if (own_cells)
                 grid_for_each_after_own_entry(grid, t, own_cell_index(r, x, y, z), checked_objects, self.box,
-                                              required_starts, filter);
+                                              required_starts, filter, group_blocks);
             else
                 grid_for_each_in_cell(grid, make_cell(x, y, z, layer), own_layer ? t + 1 : 0u, checked_objects, self.box,
-                                      required_starts, filter);
+                                      required_starts, filter, group_blocks);
             return !visit.finished();
         });
         if (!searched_all) return;
@@ -546,7 +558,7 @@ struct KeyAppender {
     unsigned long long* padding;
     KDET_HD bool push(std::uint64_t key) const { return write(&key, 1); }
     KDET_HD bool write(const std::uint64_t* batch, std::uint32_t n) const {
-        const unsigned long long first = atomic_fetch_add(count, static_cast<unsigned long long>(n));
+        const unsigned long long first = atomic_fetch_add_gathered(count, static_cast<unsigned long long>(n));
         if (first + n <= capacity) {
             for (std::uint32_t k = 0; k < n; ++k) keys[first + k] = batch[k];
             return true;
@@ -615,12 +627,13 @@ struct FindCandidatesKernel {
     const ResumePoint* resume_from; ///< null: every item, from the start; else item i resumes resume_from[i]
     ResumePoint* stopped;           ///< [items] where the items that did not fit stopped
     std::uint32_t* stopped_count;
-    /// Work items per tet, each searching part of its layers (for_each_larger_neighbour's parts): item
-    /// p * tets + t, so that neighbouring items are neighbouring tets on the same part (a scene whose
-    /// tets sit on one or two layers leaves whole warps of later parts idle, not lanes of every warp).
-    /// The GPU splits a tet's search (Exec::search_parts_per_tet), so that its threads' chains of
-    /// dependent loads are shorter; the CPU searches a tet whole.
+    /// Work items per tet (SearchPart): layer_parts x block_parts, item (l * tets + t) * block_parts + b
+    /// searching layer part l and block part b of tet t. The block parts of a tet are neighbouring
+    /// items, which walk the same cells in step and read neighbouring blocks; the layer parts are far
+    /// apart, so that a scene whose tets sit on one or two layers leaves whole warps of later layer
+    /// parts idle, not lanes of every warp.
     std::uint32_t layer_parts;
+    std::uint32_t block_parts;
     /// A frame that resumes the items that did not fit (a first frame): such an item stops searching at
     /// once, since its resumption searches again. Otherwise it searches on, counting the room the
     /// whole frame needs, so that a single rerun fits.
@@ -663,9 +676,11 @@ struct FindCandidatesKernel {
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto item = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
-        const std::uint32_t t = item % scene.tet_count, part = item / scene.tet_count;
+        const std::uint32_t tet_part = item / block_parts;
+        const std::uint32_t t = tet_part % scene.tet_count;
+        const SearchPart part{tet_part / scene.tet_count, layer_parts, item % block_parts, block_parts};
         const int layer = scene.info[t].layer;
-        if (layer < 0 || layer + static_cast<int>(part) >= params->layer_count) return;
+        if (layer < 0 || layer + static_cast<int>(part.layer) >= params->layer_count) return;
         const std::uint32_t already_stored = resume_from ? resume_from[i].stored : 0u;
         // Once a first frame's buffer is full, an item that has not started would only search until
         // its first batch and then search again after the buffer grows: it waits for that at once.
@@ -677,13 +692,13 @@ struct FindCandidatesKernel {
         Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], {}, scene.planes[t], 0};
         load_tet(scene, t, emit.vertices);
         const GridParams grid_params = *params;
-        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part, layer_parts);
+        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
         batch.flush();
         if (batch.stopped) {
             stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{item, batch.stored};
             return;
         }
-        if (emit.rejected) atomic_fetch_add(rejected, emit.rejected);
+        if (emit.rejected) atomic_fetch_add_gathered(rejected, emit.rejected);
     }
 };
 

@@ -376,12 +376,16 @@ GridView Pipeline<Exec>::populate() {
 /// @brief Stage 3 (kdet): candidate pairs, each written once. A frame that reads its counters back
 /// here (a first frame, to size the pairs' window) does not rerun when the buffer overflows: the
 /// buffer grows keeping what was stored and only the search items (tets, or parts of their searches:
-/// Exec::search_parts_per_tet) that did not fit search again, each resuming after the keys it had
+/// SearchPart) that did not fit search again, each resuming after the keys it had
 /// stored (they stopped searching when they did not fit). Later frames read nothing here; an overflow shows in the
 /// frame's counters and the frame reruns (grow_for). Returns the counters when it read them.
 template <class Exec>
 std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
-    constexpr std::uint32_t parts = Exec::search_parts_per_tet;
+    // Items are numbered in 32 bits (ResumePoint): a scene too large for that searches its tets whole.
+    const bool split = tets_.size() * Exec::search_layer_parts * Exec::search_block_parts <= 0xffffffffu;
+    const std::uint32_t layer_parts = split ? Exec::search_layer_parts : 1u;
+    const std::uint32_t block_parts = split ? Exec::search_block_parts : 1u;
+    const std::size_t parts = std::size_t{layer_parts} * block_parts;
     for (auto& points : resume_points_) points.resize_discard(tets_.size() * parts);
     std::size_t items = tets_.size() * parts;
     std::size_t first_slot = 0; ///< where this run's keys start in the buffer
@@ -391,7 +395,8 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         ResumePoint* stopped = resume_points_[run % 2].data();
         const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
         exec_.for_each(items, FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected,
-                                                   resume_from, stopped, &c->stopped_items, parts, !pairs_sized_});
+                                                   resume_from, stopped, &c->stopped_items, layer_parts, block_parts,
+                                                   !pairs_sized_});
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
         if (!after.stopped_items) return after;
