@@ -7,7 +7,7 @@
 #            brute force on armadillos r4 at the frames where they touch
 #   scaling  the procedural scene from 100k to 4M tets (and 8M), frames around the deepest one (60)
 #   peer     kdet against a CUB sort-and-sweep + sat peer on the same frames (bench/gpu_vs_sweep.cu)
-#   profile  each kernel's GPU time in two frames of four cases (Nsight Compute), the heaviest case's
+#   profile  each kernel's GPU time in two frames of five cases (Nsight Compute), the heaviest case's
 #            occupancy, divergence and cache hits, and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
 #   compare  the bundle's kdet against the other builds it holds as kdet-NAME (scripts/gpu-bundle.sh
@@ -108,6 +108,7 @@ for part in "$@"; do
     for case in "armadillos-r4-self-yes armadillos -r 4 -s yes --frames 80:81" \
       "armadillos-r4-self-no armadillos -r 4 -s no --frames 80:81" \
       "pass_through-r2 pass_through_armadillos -r 2 -s no --frames 40:41" \
+      "pass_through-r2-deepest pass_through_armadillos -r 2 -s no --frames 78:79" \
       "procedural-100k procedural --tets 100000 -s no --frames 59:60"; do
       read -r name arguments <<<"$case"
       step "ncu-$name" 90 "${nsight_compute:-ncu}" --clock-control none --metrics gpu__time_duration.sum --csv \

@@ -185,13 +185,14 @@ struct TestTable {
         : headers(slots + pool, BucketHeader{}), ids(static_cast<std::size_t>(slots + pool) * capacity), claimed_slots(slots) {
         std::uint32_t bits = 0;
         while ((1u << bits) < slots) ++bits;
-        view = GridView{headers.data(), ids.data(), nullptr, nullptr, nullptr, nullptr, 0, &overflow_used, &failure, &claimed,
+        view = GridView{headers.data(), ids.data(), nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, 0, &overflow_used, &failure, &claimed,
                         claimed_slots.data(), slots, bits, capacity, pool, 1, probes, hash};
     }
     /// A compacted copy of the table (the table itself stays open for inserts), with room for
     /// `room` entries; each entry carries its id, and its id again as the object.
     struct Compacted {
         std::vector<BucketHeader> headers;
+        std::vector<std::uint32_t> list_keys, sorted_keys, list_begin, list_end;
         std::vector<EntryBlock> entry_blocks;
         std::vector<BlockBoundGroup> block_bounds;
         std::uint32_t blocks = 0;
@@ -204,17 +205,25 @@ struct TestTable {
     template <class EntryOf>
     Compacted compacted(std::size_t room, const EntryOf& entry_of) const {
         const std::size_t blocks = (room + entry_block - 1) / entry_block;
-        Compacted c{headers, std::vector<EntryBlock>(blocks),
-                    std::vector<BlockBoundGroup>((blocks + bound_group - 1) / bound_group), static_cast<std::uint32_t>(blocks),
-                    0, 0, view};
+        Compacted c{headers, std::vector<std::uint32_t>(room), std::vector<std::uint32_t>(room),
+                    std::vector<std::uint32_t>(view.slot_count), std::vector<std::uint32_t>(view.slot_count),
+                    std::vector<EntryBlock>(blocks), std::vector<BlockBoundGroup>((blocks + bound_group - 1) / bound_group),
+                    static_cast<std::uint32_t>(blocks), 0, 0, view};
         c.view.headers = c.headers.data();
+        c.view.list_keys = c.list_keys.data();
+        c.view.list_begin = c.list_begin.data();
+        c.view.list_end = c.list_end.data();
         c.view.entry_blocks = c.entry_blocks.data();
         c.view.block_bounds = c.block_bounds.data();
         c.view.entries_used = &c.used;
         c.view.entry_capacity = static_cast<std::uint32_t>(room);
         c.view.failure = &c.failure;
-        for (std::uint32_t slot = 0; slot < view.slot_count; ++slot)
-            compact_cell(c.view, slot, entry_of);
+        for (std::uint32_t order = 0; order < view.slot_count; ++order)
+            gather_cell(c.view, order, [&](std::uint32_t id) { return entry_of(id).object; });
+        CpuExec(DetectorOptions{}).sort_lists(c.list_keys.data(), c.sorted_keys.data(), room, c.list_begin.data(),
+                                              c.list_end.data(), view.slot_count);
+        if (c.failure == 0)
+            for (std::uint32_t k = 0; k < c.used; ++k) place_entry(c.view, c.sorted_keys.data(), k, entry_of);
         for (std::uint32_t block = 0; block < c.blocks; ++block) bound_entry_block(c.view, block, c.used);
         return c;
     }

@@ -163,6 +163,13 @@ public:
     /// radix sort (one pass per 11 bits here, per 8 in CUB's).
     void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const;
 
+    /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
+    /// sorted ascending (the grid's lists by id); the lists lie within the first `capacity` keys. A
+    /// thread a list, by a Shell sort: the lists are short, and the CPU's threads fill them in about
+    /// ascending order, so its passes move few keys.
+    void sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t capacity, const std::uint32_t* begin,
+                    const std::uint32_t* end, std::size_t lists) const;
+
     /// @brief *total = the sum of in[0, n), left in the backend's memory.
     void sum(const std::uint32_t* in, std::size_t n, unsigned long long* total) const;
 

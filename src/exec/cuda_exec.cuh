@@ -10,6 +10,7 @@
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
+#include <cub/device/device_segmented_sort.cuh>
 #include <cub/device/device_select.cuh>
 #include <cuda_runtime.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -241,6 +242,20 @@ public:
         cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, buffers, capacity, 0, bits, stream_),
                    "radix sort");
         if (buffers.Current() != keys) copy(keys, buffers.Current(), capacity);
+    }
+
+    /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
+    /// sorted ascending; the lists lie within the first `capacity` keys (CUB's segmented sort, which
+    /// shares a long list among the threads of a block, where the host sorts a list on one thread).
+    void sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t capacity, const std::uint32_t* begin,
+                    const std::uint32_t* end, std::size_t lists) const {
+        if (capacity == 0 || lists == 0) return;
+        const auto items = static_cast<std::int64_t>(capacity), segments = static_cast<std::int64_t>(lists);
+        std::size_t bytes = 0;
+        cub::DeviceSegmentedSort::SortKeys(nullptr, bytes, keys, sorted, items, segments, begin, end, stream_);
+        temp_.resize_discard(bytes);
+        cuda_check(cub::DeviceSegmentedSort::SortKeys(temp_.data(), bytes, keys, sorted, items, segments, begin, end, stream_),
+                   "segmented sort");
     }
 
     /// @brief *total = the sum of in[0, n), left in device memory.

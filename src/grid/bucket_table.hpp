@@ -3,7 +3,7 @@
 /// @brief The hash table that stores the grid: fixed-capacity buckets, rehash probing on misses,
 /// overflow buckets chained per cell, and a frame stamp so the table never needs clearing. Once
 /// filled, each cell's chain is copied into one contiguous list of entries sorted by id
-/// (compact_cell), which is what queries read.
+/// (gather_cell, a sort, place_entry), which is what queries read.
 ///
 /// A bucket's `state` is stamp*2 while a thread is writing its header and stamp*2+1 once it is ready;
 /// any other stamp means the bucket is empty this frame. Overflow buckets come from a pool after the
@@ -66,7 +66,7 @@ constexpr std::uint32_t grid_id_mask = (1u << grid_id_bits) - 1u;
 /// @brief An id with its start bits, as a bucket stores it.
 KDET_HD inline std::uint32_t tag_starts(std::uint32_t id, std::uint32_t starts) { return id | starts << grid_id_bits; }
 
-/// @brief One id of a compacted cell with what a query filters on: what CompactCells takes for each
+/// @brief One id of a compacted cell with what a query filters on: what place_entry takes for each
 /// id, and what a query's visitor gets for each entry that passes.
 struct GridEntry {
     Aabb box;
@@ -155,6 +155,9 @@ struct GridView {
     BucketHeader* headers;          ///< slot_count main buckets, then overflow_capacity pool buckets
     std::uint32_t* ids;             ///< bucket_capacity ids per bucket
     EntryBlock* entry_blocks;       ///< the compacted cells' lists, [entry_capacity / entry_block rounded up]
+    std::uint32_t* list_keys;       ///< [entry_capacity] the lists' entries as list keys, unsorted, while compacting
+    std::uint32_t* list_begin;      ///< [slot_count] the range of the list of the cell claimed i-th, while compacting
+    std::uint32_t* list_end;
     BlockBoundGroup* block_bounds;  ///< the bound of each block of entries, [blocks / bound_group rounded up]
     OwnCells* own_cells;            ///< [tets] for the pipeline's queries; null where none use them (the table's own tests)
     std::uint32_t* entries_used;
@@ -274,16 +277,27 @@ KDET_HD KDET_ALWAYS_INLINE GridEntry load_entry(const GridView& g, std::uint32_t
     return GridEntry{lane_box(b.lo, b.hi, i), b.id_and_starts[i], b.object[i]};
 }
 
-/// @brief Copies the ids of the cell whose main bucket is `slot` (if it is occupied this frame) into
-/// one list of entries, entry_of(id) each with the id's start bits, sorted by id, and points the main
-/// bucket at it. When the list does not fit, the cell reads as empty and grid_entries_full is set:
-/// the frame reruns with more room.
-template <class EntryOf>
-KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const EntryOf& entry_of) {
-    BucketHeader& main = g.headers[slot];
-    if ((main.state >> 1) != g.stamp) return;
+/// @brief A list entry's sort key: the id above its start bits, so that the keys of a list sort by id
+/// (a tet is in a cell's list once).
+KDET_HD inline std::uint32_t list_key(std::uint32_t tagged) { return (tagged & grid_id_mask) << 3 | tagged >> grid_id_bits; }
+KDET_HD inline std::uint32_t tagged_of_list_key(std::uint32_t key) { return tag_starts(key >> 3, key & 7u); }
+
+/// @brief Compacting, step 1 of 3, for the cell claimed `order`-th this frame (any order at or past
+/// the count of claimed cells holds none): claims room for the cell's ids in the lists, copies them
+/// there as list keys (GridView::list_keys, unsorted), sets the main bucket's objects (object_bit of
+/// object_of(id) of each id), points the main bucket at the list, and records the list's range as list
+/// `order` (empty for none). When the list does not fit, the cell reads as empty and
+/// grid_entries_full is set: the frame reruns with more room. Step 2 sorts each list by id into a
+/// second array (the execution layer's sort_lists: on the GPU many threads share a long list, where
+/// one thread sorting it took milliseconds), step 3 fills each entry's rows from its sorted key
+/// (place_entry).
+template <class ObjectOf>
+KDET_HD inline void gather_cell(const GridView& g, std::uint32_t order, const ObjectOf& object_of) {
+    g.list_begin[order] = g.list_end[order] = 0;
+    if (order >= *g.cells_claimed) return;
+    BucketHeader& main = g.headers[g.claimed_slots[order]];
     std::uint32_t total = 0;
-    for (std::uint32_t b = slot; b != no_bucket; b = g.headers[b].next)
+    for (std::uint32_t b = g.claimed_slots[order]; b != no_bucket; b = g.headers[b].next)
         total += g.headers[b].count < g.bucket_capacity ? g.headers[b].count : g.bucket_capacity;
     const std::uint32_t first = atomic_fetch_add(g.entries_used, total);
     if (first > g.entry_capacity || total > g.entry_capacity - first) {
@@ -293,50 +307,38 @@ KDET_HD inline void compact_cell(const GridView& g, std::uint32_t slot, const En
         main.objects = 0;
         return;
     }
-    const std::uint32_t end = first + total;
-    std::uint32_t k = first;
-    for (std::uint32_t b = slot; b != no_bucket; b = g.headers[b].next) {
+    std::uint32_t k = first, objects = 0;
+    for (std::uint32_t b = g.claimed_slots[order]; b != no_bucket; b = g.headers[b].next) {
         const std::uint32_t n = g.headers[b].count < g.bucket_capacity ? g.headers[b].count : g.bucket_capacity;
         const std::uint32_t* ids = g.ids + static_cast<std::uint64_t>(b) * g.bucket_capacity;
-        for (std::uint32_t i = 0; i < n; ++i) entry_id_and_starts(g, k++) = ids[i];
-    }
-    // The ids alone sorted first, then each entry's box and object filled in beside its id. A Shell
-    // sort: the CPU's threads populate in about id order, so its passes move few ids, but the GPU's
-    // append in arrival order, where a plain insertion sort costs a quarter of the list's length
-    // squared in moves, all made by the one thread of the cell (procedural 100k on an H200: 14.8 ms
-    // in this kernel). Gaps: Ciura's, then times 2.25; only those below half the list are used.
-    constexpr std::uint32_t gaps[] = {1u, 4u, 10u, 23u, 57u, 132u, 301u, 701u, 1577u, 3548u, 7983u, 17961u,
-                                      40412u, 90927u, 204585u, 460316u, 1035711u, 2330349u, 5243285u};
-    int largest = 0;
-    while (largest + 1 < static_cast<int>(sizeof gaps / sizeof gaps[0]) && 2u * gaps[largest + 1] < total) ++largest;
-    for (int pass = largest; pass >= 0; --pass) {
-        const std::uint32_t gap = gaps[pass];
-        for (std::uint32_t i = first + gap; i < end; ++i) {
-            const std::uint32_t tagged = entry_id_and_starts(g, i);
-            std::uint32_t j = i;
-            for (; j >= first + gap && (entry_id_and_starts(g, j - gap) & grid_id_mask) > (tagged & grid_id_mask); j -= gap)
-                entry_id_and_starts(g, j) = entry_id_and_starts(g, j - gap);
-            entry_id_and_starts(g, j) = tagged;
-        }
-    }
-    std::uint32_t objects = 0;
-    for (k = first; k < end; ++k) {
-        EntryBlock& block = g.entry_blocks[k / entry_block];
-        const std::uint32_t i = k % entry_block;
-        const GridEntry e = entry_of(block.id_and_starts[i] & grid_id_mask);
-        set_lane_box(block.lo, block.hi, i, e.box);
-        block.object[i] = e.object;
-        objects |= object_bit(e.object);
-        if (g.own_cells) {
-            // Relaxed atomic: for a tet spanning more than two cells along an axis (which keeps no row)
-            // two cells' compactions may store to the same slot.
-            const std::uint32_t tagged = block.id_and_starts[i];
-            atomic_store_relaxed(&g.own_cells[tagged & grid_id_mask].after[own_cell_index_of(tagged >> grid_id_bits)], k + 1);
+        for (std::uint32_t i = 0; i < n; ++i) {
+            g.list_keys[k++] = list_key(ids[i]);
+            objects |= object_bit(object_of(ids[i] & grid_id_mask));
         }
     }
     main.count = total;
     main.first_entry = first;
     main.objects = objects;
+    g.list_begin[order] = first;
+    g.list_end[order] = first + total;
+}
+
+/// @brief Compacting, step 3 of 3: entry k of the lists (below the entries claimed, in a list that
+/// fitted) from its key in the sorted lists: its id and start bits, and entry_of(id)'s box and
+/// object, in its block's rows, and the position after it in its tet's own cells (OwnCells::after).
+template <class EntryOf>
+KDET_HD inline void place_entry(const GridView& g, const std::uint32_t* sorted_keys, std::uint32_t k, const EntryOf& entry_of) {
+    const std::uint32_t tagged = tagged_of_list_key(sorted_keys[k]);
+    const GridEntry e = entry_of(tagged & grid_id_mask);
+    EntryBlock& block = g.entry_blocks[k / entry_block];
+    const std::uint32_t i = k % entry_block;
+    block.id_and_starts[i] = tagged;
+    set_lane_box(block.lo, block.hi, i, e.box);
+    block.object[i] = e.object;
+    if (g.own_cells)
+        // Relaxed atomic: for a tet spanning more than two cells along an axis (which keeps no row)
+        // two cells' entries may store to the same slot.
+        atomic_store_relaxed(&g.own_cells[tagged & grid_id_mask].after[own_cell_index_of(tagged >> grid_id_bits)], k + 1);
 }
 
 /// @brief The bound of block `block` of the compacted entries (see entry_block), once every list is

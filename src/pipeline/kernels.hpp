@@ -436,23 +436,39 @@ struct PopulateKernel {
     }
 };
 
-/// @brief Stage 2, after populating: one work item per occupied cell, in the order the cells were
-/// claimed (GridView::claimed_slots; the items past the claimed cells do nothing); copies each cell's
-/// ids, with their boxes and objects, into one contiguous list (compact_cell). Cells claimed one after
-/// the other belong to neighbouring tets, so the boxes it gathers and the lists it writes stay close
-/// together in memory, as do the lists a tet's search reads.
-struct CompactCellsKernel {
+/// @brief Stage 2, after populating: one work item per main bucket, the i-th for the cell claimed
+/// i-th (GridView::claimed_slots; the items past the claimed cells record empty lists); copies each
+/// cell's ids into one contiguous list (gather_cell), sorted next by the execution layer. Cells claimed
+/// one after the other belong to neighbouring tets, so the lists it writes stay close together in
+/// memory, as do the lists a tet's search reads.
+struct GatherCellsKernel {
     SceneView scene;
     GridView grid;
+
+    struct ObjectOf {
+        const SceneView* scene;
+        KDET_HD std::uint32_t operator()(std::uint32_t u) const { return scene->tet_object[u]; }
+    };
+
+    KDET_HD void operator()(std::uint64_t i) const { gather_cell(grid, static_cast<std::uint32_t>(i), ObjectOf{&scene}); }
+};
+
+/// @brief Stage 2, after the lists are sorted: one work item per entry of room (those past the
+/// entries claimed do nothing), which fills the entry's rows from its sorted key (place_entry).
+struct PlaceEntriesKernel {
+    SceneView scene;
+    GridView grid;
+    const std::uint32_t* sorted_keys;
 
     struct EntryOf {
         const SceneView* scene;
         KDET_HD GridEntry operator()(std::uint32_t u) const { return GridEntry{scene->info[u].box, u, scene->tet_object[u]}; }
     };
 
-    KDET_HD void operator()(std::uint64_t i) const {
-        if (i >= *grid.cells_claimed) return;
-        compact_cell(grid, grid.claimed_slots[i], EntryOf{&scene});
+    KDET_HD void operator()(std::uint64_t k) const {
+        // A failed grid's lists are partly unwritten; it fills again.
+        if (k >= *grid.entries_used || *grid.failure) return;
+        place_entry(grid, sorted_keys, static_cast<std::uint32_t>(k), EntryOf{&scene});
     }
 };
 

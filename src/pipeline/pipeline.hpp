@@ -141,10 +141,13 @@ public:
                blocks_begin_.capacity_bytes() + block_objects_.capacity_bytes() + exec_.scratch_bytes();
     }
 
-    /// The grid's buffers: the table, the compacted lists and their bounds, the own-layer rows, the claim order.
+    /// The grid's buffers: the table, the compacted lists and their bounds, the own-layer rows, the claim
+    /// order, the lists' keys while compacting.
     std::size_t grid_bytes() const {
         return headers_.capacity_bytes() + ids_.capacity_bytes() + entry_blocks_.capacity_bytes() +
-               block_bounds_.capacity_bytes() + own_cells_.capacity_bytes() + claimed_slots_.capacity_bytes();
+               block_bounds_.capacity_bytes() + own_cells_.capacity_bytes() + claimed_slots_.capacity_bytes() +
+               list_keys_.capacity_bytes() + sorted_keys_.capacity_bytes() + list_begin_.capacity_bytes() +
+               list_end_.capacity_bytes();
     }
 
     std::string device_name() const override { return exec_.device_name(); }
@@ -233,6 +236,10 @@ private:
     buffer<BlockBoundGroup> block_bounds_; ///< the bound of each block of entry_block entries
     buffer<OwnCells> own_cells_; ///< per stored tet, where it sits in its own layer's cells
     buffer<std::uint32_t> claimed_slots_; ///< the main buckets in the order they were claimed
+    buffer<std::uint32_t> list_keys_;     ///< the lists' keys as gathered, then sorted into sorted_keys_
+    buffer<std::uint32_t> sorted_keys_;
+    buffer<std::uint32_t> list_begin_;    ///< the range of each claimed cell's list, for sorting
+    buffer<std::uint32_t> list_end_;
     buffer<FrameCounters> counters_;
     buffer<std::uint64_t> candidates_;
     buffer<std::uint64_t> candidates_grown_; ///< the next candidate buffer while one grows keeping its contents
@@ -364,11 +371,18 @@ GridView Pipeline<Exec>::populate() {
     resize_filled(block_bounds_, (blocks + bound_group - 1) / bound_group, BlockBoundGroup{});
     own_cells_.resize_discard(tets_.size());
     claimed_slots_.resize_discard(slot_count_);
-    const GridView grid{headers_.data(), ids_.data(), entry_blocks_.data(), block_bounds_.data(), own_cells_.data(), &c->grid_entries, entry_capacity_,
+    list_keys_.resize_discard(entry_capacity_);
+    sorted_keys_.resize_discard(entry_capacity_);
+    list_begin_.resize_discard(slot_count_);
+    list_end_.resize_discard(slot_count_);
+    const GridView grid{headers_.data(), ids_.data(), entry_blocks_.data(), list_keys_.data(), list_begin_.data(), list_end_.data(),
+                        block_bounds_.data(), own_cells_.data(), &c->grid_entries, entry_capacity_,
                         &c->overflow_used, &c->grid_failure, &c->cells_claimed, claimed_slots_.data(), slot_count_, slot_bits, capacity,
                         overflow_capacity_, stamp_, 64u, options_.hash};
     exec_.for_each(tets_.size(), PopulateKernel{scene_view(), grid, &c->params});
-    exec_.for_each(slot_count_, CompactCellsKernel{scene_view(), grid});
+    exec_.for_each(slot_count_, GatherCellsKernel{scene_view(), grid});
+    exec_.sort_lists(list_keys_.data(), sorted_keys_.data(), entry_capacity_, list_begin_.data(), list_end_.data(), slot_count_);
+    exec_.for_each(entry_capacity_, PlaceEntriesKernel{scene_view(), grid, sorted_keys_.data()});
     exec_.for_each(blocks, BoundEntryBlocksKernel{grid});
     return grid;
 }
