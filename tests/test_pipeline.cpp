@@ -237,7 +237,7 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
             Pipeline<CpuExec> whole(options);
             Pipeline<GpuShapedExec<3, 1, 1>> by_layers(options);
             Pipeline<GpuShapedExec<1, 8, 256>> by_blocks(options);
-            Pipeline<GpuShapedExec<2, 4, 16>> like_cuda(options); // CudaExec's
+            Pipeline<GpuShapedExec<4, 2, 16>> like_cuda(options); // CudaExec's
             const FrameResult expected = run_pipeline(whole, meshes, self);
             ASSERT_GT(expected.pairs.size(), 20u);
             for (PipelineBase* split : {static_cast<PipelineBase*>(&by_layers), static_cast<PipelineBase*>(&by_blocks),
