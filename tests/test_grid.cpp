@@ -568,17 +568,21 @@ TEST(BucketTable, QueriesVisitExactlyTheEntriesWhoseBoxesOverlapTheirsAndBlocksB
     EXPECT_EQ(everything.ids.size(), 60u);
 }
 
-TEST(BucketTable, AScanVisitsExactlyTheMatchingEntriesOfItsRangeWhereverTheRangeStartsAndEnds) {
-    // One list of 150 entries (19 blocks, three groups of block bounds); entry k is id k, its box x in
-    // [k, k + 0.5]. Ranges starting and ending inside a block, a group or at either edge.
-    constexpr std::uint32_t n = 150;
-    TestTable table(64, 4, 64, 32, HashFunction::djb2);
-    const CellCoord cell{2, 3, 4, 0};
-    for (std::uint32_t i = 0; i < n; ++i) ASSERT_NE(grid_insert(table.view, cell, i, 0u), no_bucket);
-    const auto c = table.compacted(n, [](std::uint32_t id) {
+/// One cell's list of n entries, entry k id k with its box x in [k, k + 0.5] (y and z in [0, 1]).
+TestTable::Compacted list_along_x(TestTable& table, std::uint32_t n) {
+    for (std::uint32_t i = 0; i < n; ++i) EXPECT_NE(grid_insert(table.view, CellCoord{2, 3, 4, 0}, i, 0u), no_bucket);
+    return table.compacted(n, [](std::uint32_t id) {
         const float x = static_cast<float>(id);
         return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
     });
+}
+
+TEST(BucketTable, AScanVisitsExactlyTheMatchingEntriesOfItsRangeWhereverTheRangeStartsAndEnds) {
+    // One list of 150 entries (19 blocks, three groups of block bounds), list_along_x. Ranges starting
+    // and ending inside a block, a group or at either edge.
+    constexpr std::uint32_t n = 150;
+    TestTable table(64, 4, 64, 32, HashFunction::djb2);
+    const auto c = list_along_x(table, n);
     ASSERT_EQ(c.failure, 0u);
     ASSERT_EQ(c.used, n);
     const float windows[][2] = {{-1.0f, 200.0f}, {10.2f, 21.7f}, {60.0f, 75.0f}, {130.6f, 140.4f}, {63.6f, 63.9f}};
@@ -596,19 +600,14 @@ TEST(BucketTable, AScanVisitsExactlyTheMatchingEntriesOfItsRangeWhereverTheRange
 }
 
 TEST(BucketTable, AScanSharedByPartsReadsEachBlockInExactlyOnePart) {
-    // One list of 150 entries (19 blocks, three groups), entry k is id k with its box x in [k, k + 0.5];
-    // the scans of a range by 1, 2, 4 and 8 parts (group_blocks_of_part) together visit what the whole
-    // scan visits, each entry once, and part p only entries of the blocks i of a group with i % parts == p.
+    // One list of 150 entries (19 blocks, three groups), list_along_x; the scans of a range by 1, 2, 4
+    // and 8 parts (group_blocks_of_part) together visit what the whole scan visits, each entry once, and
+    // part p only entries of the blocks i of a group with i % parts == p.
     EXPECT_EQ(group_blocks_of_part(0, 1), all_group_blocks);
     EXPECT_EQ(group_blocks_of_part(1, 4), 0x22u);
     constexpr std::uint32_t n = 150;
     TestTable table(64, 4, 64, 32, HashFunction::djb2);
-    const CellCoord cell{2, 3, 4, 0};
-    for (std::uint32_t i = 0; i < n; ++i) ASSERT_NE(grid_insert(table.view, cell, i, 0u), no_bucket);
-    const auto c = table.compacted(n, [](std::uint32_t id) {
-        const float x = static_cast<float>(id);
-        return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, id};
-    });
+    const auto c = list_along_x(table, n);
     ASSERT_EQ(c.failure, 0u);
     const Aabb query{{10.2f, 0.5f, 0.5f}, {141.7f, 0.6f, 0.6f}};
     for (const auto& [begin, end] : {std::pair{0u, n}, std::pair{5u, 71u}, std::pair{63u, 66u}, std::pair{17u, 140u}}) {
