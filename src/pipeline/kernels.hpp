@@ -641,8 +641,9 @@ struct FindCandidatesKernel {
     KeyAppender out;
     unsigned long long* rejected; ///< pairs the pre-test proved separated
     const ResumePoint* resume_from; ///< null: every item, from the start; else item i resumes resume_from[i]
-    ResumePoint* stopped;           ///< [items] where the items that did not fit stopped
-    std::uint32_t* stopped_count;
+    ResumePoint* stopped;           ///< [stopped_capacity] where the items that did not fit stopped
+    std::uint32_t* stopped_count;   ///< items that stopped, also those past the capacity (not recorded)
+    std::uint32_t stopped_capacity;
     /// Work items per tet (SearchPart): layer_parts x block_parts, item (l * tets + t) * block_parts + b
     /// searching layer part l and block part b of tet t. The block parts of a tet are neighbouring
     /// items, which walk the same cells in step and read neighbouring blocks; the layer parts are far
@@ -701,7 +702,7 @@ struct FindCandidatesKernel {
         // Once a first frame's buffer is full, an item that has not started would only search until
         // its first batch and then search again after the buffer grows: it waits for that at once.
         if (stop_when_full && atomic_load_acquire(out.count) >= out.capacity) {
-            stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{item, already_stored};
+            record_stop(ResumePoint{item, already_stored});
             return;
         }
         KeyBatch batch(&out, already_stored);
@@ -711,10 +712,15 @@ struct FindCandidatesKernel {
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
         batch.flush();
         if (batch.stopped) {
-            stopped[atomic_fetch_add(stopped_count, 1u)] = ResumePoint{item, batch.stored};
+            record_stop(ResumePoint{item, batch.stored});
             return;
         }
         if (emit.rejected) atomic_fetch_add_gathered(rejected, emit.rejected);
+    }
+
+    KDET_HD void record_stop(const ResumePoint& point) const {
+        const std::uint32_t slot = atomic_fetch_add(stopped_count, 1u);
+        if (slot < stopped_capacity) stopped[slot] = point;
     }
 };
 

@@ -243,7 +243,7 @@ private:
     buffer<FrameCounters> counters_;
     buffer<std::uint64_t> candidates_;
     buffer<std::uint64_t> candidates_grown_; ///< the next candidate buffer while one grows keeping its contents
-    buffer<ResumePoint> resume_points_[2];  ///< where tets stopped, read by one run and written by the next
+    buffer<ResumePoint> resume_points_[2];  ///< where search items stopped (one per tet), read by one run and written by the next
     buffer<std::uint64_t> out_keys_;  ///< the colliding pairs; its size is the window they are appended to
     buffer<Contact> out_contacts_;
     buffer<std::uint64_t> blocks_begin_;
@@ -391,8 +391,10 @@ GridView Pipeline<Exec>::populate() {
 /// here (a first frame, to size the pairs' window) does not rerun when the buffer overflows: the
 /// buffer grows keeping what was stored and only the search items (tets, or parts of their searches:
 /// SearchPart) that did not fit search again, each resuming after the keys it had
-/// stored (they stopped searching when they did not fit). Later frames read nothing here; an overflow shows in the
-/// frame's counters and the frame reruns (grow_for). Returns the counters when it read them.
+/// stored (they stopped searching when they did not fit). There is room to resume one item per tet;
+/// when more stop (a first buffer far too small for a split search), every item searches again into
+/// the grown buffer. Later frames read nothing here; an overflow shows in the frame's counters and the
+/// frame reruns (grow_for). Returns the counters when it read them.
 template <class Exec>
 std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
     // Items are numbered in 32 bits (ResumePoint): a scene too large for that searches its tets whole.
@@ -400,8 +402,9 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
     const std::uint32_t layer_parts = split ? Exec::search_layer_parts : 1u;
     const std::uint32_t block_parts = split ? Exec::search_block_parts : 1u;
     const std::size_t parts = std::size_t{layer_parts} * block_parts;
-    for (auto& points : resume_points_) points.resize_discard(tets_.size() * parts);
-    std::size_t items = tets_.size() * parts;
+    const std::size_t all_items = tets_.size() * parts, resume_room = tets_.size();
+    for (auto& points : resume_points_) points.resize_discard(resume_room);
+    std::size_t items = all_items;
     std::size_t first_slot = 0; ///< where this run's keys start in the buffer
     const ResumePoint* resume_from = nullptr;
     for (int run = 0;; ++run) {
@@ -409,7 +412,8 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         ResumePoint* stopped = resume_points_[run % 2].data();
         const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
         exec_.for_each(items, FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected,
-                                                   resume_from, stopped, &c->stopped_items, layer_parts, block_parts,
+                                                   resume_from, stopped, &c->stopped_items,
+                                                   static_cast<std::uint32_t>(resume_room), layer_parts, block_parts,
                                                    !pairs_sized_});
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
@@ -423,16 +427,24 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         const double stored_now = static_cast<double>(kept - std::min(kept, first_slot));
         const double estimate = finished > 0.0 ? 1.25 * stored_now / finished * after.stopped_items : 0.0;
         const std::size_t more = std::max(static_cast<std::size_t>(estimate), kept / 2);
+        const bool resume = after.stopped_items <= resume_room;
         candidates_grown_.resize_discard(kept + more + KeyBatch::size);
-        exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
+        if (resume) exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
         candidates_.swap(candidates_grown_);
         ++regrows_;
-        after.candidates = kept;
-        first_slot = kept;
-        items = after.stopped_items;
+        if (resume) {
+            after.candidates = kept;
+            first_slot = kept;
+            items = after.stopped_items;
+            resume_from = stopped;
+        } else {
+            after.candidates = after.candidate_padding = after.rejected = 0;
+            first_slot = 0;
+            items = all_items;
+            resume_from = nullptr;
+        }
         after.stopped_items = 0;
         exec_.upload(counters_.data(), &after, 1);
-        resume_from = stopped;
     }
 }
 
