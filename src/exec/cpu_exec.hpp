@@ -164,9 +164,10 @@ public:
     void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const;
 
     /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
-    /// sorted ascending (the grid's lists by id); the lists lie within the first `capacity` keys. A
-    /// thread a list, by a Shell sort: the lists are short, and the CPU's threads fill them in about
-    /// ascending order, so its passes move few keys.
+    /// sorted ascending (the grid's lists by id); the lists are disjoint and lie within the first
+    /// `capacity` keys (the GPU's sort needs them to tile a prefix of them as well). A thread a list, by
+    /// a Shell sort: the lists are short, and the CPU's threads fill them in about ascending order, so
+    /// its passes move few keys.
     void sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t capacity, const std::uint32_t* begin,
                     const std::uint32_t* end, std::size_t lists) const;
 

@@ -10,7 +10,6 @@
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
-#include <cub/device/device_segmented_sort.cuh>
 #include <cub/device/device_select.cuh>
 #include <cuda_runtime.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -160,6 +159,25 @@ struct PadKeysKernel {
     }
 };
 
+/// @brief For sort_lists: each key of list i, i < lists, prefixed by the list's start, so that one sort
+/// of all keys leaves each list in its place, sorted.
+struct PrefixListKeysKernel {
+    const std::uint32_t* keys;
+    const std::uint32_t* begin;
+    const std::uint32_t* end;
+    std::uint64_t* prefixed;
+    __device__ void operator()(std::uint64_t i) const {
+        for (std::uint32_t k = begin[i]; k < end[i]; ++k) prefixed[k] = std::uint64_t{begin[i]} << 32 | keys[k];
+    }
+};
+
+/// @brief For sort_lists: the sorted keys without their lists' starts.
+struct LowHalvesKernel {
+    const std::uint64_t* prefixed;
+    std::uint32_t* keys;
+    __device__ void operator()(std::uint64_t k) const { keys[k] = static_cast<std::uint32_t>(prefixed[k]); }
+};
+
 class CudaExec {
 public:
     template <class T>
@@ -236,28 +254,27 @@ public:
     void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
         if (capacity < 2) return;
         for_each(capacity, PadKeysKernel{keys, count});
-        spare_keys_.resize_discard(capacity);
-        cub::DoubleBuffer<std::uint64_t> buffers(keys, spare_keys_.data());
-        std::size_t bytes = 0;
-        cub::DeviceRadixSort::SortKeys(nullptr, bytes, buffers, capacity, 0, bits, stream_);
-        temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, buffers, capacity, 0, bits, stream_),
-                   "radix sort");
-        if (buffers.Current() != keys) copy(keys, buffers.Current(), capacity);
+        radix_sort(keys, capacity, bits);
     }
 
     /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
-    /// sorted ascending; the lists lie within the first `capacity` keys (CUB's segmented sort, which
-    /// shares a long list among the threads of a block, where the host sorts a list on one thread).
+    /// sorted ascending; the lists are disjoint and lie within the first `capacity` keys, and where
+    /// they do not tile a prefix of them `sorted` is left undefined (a grid whose lists did not all
+    /// fit, which fills again). One radix sort of all keys, each prefixed by its list's start: a long
+    /// list is shared among many threads, where one thread sorting it took milliseconds, and nothing
+    /// waits for the host (CUB's segmented sort reads its segment groups' sizes back to the host once
+    /// there are more than a few hundred segments).
     void sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t capacity, const std::uint32_t* begin,
                     const std::uint32_t* end, std::size_t lists) const {
-        if (capacity == 0 || lists == 0) return;
-        const auto items = static_cast<std::int64_t>(capacity), segments = static_cast<std::int64_t>(lists);
-        std::size_t bytes = 0;
-        cub::DeviceSegmentedSort::SortKeys(nullptr, bytes, keys, sorted, items, segments, begin, end, stream_);
-        temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceSegmentedSort::SortKeys(temp_.data(), bytes, keys, sorted, items, segments, begin, end, stream_),
-                   "segmented sort");
+        if (capacity == 0) return;
+        prefixed_keys_.resize_discard(capacity);
+        // Keys outside every list sort last: all ones.
+        cuda_check(cudaMemsetAsync(prefixed_keys_.data(), 0xff, capacity * sizeof(std::uint64_t), stream_), "memset");
+        for_each(lists, PrefixListKeysKernel{keys, begin, end, prefixed_keys_.data()});
+        int start_bits = 1;
+        while (start_bits < 32 && (std::uint64_t{1} << start_bits) <= capacity) ++start_bits;
+        radix_sort(prefixed_keys_.data(), capacity, 32 + start_bits);
+        for_each(capacity, LowHalvesKernel{prefixed_keys_.data(), sorted});
     }
 
     /// @brief *total = the sum of in[0, n), left in device memory.
@@ -355,7 +372,7 @@ public:
 
     /// @brief Bytes of the scratch buffers CUB needs, for memory reports (device memory only).
     std::size_t scratch_bytes() const {
-        return temp_.capacity_bytes() + spare_keys_.capacity_bytes();
+        return temp_.capacity_bytes() + spare_keys_.capacity_bytes() + prefixed_keys_.capacity_bytes();
     }
 
 private:
@@ -372,6 +389,17 @@ private:
         return static_cast<unsigned>(wanted < (1u << 30) ? wanted : (1u << 30));
     }
 
+    /// @brief Sorts n keys ascending by their bits below 2^bits (CUB's radix sort through spare_keys_).
+    void radix_sort(std::uint64_t* keys, std::size_t n, int bits) const {
+        spare_keys_.resize_discard(n);
+        cub::DoubleBuffer<std::uint64_t> buffers(keys, spare_keys_.data());
+        std::size_t bytes = 0;
+        cub::DeviceRadixSort::SortKeys(nullptr, bytes, buffers, n, 0, bits, stream_);
+        temp_.resize_discard(bytes);
+        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, buffers, n, 0, bits, stream_), "radix sort");
+        if (buffers.Current() != keys) copy(keys, buffers.Current(), n);
+    }
+
     void wait_for_stream() const {
         ++host_waits_;
         cuda_check(cudaStreamSynchronize(stream_), "synchronize");
@@ -384,6 +412,7 @@ private:
     mutable std::uint64_t host_waits_ = 0;
     mutable DeviceBuffer<unsigned char> temp_;
     mutable DeviceBuffer<std::uint64_t> spare_keys_;
+    mutable DeviceBuffer<std::uint64_t> prefixed_keys_; ///< sort_lists' keys with their lists' starts
 };
 
 } // namespace kdet
