@@ -46,6 +46,10 @@ for program in "$bundle"/kdet*; do
   ldd "$program" | awk '/=> \//{print $3}' | grep -Ev '/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|libgomp|ld-linux[^/]*)\.so' |
     xargs -r cp -Ln -t "$bundle/lib/"
 done
+# The device tool carries 64 MiB with the working tree: the programs go without their symbols (Nsight
+# Compute names the kernels from the device code); with several older builds, drop what a call does not
+# run (the sort-and-sweep peer, the tests) until `du` below and the tree fit.
+strip "$bundle"/kdet*
 git -C "$repo" log -1 --format='built at commit %H %s' >"$bundle/commit.txt"
 git -C "$repo" status --short --untracked-files=no >>"$bundle/commit.txt"
 tar -C "$data_dir" -cJf "$bundle/models.tar.xz" .
