@@ -5,6 +5,8 @@
 /// Every launch, copy and CUB call goes to the stream of DetectorOptions::cuda_stream (the default
 /// stream when none is given), so a frame runs in order after the caller's own work on that stream.
 
+#include "exec/radix_sort.hpp"
+
 #include <kdet/error.hpp>
 #include <kdet/options.hpp>
 
@@ -254,7 +256,7 @@ public:
     void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
         if (capacity < 2) return;
         for_each(capacity, PadKeysKernel{keys, count});
-        radix_sort(keys, capacity, bits);
+        sort_keys(keys, capacity, bits);
     }
 
     /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
@@ -271,9 +273,8 @@ public:
         // Keys outside every list sort last: all ones.
         cuda_check(cudaMemsetAsync(prefixed_keys_.data(), 0xff, capacity * sizeof(std::uint64_t), stream_), "memset");
         for_each(lists, PrefixListKeysKernel{keys, begin, end, prefixed_keys_.data()});
-        int start_bits = 1;
-        while (start_bits < 32 && (std::uint64_t{1} << start_bits) <= capacity) ++start_bits;
-        radix_sort(prefixed_keys_.data(), capacity, 32 + start_bits);
+        // A list's start is below capacity; the keys outside every list (all ones) still sort last.
+        sort_keys(prefixed_keys_.data(), capacity, high_word_key_bits(capacity));
         for_each(capacity, LowHalvesKernel{prefixed_keys_.data(), sorted});
     }
 
@@ -390,7 +391,7 @@ private:
     }
 
     /// @brief Sorts n keys ascending by their bits below 2^bits (CUB's radix sort through spare_keys_).
-    void radix_sort(std::uint64_t* keys, std::size_t n, int bits) const {
+    void sort_keys(std::uint64_t* keys, std::size_t n, int bits) const {
         spare_keys_.resize_discard(n);
         cub::DoubleBuffer<std::uint64_t> buffers(keys, spare_keys_.data());
         std::size_t bytes = 0;

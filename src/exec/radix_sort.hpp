@@ -1,7 +1,7 @@
 #pragma once
 /// @file radix_sort.hpp
-/// @brief The host's sort of 64-bit keys: the CPU backend's sort stage and the storage order of
-/// add_object use it.
+/// @brief The host's sort of 64-bit keys (the CPU backend's sort stage and the storage order of
+/// add_object use it), and the bits a sort of keys with a value in their high word must look at.
 
 #include <cstddef>
 #include <cstdint>
@@ -12,5 +12,13 @@ namespace kdet {
 /// a pass, a pass skipped where every key has the same digit; `scratch` holds n keys. Up to `threads`
 /// threads count and move a slice of the keys each. Small inputs go to std::sort.
 void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch, int threads);
+
+/// @brief Bits of a key whose high word (from bit 32 on) holds a value below `high_values`: every such
+/// key is below 2^bits, so a radix sort can stop there.
+inline int high_word_key_bits(std::uint64_t high_values) {
+    int bits = 32;
+    for (std::uint64_t largest = high_values ? high_values - 1 : 0; largest; largest >>= 1) ++bits;
+    return bits;
+}
 
 } // namespace kdet

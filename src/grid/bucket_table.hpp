@@ -394,8 +394,8 @@ KDET_HD KDET_ALWAYS_INLINE std::uint64_t bit_range(std::uint32_t first, std::uin
     return (~0ull << first) & (~0ull >> (64u - end));
 }
 
-/// @brief Index of the lowest set bit of a non-zero 64-bit mask.
-KDET_HD inline std::uint32_t lowest_bit64(std::uint64_t mask) {
+/// @brief Index of the lowest set bit of a non-zero mask, of 64 bits or (below) of 32.
+KDET_HD inline std::uint32_t lowest_bit(std::uint64_t mask) {
 #if defined(__CUDA_ARCH__)
     return static_cast<std::uint32_t>(__ffsll(static_cast<long long>(mask)) - 1);
 #else
@@ -403,7 +403,6 @@ KDET_HD inline std::uint32_t lowest_bit64(std::uint64_t mask) {
 #endif
 }
 
-/// @brief Index of the lowest set bit of a non-zero mask.
 KDET_HD inline std::uint32_t lowest_bit(std::uint32_t mask) {
 #if defined(__CUDA_ARCH__)
     return static_cast<std::uint32_t>(__ffs(static_cast<int>(mask)) - 1);
@@ -460,7 +459,7 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
         const std::uint32_t entries_in_range = end - base < group_entries ? end - base : group_entries;
         matches &= bit_range(entries_before, entries_in_range);
         while (matches) {
-            visit(load_entry(g, base + lowest_bit64(matches)));
+            visit(load_entry(g, base + lowest_bit(matches)));
             matches &= matches - 1ull;
         }
     }

@@ -6,6 +6,7 @@
 #include "geometry/enclosing_sphere.hpp"
 #include "geometry/face_planes.hpp"
 #include "geometry/tet_intersect.hpp"
+#include "exec/radix_sort.hpp"
 #include "grid/bucket_table.hpp"
 
 #include <kdet/results.hpp>
@@ -93,13 +94,8 @@ KDET_HD inline std::uint64_t proven_pair_key(std::uint32_t t, std::uint32_t u) {
     const std::uint32_t lo = t < u ? t : u, hi = t < u ? u : t;
     return (static_cast<std::uint64_t>(hi) << 32) | lo;
 }
-/// @brief Bits a pair key of tet ids below tet_count needs: the lower id fills the high word from bit 32
-/// on, so every key is below 2^(32 + bits of the largest id) and a radix sort can stop there.
-inline int pair_key_bits(std::uint32_t tet_count) {
-    int bits = 32;
-    for (std::uint32_t largest = tet_count ? tet_count - 1 : 0; largest; largest >>= 1) ++bits;
-    return bits;
-}
+/// @brief Bits a pair key of tet ids below tet_count needs: the lower id fills the high word.
+inline int pair_key_bits(std::uint32_t tet_count) { return high_word_key_bits(tet_count); }
 KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
 KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
 
