@@ -205,7 +205,7 @@ struct GpuShapedExec : CpuExec {
 };
 
 /// One frame of `pipeline` over `meshes`, every object against the others and, with `self`, itself;
-/// the tets stored in spatial order as Detector stores them (SceneTopology::add_object).
+/// the tets and vertices stored in spatial order as Detector stores them (SceneTopology::add_object).
 FrameResult run_pipeline(PipelineBase& pipeline, const std::vector<TetMesh>& meshes, bool self) {
     SceneTopology topology;
     std::vector<vec3> positions;
@@ -214,13 +214,15 @@ FrameResult run_pipeline(PipelineBase& pipeline, const std::vector<TetMesh>& mes
         for (std::size_t v = 0; v < mesh.num_vertices(); ++v)
             positions.push_back(vec3{static_cast<float>(mesh.positions[3 * v]), static_cast<float>(mesh.positions[3 * v + 1]),
                                      static_cast<float>(mesh.positions[3 * v + 2])});
-        topology.add_object(first_vertex, positions.data() + first_vertex, mesh.tets.data(), mesh.num_tets());
+        topology.add_object(positions.data() + first_vertex, static_cast<std::uint32_t>(mesh.num_vertices()), mesh.tets.data(),
+                            mesh.num_tets());
     }
-    topology.vertex_count = static_cast<std::uint32_t>(positions.size());
     pipeline.set_topology(topology);
+    std::vector<vec3> stored(positions.size());
+    topology.to_stored_order(0, topology.vertex_count, positions.data(), stored.data());
     std::vector<std::uint8_t> pair_enabled(meshes.size() * meshes.size(), 1);
     for (std::size_t o = 0; o < meshes.size(); ++o) pair_enabled[o * meshes.size() + o] = self ? 1 : 0;
-    pipeline.start({PositionUpload{0, positions.data(), topology.vertex_count}}, {}, pair_enabled);
+    pipeline.start({PositionUpload{0, stored.data(), topology.vertex_count}}, {}, pair_enabled);
     FrameResult result;
     EXPECT_EQ(pipeline.finish(result), no_vertex);
     return result;

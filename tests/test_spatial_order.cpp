@@ -3,6 +3,7 @@
 #include "test_support.hpp"
 
 #include "geometry/tet_intersect.hpp"
+#include "pipeline/pipeline_base.hpp"
 #include "pipeline/spatial_order.hpp"
 
 #include <kdet/detector.hpp>
@@ -125,6 +126,110 @@ TEST(SpatialOrder, PairsFlagsAndContactsUseTheCallersNumbering) {
             EXPECT_EQ(device.pair_keys[k], (std::uint64_t{expected[k].tet_a} << 32) |
                                                (detector.first_tet(1) + expected[k].tet_b));
     }
+}
+
+/// `mesh` with its vertices listed in shuffled order and `unused` more vertices that no tet uses.
+TetMesh with_shuffled_vertices(const TetMesh& mesh, unsigned seed, std::size_t unused) {
+    std::vector<std::uint32_t> new_id(mesh.num_vertices() + unused);
+    std::iota(new_id.begin(), new_id.end(), 0u);
+    std::shuffle(new_id.begin(), new_id.end(), std::mt19937(seed));
+    TetMesh out;
+    out.positions.resize(3 * new_id.size(), 1e6);
+    for (std::size_t v = 0; v < mesh.num_vertices(); ++v)
+        for (int c = 0; c < 3; ++c) out.positions[3 * new_id[v] + c] = mesh.positions[3 * v + c];
+    for (const std::uint32_t v : mesh.tets) out.tets.push_back(new_id[v]);
+    return out;
+}
+
+TEST(SpatialOrder, VerticesAreStoredInTheOrderTheStoredTetsFirstUseThemUnusedOnesLast) {
+    const TetMesh first = test::random_soup(30, 1.0, 1.0, 83);
+    const TetMesh mesh = with_shuffled_vertices(test::load_model("octopus-low.mesh"), 84, 5);
+    SceneTopology topology;
+    for (const TetMesh* m : {&first, &mesh}) {
+        std::vector<vec3> positions(m->num_vertices());
+        for (std::size_t v = 0; v < positions.size(); ++v)
+            positions[v] = make_vec3(static_cast<float>(m->positions[3 * v]), static_cast<float>(m->positions[3 * v + 1]),
+                                     static_cast<float>(m->positions[3 * v + 2]));
+        topology.add_object(positions.data(), static_cast<std::uint32_t>(positions.size()), m->tets.data(), m->num_tets());
+    }
+    const std::uint32_t base = static_cast<std::uint32_t>(first.num_vertices());
+    ASSERT_EQ(topology.vertex_count, base + mesh.num_vertices());
+    ASSERT_EQ(topology.vertex_user_id.size(), topology.vertex_count);
+    // Each object's vertices keep its range of ids, each id once.
+    std::vector<std::uint32_t> ids(topology.vertex_user_id.begin() + base, topology.vertex_user_id.end());
+    std::sort(ids.begin(), ids.end());
+    for (std::uint32_t k = 0; k < ids.size(); ++k) ASSERT_EQ(ids[k], base + k);
+    // The stored tets are the caller's, through both numberings; stored ids appear in increasing order.
+    std::uint32_t next_new = base;
+    for (std::uint32_t t = topology.object_tet_begin[1]; t < topology.object_tet_begin[2]; ++t) {
+        const std::uint32_t user_tet = topology.tet_user_id[t] - topology.object_tet_begin[1];
+        for (int k = 0; k < 4; ++k) {
+            const std::uint32_t stored = topology.tets[t].v[k];
+            EXPECT_EQ(topology.vertex_user_id[stored], base + mesh.tets[4 * user_tet + k]);
+            ASSERT_LE(stored, next_new);
+            if (stored == next_new) ++next_new;
+        }
+    }
+    // Only the five vertices no tet uses come after the used ones.
+    EXPECT_EQ(next_new, topology.vertex_count - 5);
+    std::vector<vec3> caller(mesh.num_vertices()), stored(mesh.num_vertices());
+    for (std::uint32_t v = 0; v < caller.size(); ++v) caller[v] = make_vec3(static_cast<float>(v), 0.0f, 0.0f);
+    topology.to_stored_order(base, static_cast<std::uint32_t>(caller.size()), caller.data(), stored.data());
+    for (std::uint32_t v = 0; v < stored.size(); ++v)
+        EXPECT_EQ(stored[v].x, static_cast<float>(topology.vertex_user_id[base + v] - base));
+}
+
+std::vector<IndexPair> pairs_between(const FrameResult& r, ObjectId a, ObjectId b) {
+    std::vector<IndexPair> got;
+    for (const TetPair& p : r.pairs)
+        if (p.object_a == a && p.object_b == b) got.emplace_back(p.tet_a, p.tet_b);
+    return got;
+}
+
+TEST(SpatialOrder, ResultsDoNotDependOnHowTheCallerNumbersTheVertices) {
+    // The same tets with their vertices listed in another order (and a few unused): the same pairs,
+    // whether positions come with the object, from set_positions or from set_positions_on_device.
+    // One object of two overlapping copies of a model, so that it collides with itself.
+    const TetMesh octopus = test::load_model("octopus-low.mesh");
+    const TetMesh copy = test::moved(octopus, 0.2, 0.3 * test::extent_of(octopus), 0.0, 0.0);
+    TetMesh model = octopus;
+    model.positions.insert(model.positions.end(), copy.positions.begin(), copy.positions.end());
+    for (const std::uint32_t v : copy.tets) model.tets.push_back(static_cast<std::uint32_t>(octopus.num_vertices()) + v);
+    const TetMesh shuffled = with_shuffled_vertices(model, 85, 3);
+    const auto moved_pair = [](const TetMesh& m, double dx) { return test::moved(m, 0.3, dx, 0.02, 0.0); };
+    // The moved model, listed as `shuffled` is (the same seed shuffles alike).
+    const auto moved_shuffled = [&](double dx) { return with_shuffled_vertices(moved_pair(model, dx), 85, 3); };
+    const auto xyz = [](const TetMesh& m) { return std::vector<float>(m.positions.begin(), m.positions.end()); };
+    const double shift = 0.5 * test::extent_of(model);
+    DetectorOptions brute;
+    brute.method = Method::brute_force_loop;
+    const auto expected_at = [&](double dx) { return collide(model, moved_pair(model, dx), brute); };
+
+    Detector detector;
+    detector.set_self_collision(detector.add_object(shuffled), true);
+    const ObjectId moving = detector.add_object(moved_shuffled(shift));
+    const std::vector<IndexPair> self_expected = collide_self(model, brute);
+    ASSERT_FALSE(self_expected.empty());
+    const auto check = [&](double dx, const char* how) {
+        const FrameResult& r = detector.detect();
+        const std::vector<IndexPair> expected = expected_at(dx);
+        ASSERT_FALSE(expected.empty()) << how;
+        EXPECT_EQ(pairs_between(r, 0, moving), expected) << how;
+        EXPECT_EQ(pairs_between(r, 0, 0), self_expected) << how;
+    };
+    check(shift, "added");
+    detector.set_positions(moving, moved_shuffled(0.6 * shift).positions.data(), shuffled.num_vertices());
+    check(0.6 * shift, "set_positions");
+    const std::vector<float> on_device = xyz(moved_shuffled(0.4 * shift));
+    detector.set_positions_on_device(moving, on_device.data(), shuffled.num_vertices());
+    check(0.4 * shift, "set_positions_on_device");
+    // Positions only the backend holds, staged or current, survive a rebuild for a new object.
+    detector.add_object(test::random_soup(5, 1.0, 0.0, 86));
+    check(0.4 * shift, "current on the device, then an object added");
+    const std::vector<float> staged = xyz(moved_shuffled(0.7 * shift));
+    detector.set_positions_on_device(moving, staged.data(), shuffled.num_vertices());
+    detector.add_object(test::random_soup(5, 1.0, 0.0, 87));
+    check(0.7 * shift, "staged on the device, then an object added");
 }
 
 TEST(Detector, AFailedAddLeavesTheDetectorAsItWas) {

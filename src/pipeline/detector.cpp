@@ -17,7 +17,7 @@ struct Detector::Impl {
     std::vector<std::uint32_t> object_vertex_begin{0};
     std::vector<std::uint8_t> pair_enabled; // [objects * objects]
     bool topology_changed = false;
-    std::vector<vec3> positions;            // host copy, float32 as the pipeline stores them
+    std::vector<vec3> positions;            // host copy, float32 and in the order the pipeline stores them
     std::vector<std::uint8_t> positions_dirty; // per object: changed since the last upload
     // Per object: positions were last given on the device, so only the pipeline holds them.
     std::vector<std::uint8_t> positions_on_device;
@@ -38,11 +38,15 @@ struct Detector::Impl {
             const std::uint32_t first = object_vertex_begin[o], count = object_vertex_begin[o + 1] - first;
             vec3* held = positions.data() + first;
             if (positions_staged[o]) {
-                pipeline->get_positions(first, held, count, true);
-                const std::uint32_t bad = first_non_finite(held, count);
+                // Staged in the caller's order; the host copy keeps the pipeline's.
+                std::vector<vec3> staged(count);
+                pipeline->get_positions(first, staged.data(), count, true);
+                const std::uint32_t bad = first_non_finite(staged.data(), count);
                 if (bad != no_vertex) {
                     rejected = non_finite_message(o, bad);
                     pipeline->get_positions(first, held, count, false);
+                } else {
+                    topology.to_stored_order(first, count, staged.data(), held);
                 }
             } else {
                 pipeline->get_positions(first, held, count, false);
@@ -97,7 +101,7 @@ struct Detector::Impl {
             throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
                         " vertices, expected " + std::to_string(expected));
         const std::vector<vec3> converted = to_float_positions(object, xyz, vertex_count);
-        std::copy(converted.begin(), converted.end(), positions.begin() + first);
+        topology.to_stored_order(first, static_cast<std::uint32_t>(vertex_count), converted.data(), positions.data() + first);
         positions_dirty[object] = 1;
         positions_on_device[object] = positions_staged[object] = 0;
     }
@@ -122,10 +126,11 @@ struct Detector::Impl {
 
         // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
-        topology.add_object(base, converted.data(), tets, tet_count);
-        object_vertex_begin.push_back(base + static_cast<std::uint32_t>(vertex_count));
-        topology.vertex_count = object_vertex_begin.back();
-        positions.insert(positions.end(), converted.begin(), converted.end());
+        const auto count = static_cast<std::uint32_t>(vertex_count);
+        topology.add_object(converted.data(), count, tets, tet_count);
+        object_vertex_begin.push_back(base + count);
+        positions.resize(topology.vertex_count);
+        topology.to_stored_order(base, count, converted.data(), positions.data() + base);
         positions_dirty.push_back(1);
         positions_on_device.push_back(0);
         positions_staged.push_back(0);

@@ -918,7 +918,7 @@ constexpr std::uint32_t no_vertex = 0xffffffffu;
 /// @brief Finds the lowest vertex with a non-finite coordinate among positions handed over in the
 /// backend's memory (staged from vertex `first` on); `found` is global and starts at no_vertex.
 struct FiniteCheckKernel {
-    const vec3* staged; ///< indexed by global vertex
+    const vec3* staged; ///< indexed by the caller's global vertex id
     std::uint32_t first;
     std::uint32_t* found;
     KDET_HD void operator()(std::uint64_t i) const {
@@ -932,13 +932,15 @@ struct FiniteCheckKernel {
 /// @brief Makes staged positions current, once FiniteCheckKernel found none of them bad; otherwise
 /// the previous positions stay and the frame's end reports the bad vertex.
 struct AdoptPositionsKernel {
-    const vec3* staged; ///< indexed by global vertex
-    vec3* positions;
+    const vec3* staged;                  ///< indexed by the caller's global vertex id
+    const std::uint32_t* vertex_user_id; ///< [vertices] SceneTopology's
+    vec3* positions;                     ///< indexed by stored vertex
     std::uint32_t first;
     const std::uint32_t* non_finite_vertex;
     KDET_HD void operator()(std::uint64_t i) const {
         if (*non_finite_vertex != no_vertex) return;
-        positions[first + i] = staged[first + i];
+        const std::uint32_t v = first + static_cast<std::uint32_t>(i);
+        positions[v] = staged[vertex_user_id[v]];
     }
 };
 

@@ -92,6 +92,8 @@ public:
         object_tet_begin_.resize_discard(topology.object_tet_begin.size());
         exec_.upload(object_tet_begin_.data(), topology.object_tet_begin.data(), topology.object_tet_begin.size());
         positions_.resize_discard(topology.vertex_count);
+        vertex_user_id_.resize_discard(topology.vertex_count);
+        exec_.upload(vertex_user_id_.data(), topology.vertex_user_id.data(), topology.vertex_count);
         info_.resize_discard(tets);
         planes_.resize_discard(tets);
         colliding_.resize_discard(tets);
@@ -131,7 +133,8 @@ public:
 
     std::size_t memory_bytes() const override {
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
-               user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() + staged_positions_.capacity_bytes() +
+               user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() + vertex_user_id_.capacity_bytes() +
+               staged_positions_.capacity_bytes() +
                info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
@@ -218,7 +221,8 @@ private:
     buffer<std::uint32_t> object_tet_begin_;
     buffer<std::uint32_t> user_id_;   ///< stored tet -> caller's global id
     buffer<std::uint32_t> stored_id_; ///< caller's global id -> stored tet
-    buffer<vec3> positions_;
+    buffer<vec3> positions_;          ///< in stored order (SceneTopology::vertex_user_id)
+    buffer<std::uint32_t> vertex_user_id_;
     buffer<vec3> staged_positions_; ///< handed over on the device, current once a frame found them finite
     buffer<TetInfo> info_;
     buffer<TetPlanes> planes_;
@@ -642,7 +646,7 @@ void Pipeline<Exec>::adopt_staged_positions() {
     for (const VertexRange& r : staged_)
         exec_.for_each(r.count, FiniteCheckKernel{staged_positions_.data(), r.first, verdict});
     for (const VertexRange& r : staged_)
-        exec_.for_each(r.count, AdoptPositionsKernel{staged_positions_.data(), positions_.data(), r.first, verdict});
+        exec_.for_each(r.count, AdoptPositionsKernel{staged_positions_.data(), vertex_user_id_.data(), positions_.data(), r.first, verdict});
 }
 
 /// @brief After a frame: grows what was too small for it and says from which stage it must run

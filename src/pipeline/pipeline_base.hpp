@@ -14,21 +14,35 @@ namespace kdet {
 
 /// @brief Objects as the pipeline sees them: concatenated, with per-object tet ranges.
 struct SceneTopology {
-    std::vector<TetIndices> tets;               ///< global vertex ids
+    std::vector<TetIndices> tets;               ///< stored vertex ids
     std::vector<std::uint32_t> tet_object;
     std::vector<std::uint32_t> object_tet_begin; ///< [objects + 1]
     /// [tets] the caller's global id of each stored tet: tets are stored in spatial order
     /// (spatial_order.hpp) and reported under the caller's numbering.
     std::vector<std::uint32_t> tet_user_id;
+    /// [vertex_count] the caller's global id of each stored vertex. An object's vertices keep its range
+    /// of ids and are stored in the order its stored tets first use them (vertices no tet uses last), so
+    /// that a stage reading the tets one after the other reads their positions one after the other too:
+    /// a mesh or soup whose vertices are listed in no spatial order had every tet's first vertex load
+    /// miss the caches.
+    std::vector<std::uint32_t> vertex_user_id;
     std::uint32_t vertex_count = 0;
 
-    /// @brief Appends an object: its `tet_count` tets (four vertex indices each, into its own
-    /// `positions`) stored in spatial order, its vertices numbered from `first_vertex` on. The
-    /// caller keeps vertex_count.
-    void add_object(std::uint32_t first_vertex, const vec3* positions, const std::uint32_t* tets, std::size_t tet_count);
+    /// @brief Appends an object: its `vertex_count` vertices at `positions` and its `tet_count` tets (four
+    /// vertex indices each, into `positions`), stored in spatial order, its vertices numbered on from
+    /// the vertices stored so far.
+    void add_object(const vec3* positions, std::uint32_t vertex_count, const std::uint32_t* tets, std::size_t tet_count);
+
+    /// @brief `count` positions of the vertices from global id `first` on (one object's or a range of
+    /// them), given in the caller's order, written in the order the pipeline stores them (`stored`,
+    /// also indexed from `first`).
+    void to_stored_order(std::uint32_t first, std::uint32_t count, const vec3* caller_order, vec3* stored) const {
+        for (std::uint32_t v = first; v < first + count; ++v) stored[v - first] = caller_order[vertex_user_id[v] - first];
+    }
 };
 
-/// @brief Positions of `count` vertices from global vertex `first` on, copied in at the start of a frame.
+/// @brief Positions of `count` vertices from global vertex `first` on, in stored order
+/// (SceneTopology::to_stored_order), copied in at the start of a frame.
 struct PositionUpload {
     std::uint32_t first;
     const vec3* positions;
@@ -51,7 +65,8 @@ public:
     /// checked that they are finite, so rejected positions never become current.
     virtual void stage_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
     /// @brief Copies `count` positions starting at global vertex `first` back to the host: the current
-    /// ones, or with `staged` those stage_positions() copied and no frame has adopted yet.
+    /// ones, in stored order, or with `staged` those stage_positions() copied (in the caller's order)
+    /// and no frame has adopted yet.
     virtual void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count, bool staged) = 0;
     /// @brief Enqueues one detection, after copying in the positions that changed on the host (counted
     /// in its total time) and adopting the `staged` ranges if all of them are finite; pair_enabled is

@@ -38,18 +38,32 @@ std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::u
     return order;
 }
 
-void SceneTopology::add_object(std::uint32_t first_vertex, const vec3* positions, const std::uint32_t* object_tets,
+void SceneTopology::add_object(const vec3* positions, std::uint32_t object_vertex_count, const std::uint32_t* object_tets,
                                std::size_t tet_count) {
     if (object_tet_begin.empty()) object_tet_begin.push_back(0);
     const auto object = static_cast<std::uint32_t>(object_tet_begin.size() - 1);
     const auto first_tet = static_cast<std::uint32_t>(tets.size());
+    const std::uint32_t first_vertex = vertex_count;
+    constexpr std::uint32_t unnumbered = 0xffffffffu;
+    std::vector<std::uint32_t> stored_vertex(object_vertex_count, unnumbered);
+    vertex_user_id.resize(first_vertex + std::size_t{object_vertex_count});
+    std::uint32_t numbered = 0;
+    const auto number = [&](std::uint32_t v) {
+        if (stored_vertex[v] == unnumbered) {
+            stored_vertex[v] = numbered;
+            vertex_user_id[first_vertex + numbered++] = first_vertex + v;
+        }
+        return first_vertex + stored_vertex[v];
+    };
     for (const std::uint32_t t : spatial_tet_order(positions, object_tets, tet_count)) {
         TetIndices tet;
-        for (int k = 0; k < 4; ++k) tet.v[k] = first_vertex + object_tets[4 * t + k];
+        for (int k = 0; k < 4; ++k) tet.v[k] = number(object_tets[4 * t + k]);
         tets.push_back(tet);
         tet_object.push_back(object);
         tet_user_id.push_back(first_tet + t);
     }
+    for (std::uint32_t v = 0; v < object_vertex_count; ++v) number(v);
+    vertex_count = first_vertex + object_vertex_count;
     object_tet_begin.push_back(static_cast<std::uint32_t>(tets.size()));
 }
 
