@@ -55,11 +55,22 @@ void SceneTopology::add_object(const vec3* positions, std::uint32_t object_verte
         }
         return first_vertex + stored_vertex[v];
     };
-    for (const std::uint32_t t : spatial_tet_order(positions, object_tets, tet_count)) {
+    const std::vector<std::uint32_t> order = spatial_tet_order(positions, object_tets, tet_count);
+    tets.reserve(tets.size() + tet_count);
+    tet_object.resize(tet_object.size() + tet_count, object);
+    tet_user_id.reserve(tet_user_id.size() + tet_count);
+    // The caller's tets are read in the stored order, so at random: each tet's row, and then its
+    // vertices' entries, are fetched a few tets ahead (a mesh listed in no spatial order took three
+    // times as long without).
+    constexpr std::size_t rows_ahead = 16, vertices_ahead = 8;
+    for (std::size_t i = 0; i < tet_count; ++i) {
+        if (i + rows_ahead < tet_count) __builtin_prefetch(object_tets + 4 * std::size_t{order[i + rows_ahead]});
+        if (i + vertices_ahead < tet_count)
+            for (int k = 0; k < 4; ++k) __builtin_prefetch(&stored_vertex[object_tets[4 * std::size_t{order[i + vertices_ahead]} + k]]);
+        const std::uint32_t t = order[i];
         TetIndices tet;
-        for (int k = 0; k < 4; ++k) tet.v[k] = number(object_tets[4 * t + k]);
+        for (int k = 0; k < 4; ++k) tet.v[k] = number(object_tets[4 * std::size_t{t} + k]);
         tets.push_back(tet);
-        tet_object.push_back(object);
         tet_user_id.push_back(first_tet + t);
     }
     for (std::uint32_t v = 0; v < object_vertex_count; ++v) number(v);
