@@ -77,20 +77,16 @@ struct Detector::Impl {
                         " objects)");
     }
 
-    /// Converts one object's coordinates to the float32 the pipeline stores, rejecting non-finite ones.
+    /// Rejects coordinates that are not finite as the float32 the pipeline stores.
     template <class Scalar>
-    static std::vector<vec3> to_float_positions(std::size_t object, const Scalar* xyz, std::size_t vertex_count) {
-        std::vector<vec3> converted(vertex_count);
+    static void check_finite(std::size_t object, const Scalar* xyz, std::size_t vertex_count) {
         for (std::size_t v = 0; v < vertex_count; ++v) {
-            const auto x = static_cast<float>(xyz[3 * v]), y = static_cast<float>(xyz[3 * v + 1]),
-                       z = static_cast<float>(xyz[3 * v + 2]);
+            const vec3 p = to_float(xyz + 3 * v);
             // Out-of-range doubles become infinite floats, so this also catches values beyond float range.
-            if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
                 throw Error("object " + std::to_string(object) + ": vertex " + std::to_string(v) +
                             " has a non-finite coordinate (or one beyond float range)");
-            converted[v] = vec3{x, y, z};
         }
-        return converted;
     }
 
     template <class Scalar>
@@ -100,8 +96,10 @@ struct Detector::Impl {
         if (vertex_count != expected)
             throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
                         " vertices, expected " + std::to_string(expected));
-        const std::vector<vec3> converted = to_float_positions(object, xyz, vertex_count);
-        topology.to_stored_order(first, static_cast<std::uint32_t>(vertex_count), converted.data(), positions.data() + first);
+        // Checked first, converted into place second: a simulation sets positions every frame, and a
+        // converted copy allocated each time cost a fresh (page-faulted) buffer per frame.
+        check_finite(object, xyz, vertex_count);
+        topology.to_stored_order(first, static_cast<std::uint32_t>(vertex_count), xyz, positions.data() + first);
         positions_dirty[object] = 1;
         positions_on_device[object] = positions_staged[object] = 0;
     }
@@ -122,7 +120,9 @@ struct Detector::Impl {
                     throw Error("object " + std::to_string(id) + ": tet " + std::to_string(t) + " has vertex index " +
                                 std::to_string(tets[4 * t + k]) + " out of range [0, " +
                                 std::to_string(vertex_count) + ")");
-        const std::vector<vec3> converted = to_float_positions(id, xyz, vertex_count);
+        check_finite(id, xyz, vertex_count);
+        std::vector<vec3> converted(vertex_count);
+        for (std::size_t v = 0; v < vertex_count; ++v) converted[v] = to_float(xyz + 3 * v);
 
         // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
@@ -130,7 +130,7 @@ struct Detector::Impl {
         topology.add_object(converted.data(), count, tets, tet_count);
         object_vertex_begin.push_back(base + count);
         positions.resize(topology.vertex_count);
-        topology.to_stored_order(base, count, converted.data(), positions.data() + base);
+        topology.to_stored_order(base, count, xyz, positions.data() + base);
         positions_dirty.push_back(1);
         positions_on_device.push_back(0);
         positions_staged.push_back(0);

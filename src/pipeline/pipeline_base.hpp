@@ -12,6 +12,12 @@
 
 namespace kdet {
 
+/// @brief The float32 point of the coordinates x y z at `xyz` (float or double).
+template <class Scalar>
+inline vec3 to_float(const Scalar* xyz) {
+    return vec3{static_cast<float>(xyz[0]), static_cast<float>(xyz[1]), static_cast<float>(xyz[2])};
+}
+
 /// @brief Objects as the pipeline sees them: concatenated, with per-object tet ranges.
 struct SceneTopology {
     std::vector<TetIndices> tets;               ///< stored vertex ids
@@ -34,15 +40,20 @@ struct SceneTopology {
     void add_object(const vec3* positions, std::uint32_t vertex_count, const std::uint32_t* tets, std::size_t tet_count);
 
     /// @brief `count` positions of the vertices from global id `first` on (one object's or a range of
-    /// them), given in the caller's order, written in the order the pipeline stores them (`stored`,
-    /// also indexed from `first`).
-    void to_stored_order(std::uint32_t first, std::uint32_t count, const vec3* caller_order, vec3* stored) const {
+    /// them), given in the caller's order as x y z each (`xyz`, float or double), written in the order
+    /// the pipeline stores them as float32 (`stored`, also indexed from `first`).
+    template <class Scalar>
+    void to_stored_order(std::uint32_t first, std::uint32_t count, const Scalar* xyz, vec3* stored) const {
         // Read at random where the caller's order is not spatial: fetched a few vertices ahead.
         constexpr std::uint32_t ahead = 16;
         for (std::uint32_t v = first; v < first + count; ++v) {
-            if (v + ahead < first + count) __builtin_prefetch(caller_order + (vertex_user_id[v + ahead] - first));
-            stored[v - first] = caller_order[vertex_user_id[v] - first];
+            if (v + ahead < first + count) __builtin_prefetch(xyz + 3 * std::size_t{vertex_user_id[v + ahead] - first});
+            stored[v - first] = to_float(xyz + 3 * std::size_t{vertex_user_id[v] - first});
         }
+    }
+    void to_stored_order(std::uint32_t first, std::uint32_t count, const vec3* caller_order, vec3* stored) const {
+        static_assert(sizeof(vec3) == 3 * sizeof(float), "a vec3 is its three coordinates");
+        to_stored_order(first, count, reinterpret_cast<const float*>(caller_order), stored);
     }
 };
 
