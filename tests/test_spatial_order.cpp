@@ -62,6 +62,17 @@ TEST(SpatialOrder, IsAPermutationThatKeepsNeighboursTogether) {
     EXPECT_LT(mean_step(centroid, order), 1.6);
 }
 
+TEST(SpatialOrder, IsTheSameOnAnyNumberOfThreads) {
+    const TetMesh mesh = shuffled_block(42, 5); // 74,088 tets: enough for the threaded passes
+    std::vector<vec3> positions;
+    for (std::size_t v = 0; v < mesh.num_vertices(); ++v)
+        positions.push_back(make_vec3(static_cast<float>(mesh.positions[3 * v]), static_cast<float>(mesh.positions[3 * v + 1]),
+                                      static_cast<float>(mesh.positions[3 * v + 2])));
+    const std::vector<std::uint32_t> one = spatial_tet_order(positions.data(), mesh.tets.data(), mesh.num_tets(), 1);
+    EXPECT_EQ(spatial_tet_order(positions.data(), mesh.tets.data(), mesh.num_tets(), 2), one);
+    EXPECT_EQ(spatial_tet_order(positions.data(), mesh.tets.data(), mesh.num_tets(), 3), one);
+}
+
 TEST(SpatialOrder, HandlesEmptyAndFlatInput) {
     EXPECT_TRUE(spatial_tet_order(nullptr, nullptr, 0).empty());
     const std::vector<vec3> same(4, make_vec3(1, 1, 1));

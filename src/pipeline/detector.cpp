@@ -8,6 +8,8 @@
 #include <cmath>
 #include <string>
 
+#include <omp.h>
+
 namespace kdet {
 
 struct Detector::Impl {
@@ -127,7 +129,7 @@ struct Detector::Impl {
         // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
         const auto count = static_cast<std::uint32_t>(vertex_count);
-        topology.add_object(converted.data(), count, tets, tet_count);
+        topology.add_object(converted.data(), count, tets, tet_count, options.threads > 0 ? options.threads : omp_get_max_threads());
         object_vertex_begin.push_back(base + count);
         positions.resize(topology.vertex_count);
         topology.to_stored_order(base, count, xyz, positions.data() + base);

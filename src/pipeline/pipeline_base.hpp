@@ -35,9 +35,10 @@ struct SceneTopology {
     std::uint32_t vertex_count = 0;
 
     /// @brief Appends an object: its `vertex_count` vertices at `positions` and its `tet_count` tets (four
-    /// vertex indices each, into `positions`), stored in spatial order, its vertices numbered on from
-    /// the vertices stored so far.
-    void add_object(const vec3* positions, std::uint32_t vertex_count, const std::uint32_t* tets, std::size_t tet_count);
+    /// vertex indices each, into `positions`), stored in spatial order (computed on `threads` threads),
+    /// its vertices numbered on from the vertices stored so far.
+    void add_object(const vec3* positions, std::uint32_t vertex_count, const std::uint32_t* tets, std::size_t tet_count,
+                    int threads = 1);
 
     /// @brief `count` positions of the vertices from global id `first` on (one object's or a range of
     /// them), given in the caller's order as x y z each (`xyz`, float or double), written in the order

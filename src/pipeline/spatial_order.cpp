@@ -9,37 +9,41 @@
 
 namespace kdet {
 
-std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::uint32_t* tets, std::size_t tet_count) {
+std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::uint32_t* tets, std::size_t tet_count, int threads) {
+    const auto n = static_cast<std::ptrdiff_t>(tet_count);
     std::vector<vec3> centroid(tet_count);
     const float inf = std::numeric_limits<float>::infinity();
-    vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
-    for (std::size_t t = 0; t < tet_count; ++t) {
+    float lo_x = inf, lo_y = inf, lo_z = inf, hi_x = -inf, hi_y = -inf, hi_z = -inf;
+#pragma omp parallel for num_threads(threads) if (n > 65536) reduction(min : lo_x, lo_y, lo_z) reduction(max : hi_x, hi_y, hi_z)
+    for (std::ptrdiff_t t = 0; t < n; ++t) {
         const std::uint32_t* v = tets + 4 * t;
-        centroid[t] = (positions[v[0]] + positions[v[1]] + positions[v[2]] + positions[v[3]]) * 0.25f;
-        lo = min_v(lo, centroid[t]);
-        hi = max_v(hi, centroid[t]);
+        const vec3 c = (positions[v[0]] + positions[v[1]] + positions[v[2]] + positions[v[3]]) * 0.25f;
+        centroid[static_cast<std::size_t>(t)] = c;
+        lo_x = std::min(lo_x, c.x), lo_y = std::min(lo_y, c.y), lo_z = std::min(lo_z, c.z);
+        hi_x = std::max(hi_x, c.x), hi_y = std::max(hi_y, c.y), hi_z = std::max(hi_z, c.z);
     }
     auto quantize = [](float x, float low, float high) {
         const float scaled = high > low ? (x - low) / (high - low) * 1023.0f : 0.0f;
         return static_cast<std::uint32_t>(std::clamp(scaled, 0.0f, 1023.0f));
     };
     std::vector<std::uint64_t> keys(tet_count);
-    for (std::size_t t = 0; t < tet_count; ++t) {
-        const vec3 c = centroid[t];
-        const std::uint32_t code = hash_detail::spread_bits_3(quantize(c.x, lo.x, hi.x)) |
-                                   (hash_detail::spread_bits_3(quantize(c.y, lo.y, hi.y)) << 1) |
-                                   (hash_detail::spread_bits_3(quantize(c.z, lo.z, hi.z)) << 2);
-        keys[t] = (static_cast<std::uint64_t>(code) << 32) | t;
+#pragma omp parallel for num_threads(threads) if (n > 65536)
+    for (std::ptrdiff_t t = 0; t < n; ++t) {
+        const vec3 c = centroid[static_cast<std::size_t>(t)];
+        const std::uint32_t code = hash_detail::spread_bits_3(quantize(c.x, lo_x, hi_x)) |
+                                   (hash_detail::spread_bits_3(quantize(c.y, lo_y, hi_y)) << 1) |
+                                   (hash_detail::spread_bits_3(quantize(c.z, lo_z, hi_z)) << 2);
+        keys[static_cast<std::size_t>(t)] = (static_cast<std::uint64_t>(code) << 32) | static_cast<std::uint64_t>(t);
     }
     std::vector<std::uint64_t> scratch(tet_count);
-    radix_sort(keys.data(), tet_count, 62, scratch.data(), 1);
+    radix_sort(keys.data(), tet_count, 62, scratch.data(), threads);
     std::vector<std::uint32_t> order(tet_count);
     for (std::size_t i = 0; i < tet_count; ++i) order[i] = static_cast<std::uint32_t>(keys[i] & 0xffffffffu);
     return order;
 }
 
 void SceneTopology::add_object(const vec3* positions, std::uint32_t object_vertex_count, const std::uint32_t* object_tets,
-                               std::size_t tet_count) {
+                               std::size_t tet_count, int threads) {
     if (object_tet_begin.empty()) object_tet_begin.push_back(0);
     const auto object = static_cast<std::uint32_t>(object_tet_begin.size() - 1);
     const auto first_tet = static_cast<std::uint32_t>(tets.size());
@@ -55,7 +59,7 @@ void SceneTopology::add_object(const vec3* positions, std::uint32_t object_verte
         }
         return first_vertex + stored_vertex[v];
     };
-    const std::vector<std::uint32_t> order = spatial_tet_order(positions, object_tets, tet_count);
+    const std::vector<std::uint32_t> order = spatial_tet_order(positions, object_tets, tet_count, threads);
     tets.reserve(tets.size() + tet_count);
     tet_object.resize(tet_object.size() + tet_count, object);
     tet_user_id.reserve(tet_user_id.size() + tet_count);

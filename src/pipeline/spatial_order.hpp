@@ -16,7 +16,9 @@
 namespace kdet {
 
 /// @brief Tet indices sorted by the Morton code of the tet's centroid within the box of all centroids
-/// (10 bits per axis), ties by index. A permutation of 0 .. tet_count-1.
-std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::uint32_t* tets, std::size_t tet_count);
+/// (10 bits per axis), ties by index. A permutation of 0 .. tet_count-1, the same on any number of
+/// `threads` (a one-off query on a large mesh computes it on the detector's threads).
+std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::uint32_t* tets, std::size_t tet_count,
+                                             int threads = 1);
 
 } // namespace kdet
