@@ -61,10 +61,19 @@ struct Detector::Impl {
         if (!rejected.empty()) throw Error(rejected);
     }
 
-    static std::uint32_t first_non_finite(const vec3* p, std::uint32_t count) {
-        for (std::uint32_t v = 0; v < count; ++v)
-            if (!std::isfinite(p[v].x) || !std::isfinite(p[v].y) || !std::isfinite(p[v].z)) return v;
+    /// The first of `count` vertices (x y z each, float or double) with a coordinate that is not
+    /// finite as the float32 the pipeline stores, or no_vertex. Out-of-range doubles become infinite
+    /// floats, so this also catches values beyond float range.
+    template <class Scalar>
+    static std::uint32_t first_non_finite(const Scalar* xyz, std::size_t count) {
+        for (std::size_t v = 0; v < count; ++v) {
+            const vec3 p = to_float(xyz + 3 * v);
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return static_cast<std::uint32_t>(v);
+        }
         return no_vertex;
+    }
+    static std::uint32_t first_non_finite(const vec3* p, std::size_t count) {
+        return first_non_finite(reinterpret_cast<const float*>(p), count);
     }
 
     static std::string non_finite_message(std::size_t object, std::uint32_t vertex) {
@@ -82,13 +91,10 @@ struct Detector::Impl {
     /// Rejects coordinates that are not finite as the float32 the pipeline stores.
     template <class Scalar>
     static void check_finite(std::size_t object, const Scalar* xyz, std::size_t vertex_count) {
-        for (std::size_t v = 0; v < vertex_count; ++v) {
-            const vec3 p = to_float(xyz + 3 * v);
-            // Out-of-range doubles become infinite floats, so this also catches values beyond float range.
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-                throw Error("object " + std::to_string(object) + ": vertex " + std::to_string(v) +
-                            " has a non-finite coordinate (or one beyond float range)");
-        }
+        const std::uint32_t bad = first_non_finite(xyz, vertex_count);
+        if (bad != no_vertex)
+            throw Error("object " + std::to_string(object) + ": vertex " + std::to_string(bad) +
+                        " has a non-finite coordinate (or one beyond float range)");
     }
 
     template <class Scalar>
@@ -132,7 +138,7 @@ struct Detector::Impl {
         topology.add_object(converted.data(), count, tets, tet_count, options.threads > 0 ? options.threads : omp_get_max_threads());
         object_vertex_begin.push_back(base + count);
         positions.resize(topology.vertex_count);
-        topology.to_stored_order(base, count, xyz, positions.data() + base);
+        topology.to_stored_order(base, count, converted.data(), positions.data() + base);
         positions_dirty.push_back(1);
         positions_on_device.push_back(0);
         positions_staged.push_back(0);
