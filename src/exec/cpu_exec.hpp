@@ -125,11 +125,14 @@ public:
 
     stage_clock make_stage_clock() const { return stage_clock(); }
 
-    /// @brief Runs f(i) for every i in [0, n) on all threads.
+    /// @brief Runs f(i) for every i in [0, n) on all threads; each item holds `work_per_item` elements
+    /// (tets, keys), so that a stage of few heavy items is shared like one of many light ones: on one
+    /// thread below 512 elements, else in dynamic chunks of about 256 elements.
     template <class F>
-    void for_each(std::uint64_t n, const F& f) const {
+    void for_each(std::uint64_t n, const F& f, std::uint32_t work_per_item = 1) const {
         const auto count = static_cast<std::int64_t>(n);
-#pragma omp parallel for schedule(dynamic, 256) num_threads(threads_) if (count > 512)
+        const std::int64_t chunk = std::max<std::int64_t>(1, 256 / std::int64_t{work_per_item});
+#pragma omp parallel for schedule(dynamic, chunk) num_threads(threads_) if (count * work_per_item > 512)
         for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
     }
 

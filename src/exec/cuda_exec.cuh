@@ -215,7 +215,7 @@ public:
     stage_clock make_stage_clock() const { return stage_clock(stream_); }
 
     template <class F>
-    void for_each(std::uint64_t n, const F& f) const {
+    void for_each(std::uint64_t n, const F& f, std::uint32_t /*work_per_item: a thread an item whatever it holds*/ = 1) const {
         if (n == 0) return;
         const int block = launchable_block_size(for_each_kernel<F>);
         for_each_kernel<<<blocks_for(n, block), block, 0, stream_>>>(n, f);

@@ -300,7 +300,7 @@ void Pipeline<Exec>::grid_geometry() {
     exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, c->spacing_octaves, &c->region, &c->params});
     constexpr std::uint32_t chunk = Exec::plan_chunk;
     exec_.for_each((tets_.size() + chunk - 1) / chunk,
-                   GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask});
+                   GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask}, chunk);
 }
 
 /// @brief Sizes the table for a plan: per layer the occupied cells are at most the plan's bound
