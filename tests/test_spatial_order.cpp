@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <random>
 
@@ -241,6 +242,37 @@ TEST(SpatialOrder, ResultsDoNotDependOnHowTheCallerNumbersTheVertices) {
     detector.set_positions_on_device(moving, staged.data(), shuffled.num_vertices());
     detector.add_object(test::random_soup(5, 1.0, 0.0, 87));
     check(0.7 * shift, "staged on the device, then an object added");
+}
+
+TEST(SpatialOrder, LargeObjectsPositionsAreCheckedAndStoredAlikeOnAnyNumberOfThreads) {
+    // Enough vertices (80k) for the detector to check and reorder positions on several threads.
+    const TetMesh soup = test::random_soup(20000, 1.0, 2.0, 88);
+    const TetMesh shuffled = with_shuffled_vertices(soup, 89, 7);
+    const TetMesh moved_soup = test::moved(soup, 0.1, 0.05, 0.0, 0.0);
+    const TetMesh moved_shuffled = with_shuffled_vertices(moved_soup, 89, 7);
+    DetectorOptions one_thread;
+    one_thread.threads = 1;
+    Detector reference(one_thread);
+    reference.set_self_collision(reference.add_object(soup), true);
+    reference.set_positions(0, moved_soup.positions.data(), moved_soup.num_vertices());
+    const std::vector<IndexPair> expected = pairs_between(reference.detect(), 0, 0);
+    ASSERT_FALSE(expected.empty());
+    for (const int threads : {1, 2, 3}) {
+        DetectorOptions options;
+        options.threads = threads;
+        Detector detector(options);
+        detector.set_self_collision(detector.add_object(shuffled), true);
+        detector.set_positions(0, moved_shuffled.positions.data(), shuffled.num_vertices());
+        EXPECT_EQ(pairs_between(detector.detect(), 0, 0), expected) << threads << " threads";
+        // The first bad vertex is named whichever thread finds it; the positions stay as they were.
+        std::vector<double> bad = moved_shuffled.positions;
+        bad[3 * 70001 + 2] = std::numeric_limits<double>::quiet_NaN();
+        bad[3 * 30002] = std::numeric_limits<double>::infinity();
+        EXPECT_EQ(test::error_message([&] { detector.set_positions(0, bad.data(), shuffled.num_vertices()); }),
+                  "object 0: vertex 30002 has a non-finite coordinate (or one beyond float range)")
+            << threads << " threads";
+        EXPECT_EQ(pairs_between(detector.detect(), 0, 0), expected) << threads << " threads, after the rejection";
+    }
 }
 
 TEST(Detector, AFailedAddLeavesTheDetectorAsItWas) {

@@ -48,7 +48,7 @@ struct Detector::Impl {
                     rejected = non_finite_message(o, bad);
                     pipeline->get_positions(first, held, count, false);
                 } else {
-                    topology.to_stored_order(first, count, staged.data(), held);
+                    topology.to_stored_order(first, count, staged.data(), held, host_threads());
                 }
             } else {
                 pipeline->get_positions(first, held, count, false);
@@ -64,17 +64,26 @@ struct Detector::Impl {
     /// The first of `count` vertices (x y z each, float or double) with a coordinate that is not
     /// finite as the float32 the pipeline stores, or no_vertex. Out-of-range doubles become infinite
     /// floats, so this also catches values beyond float range.
+    /// Scanned on the detector's threads when there are many (every frame's positions pass here), so
+    /// every vertex is read: the first bad one is the smallest index found.
     template <class Scalar>
-    static std::uint32_t first_non_finite(const Scalar* xyz, std::size_t count) {
-        for (std::size_t v = 0; v < count; ++v) {
+    std::uint32_t first_non_finite(const Scalar* xyz, std::size_t count) const {
+        const auto n = static_cast<std::ptrdiff_t>(count);
+        std::uint32_t first_bad = no_vertex;
+#pragma omp parallel for num_threads(host_threads()) schedule(static) if (n > 65536) reduction(min : first_bad)
+        for (std::ptrdiff_t v = 0; v < n; ++v) {
             const vec3 p = to_float(xyz + 3 * v);
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return static_cast<std::uint32_t>(v);
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+                first_bad = std::min(first_bad, static_cast<std::uint32_t>(v));
         }
-        return no_vertex;
+        return first_bad;
     }
-    static std::uint32_t first_non_finite(const vec3* p, std::size_t count) {
+    std::uint32_t first_non_finite(const vec3* p, std::size_t count) const {
         return first_non_finite(reinterpret_cast<const float*>(p), count);
     }
+
+    /// The threads of the host's work on positions: the detector's, as its CPU backend uses.
+    int host_threads() const { return options.threads > 0 ? options.threads : omp_get_max_threads(); }
 
     static std::string non_finite_message(std::size_t object, std::uint32_t vertex) {
         return "object " + std::to_string(object) + ": vertex " + std::to_string(vertex) +
@@ -90,7 +99,7 @@ struct Detector::Impl {
 
     /// Rejects coordinates that are not finite as the float32 the pipeline stores.
     template <class Scalar>
-    static void check_finite(std::size_t object, const Scalar* xyz, std::size_t vertex_count) {
+    void check_finite(std::size_t object, const Scalar* xyz, std::size_t vertex_count) const {
         const std::uint32_t bad = first_non_finite(xyz, vertex_count);
         if (bad != no_vertex)
             throw Error("object " + std::to_string(object) + ": vertex " + std::to_string(bad) +
@@ -107,7 +116,7 @@ struct Detector::Impl {
         // Checked first, converted into place second: a simulation sets positions every frame, and a
         // converted copy allocated each time cost a fresh (page-faulted) buffer per frame.
         check_finite(object, xyz, vertex_count);
-        topology.to_stored_order(first, static_cast<std::uint32_t>(vertex_count), xyz, positions.data() + first);
+        topology.to_stored_order(first, static_cast<std::uint32_t>(vertex_count), xyz, positions.data() + first, host_threads());
         positions_dirty[object] = 1;
         positions_on_device[object] = positions_staged[object] = 0;
     }
@@ -135,10 +144,10 @@ struct Detector::Impl {
         // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
         const auto count = static_cast<std::uint32_t>(vertex_count);
-        topology.add_object(converted.data(), count, tets, tet_count, options.threads > 0 ? options.threads : omp_get_max_threads());
+        topology.add_object(converted.data(), count, tets, tet_count, host_threads());
         object_vertex_begin.push_back(base + count);
         positions.resize(topology.vertex_count);
-        topology.to_stored_order(base, count, converted.data(), positions.data() + base);
+        topology.to_stored_order(base, count, converted.data(), positions.data() + base, host_threads());
         positions_dirty.push_back(1);
         positions_on_device.push_back(0);
         positions_staged.push_back(0);

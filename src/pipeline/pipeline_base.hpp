@@ -42,19 +42,13 @@ struct SceneTopology {
 
     /// @brief `count` positions of the vertices from global id `first` on (one object's or a range of
     /// them), given in the caller's order as x y z each (`xyz`, float or double), written in the order
-    /// the pipeline stores them as float32 (`stored`, also indexed from `first`).
-    template <class Scalar>
-    void to_stored_order(std::uint32_t first, std::uint32_t count, const Scalar* xyz, vec3* stored) const {
-        // Read at random where the caller's order is not spatial: fetched a few vertices ahead.
-        constexpr std::uint32_t ahead = 16;
-        for (std::uint32_t v = first; v < first + count; ++v) {
-            if (v + ahead < first + count) __builtin_prefetch(xyz + 3 * std::size_t{vertex_user_id[v + ahead] - first});
-            stored[v - first] = to_float(xyz + 3 * std::size_t{vertex_user_id[v] - first});
-        }
-    }
-    void to_stored_order(std::uint32_t first, std::uint32_t count, const vec3* caller_order, vec3* stored) const {
+    /// the pipeline stores them as float32 (`stored`, also indexed from `first`), on `threads` threads
+    /// when there are many: a simulation hands over every object's positions each frame.
+    void to_stored_order(std::uint32_t first, std::uint32_t count, const double* xyz, vec3* stored, int threads = 1) const;
+    void to_stored_order(std::uint32_t first, std::uint32_t count, const float* xyz, vec3* stored, int threads = 1) const;
+    void to_stored_order(std::uint32_t first, std::uint32_t count, const vec3* caller_order, vec3* stored, int threads = 1) const {
         static_assert(sizeof(vec3) == 3 * sizeof(float), "a vec3 is its three coordinates");
-        to_stored_order(first, count, reinterpret_cast<const float*>(caller_order), stored);
+        to_stored_order(first, count, reinterpret_cast<const float*>(caller_order), stored, threads);
     }
 };
 

@@ -82,4 +82,34 @@ void SceneTopology::add_object(const vec3* positions, std::uint32_t object_verte
     object_tet_begin.push_back(static_cast<std::uint32_t>(tets.size()));
 }
 
+namespace {
+
+/// Vertices per thread below which one thread converts them alone.
+constexpr std::ptrdiff_t vertices_per_thread = 32768;
+
+template <class Scalar>
+void gather_in_stored_order(const std::vector<std::uint32_t>& vertex_user_id, std::uint32_t first, std::uint32_t count,
+                            const Scalar* xyz, vec3* stored, int threads) {
+    // Read at random where the caller's order is not spatial: fetched a few vertices ahead.
+    constexpr std::ptrdiff_t ahead = 16;
+    const std::uint32_t* user_id = vertex_user_id.data() + first;
+    const auto n = static_cast<std::ptrdiff_t>(count);
+    threads = static_cast<int>(std::max<std::ptrdiff_t>(1, std::min<std::ptrdiff_t>(threads, n / vertices_per_thread)));
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+    for (std::ptrdiff_t v = 0; v < n; ++v) {
+        if (v + ahead < n) __builtin_prefetch(xyz + 3 * std::size_t{user_id[v + ahead] - first});
+        stored[v] = to_float(xyz + 3 * std::size_t{user_id[v] - first});
+    }
+}
+
+} // namespace
+
+void SceneTopology::to_stored_order(std::uint32_t first, std::uint32_t count, const double* xyz, vec3* stored, int threads) const {
+    gather_in_stored_order(vertex_user_id, first, count, xyz, stored, threads);
+}
+
+void SceneTopology::to_stored_order(std::uint32_t first, std::uint32_t count, const float* xyz, vec3* stored, int threads) const {
+    gather_in_stored_order(vertex_user_id, first, count, xyz, stored, threads);
+}
+
 } // namespace kdet
