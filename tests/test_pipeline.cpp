@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <random>
 #include <set>
 #include <string>
 
@@ -297,6 +298,33 @@ TEST(Pipeline, ThreadCountDoesNotChangeTheAnswer) {
     const Outcome r1 = run({a, b}, true, one), r2 = run({a, b}, true, two);
     EXPECT_EQ(r1.pairs, r2.pairs);
     EXPECT_EQ(r1.counts.unique_candidates, r2.counts.unique_candidates);
+}
+
+TEST(Pipeline, PairsFromKeysNameEachSidesObjectAndTet) {
+    // 3 objects (counted without a branch) and 40 (a binary search), 100k keys (shared by threads),
+    // objects of every size, empty ones included, against a search over the objects one by one.
+    std::mt19937 rng(90);
+    for (const std::size_t objects : {std::size_t{3}, std::size_t{40}}) {
+        std::vector<std::uint32_t> begin{0};
+        for (std::size_t o = 0; o < objects; ++o) begin.push_back(begin.back() + (o % 7 == 3 ? 0u : static_cast<std::uint32_t>(rng() % 5000u)));
+        std::uniform_int_distribution<std::uint32_t> tet(0, begin.back() - 1);
+        std::vector<std::uint64_t> keys(100000);
+        for (std::uint64_t& key : keys) key = (std::uint64_t{tet(rng)} << 32) | tet(rng);
+        const auto object_of = [&](std::uint32_t global) {
+            std::uint32_t o = 0;
+            while (begin[o + 1] <= global) ++o;
+            return o;
+        };
+        for (const int threads : {1, 2}) {
+            std::vector<TetPair> pairs(keys.size());
+            pairs_from_keys(begin, keys.data(), keys.size(), pairs.data(), threads);
+            for (std::size_t k = 0; k < keys.size(); ++k) {
+                const std::uint32_t a = key_first(keys[k]), b = key_second(keys[k]);
+                const TetPair expected{object_of(a), a - begin[object_of(a)], object_of(b), b - begin[object_of(b)]};
+                ASSERT_EQ(pairs[k], expected) << objects << " objects, " << threads << " threads, key " << k;
+            }
+        }
+    }
 }
 
 TEST(Detector, FrameByFrameMatchesOneOffQueries) {

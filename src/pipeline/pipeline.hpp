@@ -744,16 +744,8 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
     result.colliding.resize(options_.results_to_host ? objects : 0);
     if (options_.results_to_host) {
         const auto& begin = topology_.object_tet_begin;
-        auto locate = [&](std::uint32_t global, std::uint32_t& object, std::uint32_t& local) {
-            object = static_cast<std::uint32_t>(std::upper_bound(begin.begin(), begin.end(), global) - begin.begin() - 1);
-            local = global - begin[object];
-        };
         result.pairs.resize(colliding_count_);
-        for (std::size_t k = 0; k < colliding_count_; ++k) {
-            TetPair& p = result.pairs[k];
-            locate(key_first(host_keys_[k]), p.object_a, p.tet_a);
-            locate(key_second(host_keys_[k]), p.object_b, p.tet_b);
-        }
+        pairs_from_keys(begin, host_keys_.data(), colliding_count_, result.pairs.data(), options_.threads);
         if (options_.contacts) result.contacts.assign(host_contacts_.begin(), host_contacts_.begin() + colliding_count_);
         for (std::size_t o = 0; o < objects; ++o) {
             const std::uint32_t b = begin[o], e = begin[o + 1];

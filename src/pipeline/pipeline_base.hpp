@@ -52,6 +52,12 @@ struct SceneTopology {
     }
 };
 
+/// @brief Each of `count` colliding pairs' keys (two global tet ids in the caller's numbering) as the
+/// caller's object and tet of each side, on `threads` threads (0: OpenMP's default): a frame of a
+/// large scene hands out millions of pairs.
+void pairs_from_keys(const std::vector<std::uint32_t>& object_tet_begin, const std::uint64_t* keys, std::size_t count,
+                     TetPair* pairs, int threads);
+
 /// @brief Positions of `count` vertices from global vertex `first` on, in stored order
 /// (SceneTopology::to_stored_order), copied in at the start of a frame.
 struct PositionUpload {

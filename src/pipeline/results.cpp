@@ -1,0 +1,45 @@
+#include "pipeline/pipeline_base.hpp"
+
+#include <algorithm>
+
+#include <omp.h>
+
+namespace kdet {
+
+namespace {
+
+/// The object of global tet `global` and its index there. With few objects a count of the objects
+/// starting at or before it, without a branch: the objects of a pair's second tets alternate at
+/// random, and a binary search mispredicted about once per level.
+struct TetLocator {
+    const std::vector<std::uint32_t>& begin; ///< [objects + 1]
+    static constexpr std::size_t few_objects = 16;
+
+    void operator()(std::uint32_t global, std::uint32_t& object, std::uint32_t& tet) const {
+        const std::size_t objects = begin.size() - 1;
+        std::uint32_t o = 0;
+        if (objects <= few_objects) {
+            for (std::size_t k = 1; k < objects; ++k) o += global >= begin[k] ? 1u : 0u;
+        } else {
+            o = static_cast<std::uint32_t>(std::upper_bound(begin.begin(), begin.end(), global) - begin.begin() - 1);
+        }
+        object = o;
+        tet = global - begin[o];
+    }
+};
+
+} // namespace
+
+void pairs_from_keys(const std::vector<std::uint32_t>& object_tet_begin, const std::uint64_t* keys, std::size_t count,
+                     TetPair* pairs, int threads) {
+    const TetLocator locate{object_tet_begin};
+    const auto n = static_cast<std::ptrdiff_t>(count);
+#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) schedule(static) if (n > 65536)
+    for (std::ptrdiff_t k = 0; k < n; ++k) {
+        TetPair& p = pairs[k];
+        locate(key_first(keys[k]), p.object_a, p.tet_a);
+        locate(key_second(keys[k]), p.object_b, p.tet_b);
+    }
+}
+
+} // namespace kdet
