@@ -300,13 +300,14 @@ TEST(Pipeline, ThreadCountDoesNotChangeTheAnswer) {
     EXPECT_EQ(r1.counts.unique_candidates, r2.counts.unique_candidates);
 }
 
-TEST(Pipeline, PairsFromKeysNameEachSidesObjectAndTet) {
-    // 3 objects (counted without a branch) and 40 (a binary search), 100k keys (shared by threads),
-    // objects of every size, empty ones included, against a search over the objects one by one.
+TEST(Pipeline, PairsAndFlagsAreHandedOutByObjectOnAnyNumberOfThreads) {
+    // 3 objects (counted without a branch) and 40 (a binary search), 100k keys and about 100k tets
+    // (shared by threads), objects of every size, empty ones included, against a search over the
+    // objects one by one.
     std::mt19937 rng(90);
     for (const std::size_t objects : {std::size_t{3}, std::size_t{40}}) {
         std::vector<std::uint32_t> begin{0};
-        for (std::size_t o = 0; o < objects; ++o) begin.push_back(begin.back() + (o % 7 == 3 ? 0u : static_cast<std::uint32_t>(rng() % 5000u)));
+        for (std::size_t o = 0; o < objects; ++o) begin.push_back(begin.back() + (o % 7 == 3 ? 0u : static_cast<std::uint32_t>(rng() % (objects == 3 ? 70000u : 5000u))));
         std::uniform_int_distribution<std::uint32_t> tet(0, begin.back() - 1);
         std::vector<std::uint64_t> keys(100000);
         for (std::uint64_t& key : keys) key = (std::uint64_t{tet(rng)} << 32) | tet(rng);
@@ -322,6 +323,16 @@ TEST(Pipeline, PairsFromKeysNameEachSidesObjectAndTet) {
                 const std::uint32_t a = key_first(keys[k]), b = key_second(keys[k]);
                 const TetPair expected{object_of(a), a - begin[object_of(a)], object_of(b), b - begin[object_of(b)]};
                 ASSERT_EQ(pairs[k], expected) << objects << " objects, " << threads << " threads, key " << k;
+            }
+            std::vector<std::uint32_t> flags(begin.back());
+            for (std::uint32_t& flag : flags) flag = rng() % 3u == 0 ? 1u + rng() % 4u : 0u;
+            std::vector<std::vector<std::uint8_t>> colliding(1, std::vector<std::uint8_t>(3, 7));
+            flags_by_object(begin, flags.data(), colliding, threads);
+            ASSERT_EQ(colliding.size(), objects);
+            for (std::uint32_t o = 0; o < objects; ++o) {
+                ASSERT_EQ(colliding[o].size(), begin[o + 1] - begin[o]) << "object " << o;
+                for (std::uint32_t t = begin[o]; t < begin[o + 1]; ++t)
+                    ASSERT_EQ(colliding[o][t - begin[o]], flags[t] ? 1 : 0) << "object " << o << ", global tet " << t;
             }
         }
     }

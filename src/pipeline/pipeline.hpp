@@ -747,11 +747,7 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
         result.pairs.resize(colliding_count_);
         pairs_from_keys(begin, host_keys_.data(), colliding_count_, result.pairs.data(), options_.threads);
         if (options_.contacts) result.contacts.assign(host_contacts_.begin(), host_contacts_.begin() + colliding_count_);
-        for (std::size_t o = 0; o < objects; ++o) {
-            const std::uint32_t b = begin[o], e = begin[o + 1];
-            result.colliding[o].resize(e - b);
-            for (std::uint32_t t = b; t < e; ++t) result.colliding[o][t - b] = host_flags_[t] ? 1 : 0;
-        }
+        flags_by_object(begin, host_flags_.data(), result.colliding, options_.threads);
     }
     result.memory_bytes = memory_bytes();
     result.grid_bytes = grid_bytes();

@@ -58,6 +58,11 @@ struct SceneTopology {
 void pairs_from_keys(const std::vector<std::uint32_t>& object_tet_begin, const std::uint64_t* keys, std::size_t count,
                      TetPair* pairs, int threads);
 
+/// @brief Each object's per-tet flags (1: the tet collides) from the per-global-tet counts `flags`, on
+/// `threads` threads (0: OpenMP's default).
+void flags_by_object(const std::vector<std::uint32_t>& object_tet_begin, const std::uint32_t* flags,
+                     std::vector<std::vector<std::uint8_t>>& colliding, int threads);
+
 /// @brief Positions of `count` vertices from global vertex `first` on, in stored order
 /// (SceneTopology::to_stored_order), copied in at the start of a frame.
 struct PositionUpload {

@@ -42,4 +42,29 @@ void pairs_from_keys(const std::vector<std::uint32_t>& object_tet_begin, const s
     }
 }
 
+void flags_by_object(const std::vector<std::uint32_t>& object_tet_begin, const std::uint32_t* flags,
+                     std::vector<std::vector<std::uint8_t>>& colliding, int threads) {
+    const std::size_t objects = object_tet_begin.empty() ? 0 : object_tet_begin.size() - 1;
+    colliding.resize(objects);
+    if (objects == 0) return;
+    for (std::size_t o = 0; o < objects; ++o) colliding[o].resize(object_tet_begin[o + 1] - object_tet_begin[o]);
+    const auto n = static_cast<std::ptrdiff_t>(object_tet_begin.back());
+    const TetLocator locate{object_tet_begin};
+#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads()) if (n > 65536)
+    {
+        // Each thread a contiguous range of global tets, walked object by object.
+        const std::ptrdiff_t parts = omp_get_num_threads(), part = omp_get_thread_num();
+        const auto first = static_cast<std::uint32_t>(n * part / parts), end = static_cast<std::uint32_t>(n * (part + 1) / parts);
+        if (first < end) {
+            std::uint32_t object = 0, tet = 0;
+            locate(first, object, tet);
+            for (std::uint32_t t = first; t < end; ++object) {
+                const std::uint32_t object_end = std::min(end, object_tet_begin[object + 1]);
+                std::uint8_t* out = colliding[object].data();
+                for (; t < object_end; ++t) out[t - object_tet_begin[object]] = flags[t] ? 1 : 0;
+            }
+        }
+    }
+}
+
 } // namespace kdet
