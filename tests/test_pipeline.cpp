@@ -307,7 +307,9 @@ TEST(Pipeline, PairsAndFlagsAreHandedOutByObjectOnAnyNumberOfThreads) {
     std::mt19937 rng(90);
     for (const std::size_t objects : {std::size_t{3}, std::size_t{40}}) {
         std::vector<std::uint32_t> begin{0};
-        for (std::size_t o = 0; o < objects; ++o) begin.push_back(begin.back() + (o % 7 == 3 ? 0u : static_cast<std::uint32_t>(rng() % (objects == 3 ? 70000u : 5000u))));
+        const std::uint32_t largest = objects == 3 ? 70000u : 5000u;
+        for (std::size_t o = 0; o < objects; ++o)
+            begin.push_back(begin.back() + (o % 7 == 3 ? 0u : static_cast<std::uint32_t>(rng() % largest)));
         std::uniform_int_distribution<std::uint32_t> tet(0, begin.back() - 1);
         std::vector<std::uint64_t> keys(100000);
         for (std::uint64_t& key : keys) key = (std::uint64_t{tet(rng)} << 32) | tet(rng);

@@ -63,9 +63,8 @@ struct Detector::Impl {
 
     /// The first of `count` vertices (x y z each, float or double) with a coordinate that is not
     /// finite as the float32 the pipeline stores, or no_vertex. Out-of-range doubles become infinite
-    /// floats, so this also catches values beyond float range.
-    /// Scanned on the detector's threads when there are many (every frame's positions pass here), so
-    /// every vertex is read: the first bad one is the smallest index found.
+    /// floats, so this also catches values beyond float range. Every frame's positions pass here, so
+    /// many are scanned on the detector's threads, each to its end: the smallest bad index wins.
     template <class Scalar>
     std::uint32_t first_non_finite(const Scalar* xyz, std::size_t count) const {
         const auto n = static_cast<std::ptrdiff_t>(count);
