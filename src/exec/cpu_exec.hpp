@@ -151,6 +151,11 @@ public:
     /// adds its counts with a few atomics and bounds the cells by what its previous tet covered.
     static constexpr std::uint32_t plan_chunk = 256;
 
+    /// @brief The backend's memory is the host's: a frame's end reads the pairs, flags and contacts
+    /// where the pipeline left them, where a copy of the whole pairs' window (tens of MB at 1M tets)
+    /// cost one thread's time every frame.
+    static constexpr bool host_reads_results_in_place = true;
+
     /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`),
     /// divided by `per_item` (rounded up) when each item takes that many: a stage whose size an earlier
     /// stage counted is launched without the host reading the count.

@@ -205,6 +205,9 @@ public:
     /// the plan's bound on the cells loosens a little (each item counts its first tet's cells whole).
     static constexpr std::uint32_t plan_chunk = 16;
 
+    /// @brief Results are copied to the host before a frame's end reads them.
+    static constexpr bool host_reads_results_in_place = false;
+
     explicit CudaExec(const DetectorOptions& options)
         : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
         int devices = 0;

@@ -262,7 +262,8 @@ private:
     std::size_t colliding_count_ = 0; ///< pairs in out_keys_ after the last detection
     GridView grid_{}; ///< the frame's grid, once populated
 
-    // The frame in flight: the staged ranges it adopts, and what it copies back at its end, read by finish().
+    // The frame in flight: the staged ranges it adopts, and what it copies back at its end, read by
+    // finish() (the results only where the backend's memory is not the host's).
     std::vector<VertexRange> staged_;
     FrameCounters last_{};
     std::vector<std::uint64_t> host_keys_;
@@ -600,7 +601,7 @@ void Pipeline<Exec>::enqueue_results() {
     exec_.sum(user_colliding_.data(), tets, &c->colliding_tets);
 
     exec_.download_later(&last_, counters_.data(), 1);
-    if (!options_.results_to_host) return;
+    if (!options_.results_to_host || Exec::host_reads_results_in_place) return;
     host_keys_.resize(method == Method::kdet_no_pairs ? 0 : pairs_window_);
     exec_.download_later(host_keys_.data(), out_keys_.data(), host_keys_.size());
     host_flags_.resize(tets);
@@ -743,11 +744,15 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
     const std::size_t objects = object_boxes_.size();
     result.colliding.resize(options_.results_to_host ? objects : 0);
     if (options_.results_to_host) {
+        constexpr bool in_place = Exec::host_reads_results_in_place;
+        const std::uint64_t* keys = in_place ? out_keys_.data() : host_keys_.data();
+        const std::uint32_t* flags = in_place ? user_colliding_.data() : host_flags_.data();
+        const Contact* contacts = in_place ? out_contacts_.data() : host_contacts_.data();
         const auto& begin = topology_.object_tet_begin;
         result.pairs.resize(colliding_count_);
-        pairs_from_keys(begin, host_keys_.data(), colliding_count_, result.pairs.data(), options_.threads);
-        if (options_.contacts) result.contacts.assign(host_contacts_.begin(), host_contacts_.begin() + colliding_count_);
-        flags_by_object(begin, host_flags_.data(), result.colliding, options_.threads);
+        pairs_from_keys(begin, keys, colliding_count_, result.pairs.data(), options_.threads);
+        if (options_.contacts) result.contacts.assign(contacts, contacts + colliding_count_);
+        flags_by_object(begin, flags, result.colliding, options_.threads);
     }
     result.memory_bytes = memory_bytes();
     result.grid_bytes = grid_bytes();
