@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -70,6 +71,22 @@ TEST(CpuSort, SortsTheCountedKeysOfEveryWidthAndLeavesNoKeyOut) {
                 EXPECT_TRUE(std::equal(expected.begin(), expected.end(), keys.begin()))
                     << n << " keys of " << bits << " bits, " << threads << " threads";
             }
+}
+
+TEST(CpuExec, UploadsCopyEveryElementWhateverTheSlices) {
+    // Below 1 MiB one copy; above it a slice per thread (3 MiB + 3 elements: slices of unequal size).
+    for (const int threads : {1, 2, 3})
+        for (const std::size_t n : {std::size_t{0}, std::size_t{1000}, std::size_t{3 * (1u << 20) / 4 + 3}}) {
+            DetectorOptions options;
+            options.threads = threads;
+            const CpuExec exec(options);
+            std::vector<std::uint32_t> host(n), device(n + 2, 7u);
+            std::iota(host.begin(), host.end(), 1u);
+            exec.upload(device.data(), host.data(), n);
+            EXPECT_TRUE(std::equal(host.begin(), host.end(), device.begin())) << n << " elements, " << threads << " threads";
+            EXPECT_EQ(device[n], 7u) << "written past the end";
+            EXPECT_EQ(device[n + 1], 7u) << "written past the end";
+        }
 }
 
 TEST(ReduceRuns, MergesEachRunOfEqualKeysWhereverTheThreadsSplitTheItems) {

@@ -217,9 +217,22 @@ public:
         *run_count = runs;
     }
 
+    /// @brief Copies into the backend's memory; a large copy (a big scene's positions, every frame) in
+    /// slices of 1 MiB or more on the layer's threads.
     template <class T>
     void upload(T* device, const T* host, std::size_t n) const {
-        if (n) std::memcpy(device, host, n * sizeof(T));
+        const std::size_t bytes = n * sizeof(T);
+        const int slices = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(threads_), bytes >> 20));
+        if (slices <= 1) {
+            if (n) std::memcpy(device, host, bytes);
+            return;
+        }
+#pragma omp parallel for num_threads(slices)
+        for (int s = 0; s < slices; ++s) {
+            const std::size_t first = n * static_cast<std::size_t>(s) / static_cast<std::size_t>(slices);
+            const std::size_t end = n * static_cast<std::size_t>(s + 1) / static_cast<std::size_t>(slices);
+            std::memcpy(device + first, host + first, (end - first) * sizeof(T));
+        }
     }
     /// @brief Copies out of the backend's memory: a point where the GPU backend waits for the device,
     /// counted here too so that both backends report the same number of host waits.
