@@ -8,8 +8,6 @@
 #include <cmath>
 #include <string>
 
-#include <omp.h>
-
 namespace kdet {
 
 struct Detector::Impl {
@@ -69,7 +67,7 @@ struct Detector::Impl {
     std::uint32_t first_non_finite(const Scalar* xyz, std::size_t count) const {
         const auto n = static_cast<std::ptrdiff_t>(count);
         std::uint32_t first_bad = no_vertex;
-#pragma omp parallel for num_threads(host_threads()) schedule(static) if (n > 65536) reduction(min : first_bad)
+#pragma omp parallel for num_threads(host_threads()) schedule(static) if (n > host_parallel_elements) reduction(min : first_bad)
         for (std::ptrdiff_t v = 0; v < n; ++v) {
             const vec3 p = to_float(xyz + 3 * v);
             if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
@@ -82,7 +80,7 @@ struct Detector::Impl {
     }
 
     /// The threads of the host's work on positions: the detector's, as its CPU backend uses.
-    int host_threads() const { return options.threads > 0 ? options.threads : omp_get_max_threads(); }
+    int host_threads() const { return kdet::host_threads(options.threads); }
 
     static std::string non_finite_message(std::size_t object, std::uint32_t vertex) {
         return "object " + std::to_string(object) + ": vertex " + std::to_string(vertex) +

@@ -18,6 +18,14 @@ inline vec3 to_float(const Scalar* xyz) {
     return vec3{static_cast<float>(xyz[0]), static_cast<float>(xyz[1]), static_cast<float>(xyz[2])};
 }
 
+/// @brief Elements (tets, vertices, pairs) up to which the host's own loops over them run on one
+/// thread: sharing fewer costs more than it saves.
+constexpr std::ptrdiff_t host_parallel_elements = 65536;
+
+/// @brief The threads of the host's own loops for DetectorOptions::threads = `requested` (0: OpenMP's
+/// default), as the CPU backend uses.
+int host_threads(int requested);
+
 /// @brief Objects as the pipeline sees them: concatenated, with per-object tet ranges.
 struct SceneTopology {
     std::vector<TetIndices> tets;               ///< stored vertex ids
@@ -53,13 +61,13 @@ struct SceneTopology {
 };
 
 /// @brief Each of `count` colliding pairs' keys (two global tet ids in the caller's numbering) as the
-/// caller's object and tet of each side, on `threads` threads (0: OpenMP's default): a frame of a
+/// caller's object and tet of each side, on host_threads(`threads`) threads: a frame of a
 /// large scene hands out millions of pairs.
 void pairs_from_keys(const std::vector<std::uint32_t>& object_tet_begin, const std::uint64_t* keys, std::size_t count,
                      TetPair* pairs, int threads);
 
 /// @brief Each object's per-tet flags (1: the tet collides) from the per-global-tet counts `flags`, on
-/// `threads` threads (0: OpenMP's default).
+/// host_threads(`threads`) threads.
 void flags_by_object(const std::vector<std::uint32_t>& object_tet_begin, const std::uint32_t* flags,
                      std::vector<std::vector<std::uint8_t>>& colliding, int threads);
 

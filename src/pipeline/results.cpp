@@ -30,11 +30,13 @@ struct TetLocator {
 
 } // namespace
 
+int host_threads(int requested) { return requested > 0 ? requested : omp_get_max_threads(); }
+
 void pairs_from_keys(const std::vector<std::uint32_t>& object_tet_begin, const std::uint64_t* keys, std::size_t count,
                      TetPair* pairs, int threads) {
     const TetLocator locate{object_tet_begin};
     const auto n = static_cast<std::ptrdiff_t>(count);
-#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) schedule(static) if (n > 65536)
+#pragma omp parallel for num_threads(host_threads(threads)) schedule(static) if (n > host_parallel_elements)
     for (std::ptrdiff_t k = 0; k < n; ++k) {
         TetPair& p = pairs[k];
         locate(key_first(keys[k]), p.object_a, p.tet_a);
@@ -50,7 +52,7 @@ void flags_by_object(const std::vector<std::uint32_t>& object_tet_begin, const s
     for (std::size_t o = 0; o < objects; ++o) colliding[o].resize(object_tet_begin[o + 1] - object_tet_begin[o]);
     const auto n = static_cast<std::ptrdiff_t>(object_tet_begin.back());
     const TetLocator locate{object_tet_begin};
-#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads()) if (n > 65536)
+#pragma omp parallel num_threads(host_threads(threads)) if (n > host_parallel_elements)
     {
         // Each thread a contiguous range of global tets, walked object by object.
         const std::ptrdiff_t parts = omp_get_num_threads(), part = omp_get_thread_num();

@@ -14,7 +14,7 @@ std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::u
     std::vector<vec3> centroid(tet_count);
     const float inf = std::numeric_limits<float>::infinity();
     float lo_x = inf, lo_y = inf, lo_z = inf, hi_x = -inf, hi_y = -inf, hi_z = -inf;
-#pragma omp parallel for num_threads(threads) if (n > 65536) reduction(min : lo_x, lo_y, lo_z) reduction(max : hi_x, hi_y, hi_z)
+#pragma omp parallel for num_threads(threads) if (n > host_parallel_elements) reduction(min : lo_x, lo_y, lo_z) reduction(max : hi_x, hi_y, hi_z)
     for (std::ptrdiff_t t = 0; t < n; ++t) {
         const std::uint32_t* v = tets + 4 * t;
         const vec3 c = (positions[v[0]] + positions[v[1]] + positions[v[2]] + positions[v[3]]) * 0.25f;
@@ -27,7 +27,7 @@ std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::u
         return static_cast<std::uint32_t>(std::clamp(scaled, 0.0f, 1023.0f));
     };
     std::vector<std::uint64_t> keys(tet_count);
-#pragma omp parallel for num_threads(threads) if (n > 65536)
+#pragma omp parallel for num_threads(threads) if (n > host_parallel_elements)
     for (std::ptrdiff_t t = 0; t < n; ++t) {
         const vec3 c = centroid[static_cast<std::size_t>(t)];
         const std::uint32_t code = hash_detail::spread_bits_3(quantize(c.x, lo_x, hi_x)) |
@@ -84,9 +84,6 @@ void SceneTopology::add_object(const vec3* positions, std::uint32_t object_verte
 
 namespace {
 
-/// Vertices per thread below which one thread converts them alone.
-constexpr std::ptrdiff_t vertices_per_thread = 32768;
-
 template <class Scalar>
 void gather_in_stored_order(const std::vector<std::uint32_t>& vertex_user_id, std::uint32_t first, std::uint32_t count,
                             const Scalar* xyz, vec3* stored, int threads) {
@@ -94,8 +91,7 @@ void gather_in_stored_order(const std::vector<std::uint32_t>& vertex_user_id, st
     constexpr std::ptrdiff_t ahead = 16;
     const std::uint32_t* user_id = vertex_user_id.data() + first;
     const auto n = static_cast<std::ptrdiff_t>(count);
-    threads = static_cast<int>(std::max<std::ptrdiff_t>(1, std::min<std::ptrdiff_t>(threads, n / vertices_per_thread)));
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+#pragma omp parallel for num_threads(threads) schedule(static) if (n > host_parallel_elements)
     for (std::ptrdiff_t v = 0; v < n; ++v) {
         if (v + ahead < n) __builtin_prefetch(xyz + 3 * std::size_t{user_id[v + ahead] - first});
         stored[v] = to_float(xyz + 3 * std::size_t{user_id[v] - first});
