@@ -272,6 +272,22 @@ TEST(SpatialOrder, LargeObjectsPositionsAreCheckedAndStoredAlikeOnAnyNumberOfThr
                   "object 0: vertex 30002 has a non-finite coordinate (or one beyond float range)")
             << threads << " threads";
         EXPECT_EQ(pairs_between(detector.detect(), 0, 0), expected) << threads << " threads, after the rejection";
+        // So are the first bad index and the first bad vertex of an object added (its 80k indices and
+        // vertices checked on the threads too); the detector keeps the one object it had.
+        const std::string vertices = std::to_string(shuffled.num_vertices());
+        TetMesh bad_indices = shuffled;
+        bad_indices.tets[4 * 15000 + 1] = 80000000u;
+        bad_indices.tets[4 * 6000 + 3] = static_cast<std::uint32_t>(shuffled.num_vertices());
+        EXPECT_EQ(test::error_message([&] { detector.add_object(bad_indices); }),
+                  "object 1: tet 6000 has vertex index " + vertices + " out of range [0, " + vertices + ")")
+            << threads << " threads";
+        TetMesh bad_vertices = shuffled;
+        bad_vertices.positions[3 * 60000 + 1] = std::numeric_limits<double>::quiet_NaN();
+        bad_vertices.positions[3 * 20001] = -std::numeric_limits<double>::infinity();
+        EXPECT_EQ(test::error_message([&] { detector.add_object(bad_vertices); }),
+                  "object 1: vertex 20001 has a non-finite coordinate (or one beyond float range)")
+            << threads << " threads";
+        EXPECT_EQ(detector.object_count(), 1u);
     }
 }
 

@@ -6,9 +6,12 @@
 
 namespace kdet {
 
-void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch, int threads) {
+void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch, int threads, int first_bit) {
     if (n <= 1 << 14) {
-        std::sort(keys, keys + n);
+        if (first_bit == 0)
+            std::sort(keys, keys + n);
+        else
+            std::stable_sort(keys, keys + n, [first_bit](std::uint64_t a, std::uint64_t b) { return a >> first_bit < b >> first_bit; });
         return;
     }
     // Only over the bits the keys use, skipping digits that every key shares (a pair key of a 100k-tet
@@ -22,7 +25,7 @@ void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scr
     std::vector<std::size_t> start(digits * static_cast<std::size_t>(slices)); // slice s, digit d at [s digits + d]
     std::uint64_t* from = keys;
     std::uint64_t* to = scratch;
-    for (int shift = 0; shift < bits; shift += digit_bits) {
+    for (int shift = first_bit; shift < bits; shift += digit_bits) {
         const auto digit = [shift](std::uint64_t key) { return (key >> shift) & (digits - 1); };
 #pragma omp parallel for num_threads(slices)
         for (int s = 0; s < slices; ++s) {

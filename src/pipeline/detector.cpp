@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 
 namespace kdet {
@@ -79,6 +80,17 @@ struct Detector::Impl {
         return first_non_finite(reinterpret_cast<const float*>(p), count);
     }
 
+    /// The position of the first of `count` vertex indices that is not below `vertex_count`, or count:
+    /// many are scanned on the detector's threads, each to its end, the smallest position winning.
+    std::size_t first_index_out_of_range(const std::uint32_t* indices, std::size_t count, std::size_t vertex_count) const {
+        const auto n = static_cast<std::ptrdiff_t>(count);
+        std::ptrdiff_t first_bad = n;
+#pragma omp parallel for num_threads(host_threads()) schedule(static) if (n > host_parallel_elements) reduction(min : first_bad)
+        for (std::ptrdiff_t i = 0; i < n; ++i)
+            if (indices[i] >= vertex_count) first_bad = std::min(first_bad, i);
+        return static_cast<std::size_t>(first_bad);
+    }
+
     /// The threads of the host's work on positions: the detector's, as its CPU backend uses.
     int host_threads() const { return kdet::host_threads(options.threads); }
 
@@ -128,23 +140,25 @@ struct Detector::Impl {
                         std::to_string(grid_id_mask));
         if (total_vertices >= 0xffffffffull) throw Error("too many vertices for 32-bit ids");
         const ObjectId id = static_cast<ObjectId>(objects());
-        for (std::size_t t = 0; t < tet_count; ++t)
-            for (int k = 0; k < 4; ++k)
-                if (tets[4 * t + k] >= vertex_count)
-                    throw Error("object " + std::to_string(id) + ": tet " + std::to_string(t) + " has vertex index " +
-                                std::to_string(tets[4 * t + k]) + " out of range [0, " +
-                                std::to_string(vertex_count) + ")");
-        check_finite(id, xyz, vertex_count);
-        std::vector<vec3> converted(vertex_count);
-        for (std::size_t v = 0; v < vertex_count; ++v) converted[v] = to_float(xyz + 3 * v);
+        const std::size_t bad_index = first_index_out_of_range(tets, 4 * tet_count, vertex_count);
+        if (bad_index < 4 * tet_count)
+            throw Error("object " + std::to_string(id) + ": tet " + std::to_string(bad_index / 4) + " has vertex index " +
+                        std::to_string(tets[bad_index]) + " out of range [0, " + std::to_string(vertex_count) + ")");
+        // Converted on the detector's threads into memory left uninitialised (each element is written
+        // once), then checked as the float32 the pipeline stores, as check_finite checks.
+        const std::unique_ptr<vec3[]> converted(new vec3[vertex_count]);
+        const auto vertices = static_cast<std::ptrdiff_t>(vertex_count);
+#pragma omp parallel for num_threads(host_threads()) schedule(static) if (vertices > host_parallel_elements)
+        for (std::ptrdiff_t v = 0; v < vertices; ++v) converted[v] = to_float(xyz + 3 * v);
+        check_finite(id, reinterpret_cast<const float*>(converted.get()), vertex_count);
 
         // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
         const auto count = static_cast<std::uint32_t>(vertex_count);
-        topology.add_object(converted.data(), count, tets, tet_count, host_threads());
+        topology.add_object(converted.get(), count, tets, tet_count, host_threads());
         object_vertex_begin.push_back(base + count);
         positions.resize(topology.vertex_count);
-        topology.to_stored_order(base, count, converted.data(), positions.data() + base, host_threads());
+        topology.to_stored_order(base, count, converted.get(), positions.data() + base, host_threads());
         positions_dirty.push_back(1);
         positions_on_device.push_back(0);
         positions_staged.push_back(0);
