@@ -173,9 +173,9 @@ public:
 
     /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
     /// sorted ascending (the grid's lists by id); the lists are disjoint and lie within the first
-    /// `capacity` keys (the GPU's sort needs them to tile a prefix of them as well). A thread a list, by
-    /// a Shell sort: the lists are short, and the CPU's threads fill them in about ascending order, so
-    /// its passes move few keys.
+    /// `capacity` keys (the GPU's sort needs them to tile a prefix of them as well). A thread a list:
+    /// the CPU's threads fill the lists in about ascending order, so most arrive sorted and are only
+    /// checked; the others take a Shell sort (the lists are short).
     void sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t capacity, const std::uint32_t* begin,
                     const std::uint32_t* end, std::size_t lists) const;
 
