@@ -28,6 +28,15 @@ KDET_HD inline std::uint32_t djb2_word(std::uint32_t word) {
     return (word & 0xffu) * 35937u + ((word >> 8) & 0xffu) * 1089u + ((word >> 16) & 0xffu) * 33u + (word >> 24);
 }
 
+/// djb2_word of the two 32-bit halves of v at once, each in the same half of the result: byte pairs
+/// first (b0 * 33 + b1 and b2 * 33 + b3 in each 16-bit lane, below 2^14), then each half's two pairs
+/// (pair0 * 33^2 + pair1, below 2^24), so no lane carries into the next.
+KDET_HD inline std::uint64_t djb2_word_pair(std::uint64_t v) {
+    constexpr std::uint64_t even_bytes = 0x00ff00ff00ff00ffull, low_lanes = 0x0000ffff0000ffffull;
+    const std::uint64_t pairs = (v & even_bytes) * 33u + ((v >> 8) & even_bytes);
+    return (pairs & low_lanes) * 1089u + ((pairs >> 16) & low_lanes);
+}
+
 /// 33^(4 * words): what DJB2 multiplies the hash so far by over `words` more words.
 constexpr std::uint32_t djb2_shift(int words) { return words == 0 ? 1u : 1185921u * djb2_shift(words - 1); }
 
@@ -61,8 +70,10 @@ struct CellHash {
 KDET_HD inline std::uint32_t djb2_cell_part(CellCoord c) {
     using namespace hash_detail;
     constexpr std::uint32_t start = 5381u * djb2_shift(5);
-    return start + djb2_word(c.x) * djb2_shift(4) + djb2_word(c.y) * djb2_shift(3) + djb2_word(c.z) * djb2_shift(2) +
-           djb2_word(c.layer) * djb2_shift(1);
+    const std::uint64_t xy = djb2_word_pair(c.x | static_cast<std::uint64_t>(c.y) << 32);
+    const std::uint64_t zl = djb2_word_pair(c.z | static_cast<std::uint64_t>(c.layer) << 32);
+    return start + static_cast<std::uint32_t>(xy) * djb2_shift(4) + static_cast<std::uint32_t>(xy >> 32) * djb2_shift(3) +
+           static_cast<std::uint32_t>(zl) * djb2_shift(2) + static_cast<std::uint32_t>(zl >> 32) * djb2_shift(1);
 }
 
 /// @brief FNV-1a (32-bit) over the bytes of the cell key; the probe number's bytes follow.
