@@ -418,6 +418,7 @@ constexpr std::uint32_t all_group_blocks = (1u << bound_group) - 1u;
 /// block i of a group where i % parts == part (parts divides bound_group), so that the parts together
 /// read every block once, neighbouring parts neighbouring blocks.
 KDET_HD constexpr std::uint32_t group_blocks_of_part(std::uint32_t part, std::uint32_t parts) {
+    if (parts == 1) return all_group_blocks; // the CPU's whole searches: no loop per tet
     std::uint32_t blocks = 0;
     for (std::uint32_t i = part; i < bound_group; i += parts) blocks |= 1u << i;
     return blocks;
