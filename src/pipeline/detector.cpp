@@ -60,35 +60,31 @@ struct Detector::Impl {
         if (!rejected.empty()) throw Error(rejected);
     }
 
+    /// The first i below `count` for which bad(i) holds, or count. Every frame's positions pass here,
+    /// so many are scanned on the detector's threads, each to its end: the smallest such i wins.
+    template <class Bad>
+    std::size_t first_where(std::size_t count, const Bad& bad) const {
+        const auto n = static_cast<std::ptrdiff_t>(count);
+        std::ptrdiff_t first = n;
+#pragma omp parallel for num_threads(host_threads()) schedule(static) if (n > host_parallel_elements) reduction(min : first)
+        for (std::ptrdiff_t i = 0; i < n; ++i)
+            if (bad(i)) first = std::min(first, i);
+        return static_cast<std::size_t>(first);
+    }
+
     /// The first of `count` vertices (x y z each, float or double) with a coordinate that is not
     /// finite as the float32 the pipeline stores, or no_vertex. Out-of-range doubles become infinite
-    /// floats, so this also catches values beyond float range. Every frame's positions pass here, so
-    /// many are scanned on the detector's threads, each to its end: the smallest bad index wins.
+    /// floats, so this also catches values beyond float range.
     template <class Scalar>
     std::uint32_t first_non_finite(const Scalar* xyz, std::size_t count) const {
-        const auto n = static_cast<std::ptrdiff_t>(count);
-        std::uint32_t first_bad = no_vertex;
-#pragma omp parallel for num_threads(host_threads()) schedule(static) if (n > host_parallel_elements) reduction(min : first_bad)
-        for (std::ptrdiff_t v = 0; v < n; ++v) {
+        const std::size_t first = first_where(count, [xyz](std::ptrdiff_t v) {
             const vec3 p = to_float(xyz + 3 * v);
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-                first_bad = std::min(first_bad, static_cast<std::uint32_t>(v));
-        }
-        return first_bad;
+            return !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z);
+        });
+        return first < count ? static_cast<std::uint32_t>(first) : no_vertex;
     }
     std::uint32_t first_non_finite(const vec3* p, std::size_t count) const {
         return first_non_finite(reinterpret_cast<const float*>(p), count);
-    }
-
-    /// The position of the first of `count` vertex indices that is not below `vertex_count`, or count:
-    /// many are scanned on the detector's threads, each to its end, the smallest position winning.
-    std::size_t first_index_out_of_range(const std::uint32_t* indices, std::size_t count, std::size_t vertex_count) const {
-        const auto n = static_cast<std::ptrdiff_t>(count);
-        std::ptrdiff_t first_bad = n;
-#pragma omp parallel for num_threads(host_threads()) schedule(static) if (n > host_parallel_elements) reduction(min : first_bad)
-        for (std::ptrdiff_t i = 0; i < n; ++i)
-            if (indices[i] >= vertex_count) first_bad = std::min(first_bad, i);
-        return static_cast<std::size_t>(first_bad);
     }
 
     /// The threads of the host's work on positions: the detector's, as its CPU backend uses.
@@ -140,7 +136,7 @@ struct Detector::Impl {
                         std::to_string(grid_id_mask));
         if (total_vertices >= 0xffffffffull) throw Error("too many vertices for 32-bit ids");
         const ObjectId id = static_cast<ObjectId>(objects());
-        const std::size_t bad_index = first_index_out_of_range(tets, 4 * tet_count, vertex_count);
+        const std::size_t bad_index = first_where(4 * tet_count, [&](std::ptrdiff_t i) { return tets[i] >= vertex_count; });
         if (bad_index < 4 * tet_count)
             throw Error("object " + std::to_string(id) + ": tet " + std::to_string(bad_index / 4) + " has vertex index " +
                         std::to_string(tets[bad_index]) + " out of range [0, " + std::to_string(vertex_count) + ")");
