@@ -200,8 +200,8 @@ TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
 template <std::uint32_t LayerParts, std::uint32_t BlockParts, std::uint32_t PlanChunk>
 struct GpuShapedExec : CpuExec {
     using CpuExec::CpuExec;
-    static constexpr std::uint32_t search_layer_parts = LayerParts;
-    static constexpr std::uint32_t search_block_parts = BlockParts;
+    static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return LayerParts; }
+    static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return BlockParts; }
     static constexpr std::uint32_t plan_chunk = PlanChunk;
 };
 
@@ -235,16 +235,18 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
     for (std::size_t capacity : {std::size_t{0}, std::size_t{1}, std::size_t{200}}) {
         DetectorOptions options;
         options.initial_candidate_capacity = capacity; // small ones make the split items stop and resume
-        for (const auto& [meshes, self] : {std::pair{std::vector<TetMesh>{a, b}, true},
-                                           std::pair{std::vector<TetMesh>{folded, moved(folded, 0.4, 0.02, 0.01, 0.0)}, true}}) {
+        const std::vector<TetMesh> folded_and_moved{folded, moved(folded, 0.4, 0.02, 0.01, 0.0)};
+        for (const auto& [meshes, self] : {std::pair{std::vector<TetMesh>{a, b}, true}, std::pair{folded_and_moved, true},
+                                           std::pair{folded_and_moved, false}}) {
             Pipeline<CpuExec> whole(options);
             Pipeline<GpuShapedExec<3, 1, 1>> by_layers(options);
             Pipeline<GpuShapedExec<1, 8, 256>> by_blocks(options);
             Pipeline<GpuShapedExec<4, 2, 16>> like_cuda(options); // CudaExec's
+            Pipeline<GpuShapedExec<2, 4, 16>> like_cuda_without_self(options); // CudaExec's for small scenes without self-collision
             const FrameResult expected = run_pipeline(whole, meshes, self);
             ASSERT_GT(expected.pairs.size(), 20u);
             for (PipelineBase* split : {static_cast<PipelineBase*>(&by_layers), static_cast<PipelineBase*>(&by_blocks),
-                                        static_cast<PipelineBase*>(&like_cuda)}) {
+                                        static_cast<PipelineBase*>(&like_cuda), static_cast<PipelineBase*>(&like_cuda_without_self)}) {
                 const FrameResult got = run_pipeline(*split, meshes, self);
                 EXPECT_EQ(got.pairs, expected.pairs) << "capacity " << capacity;
                 EXPECT_EQ(got.colliding, expected.colliding);

@@ -143,9 +143,10 @@ public:
     static constexpr std::uint32_t keys_per_appending_item = 16;
 
     /// @brief Work items a tet's candidate search is split into, by layers and by blocks of each list
-    /// (SearchPart): none, so that a thread loads the tet once and its dynamic chunks stay balanced.
-    static constexpr std::uint32_t search_layer_parts = 1;
-    static constexpr std::uint32_t search_block_parts = 1;
+    /// (SearchPart), whether a scene has self-collision and however many tets: none, so that a thread
+    /// loads the tet once and its dynamic chunks stay balanced.
+    static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
+    static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
 
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): many, since an item
     /// adds its counts with a few atomics and bounds the cells by what its previous tet covered.

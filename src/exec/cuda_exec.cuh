@@ -189,16 +189,27 @@ public:
     /// @brief Consecutive keys per work item of a stage that appends what it finds: one, a thread each.
     static constexpr std::uint32_t keys_per_appending_item = 1;
 
-    /// @brief Work items a tet's candidate search is split into (SearchPart): every fourth of its
-    /// layers, and in each list every second block. A thread's search is a chain of dependent loads
-    /// (cells, then blocks of entries) that occupancy cannot hide when a scene has few tets: on an
-    /// H200 the kernel took about as long for 20k tets as for 164k (1-4 ms, the longest threads'
-    /// chains), and on an H100 a warp of the split by layers alone ran 3 of its 32 lanes on average.
-    /// The block parts of a tet are neighbouring lanes that walk the same cells in step. Of 1 x 8,
-    /// 2 x 4, 4 x 1, 4 x 2 and 4 x 4 on an H100 (docs/performance.md), 4 x 2 searched the
-    /// resolution-4 scenes with self-collision fastest and kept the memory of 8 items per tet.
-    static constexpr std::uint32_t search_layer_parts = 4;
-    static constexpr std::uint32_t search_block_parts = 2;
+    /// @brief Work items a tet's candidate search is split into (SearchPart): every fourth of its layers
+    /// and in each list every second block (4 x 2), or, for a scene of at most split_by_blocks_max_tets
+    /// tets without self-collision, every second layer and every fourth block (2 x 4). A thread's search
+    /// is a chain of dependent loads (cells, then blocks of entries) that occupancy cannot hide when a
+    /// scene has few tets: on an H200 the kernel took about as long for 20k tets as for 164k (1-4 ms,
+    /// the longest threads' chains), and on an H100 a warp of the split by layers alone ran 3 of its 32
+    /// lanes on average. The block parts of a tet are neighbouring lanes that walk the same cells in
+    /// step. Of 1 x 8, 2 x 4, 4 x 1, 4 x 2 and 4 x 4 on an H100 (docs/performance.md), 4 x 2 searched
+    /// the resolution-4 scenes with self-collision fastest and the procedural scene from 400k tets on;
+    /// without self-collision 2 x 4 searched the resolution-4 scenes 8-15 % faster, the pass-through
+    /// 17 %, and the procedural scene up to 200k tets a little faster. Both keep 8 items a tet.
+    static constexpr std::size_t split_by_blocks_max_tets = 300000;
+    static constexpr bool split_by_blocks(bool self_collision, std::size_t tets) {
+        return !self_collision && tets <= split_by_blocks_max_tets;
+    }
+    static constexpr std::uint32_t search_layer_parts(bool self_collision, std::size_t tets) {
+        return split_by_blocks(self_collision, tets) ? 2 : 4;
+    }
+    static constexpr std::uint32_t search_block_parts(bool self_collision, std::size_t tets) {
+        return split_by_blocks(self_collision, tets) ? 4 : 2;
+    }
 
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): few, since a thread
     /// walks its tets in series (256 took 0.2-0.33 ms on an H200, a tenth of the frame's kernels);

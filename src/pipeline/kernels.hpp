@@ -492,8 +492,8 @@ struct ObjectFilter {
 
 /// @brief The share of a tet's candidate search that one work item takes: the layers t's own + layer,
 /// + layer + layers, ..., and in each cell's list the blocks of each group that
-/// group_blocks_of_part(block, blocks) names. The GPU splits a search (Exec::search_layer_parts,
-/// Exec::search_block_parts) because a thread's search is a chain of dependent loads that occupancy
+/// group_blocks_of_part(block, blocks) names. The GPU splits a search (Exec::search_layer_parts(),
+/// Exec::search_block_parts()) because a thread's search is a chain of dependent loads that occupancy
 /// cannot hide; the CPU searches a tet whole.
 struct SearchPart {
     std::uint32_t layer = 0, layers = 1;

@@ -259,6 +259,7 @@ private:
     std::size_t pairs_window_ = 0;   ///< room for colliding pairs this frame
     bool grid_planned_ = false;      ///< the grid has been sized from a plan read back once
     bool pairs_sized_ = false;       ///< the pairs' window has been sized from a count read back once
+    bool self_collision_ = false;    ///< some object is checked against itself this frame
     std::size_t colliding_count_ = 0; ///< pairs in out_keys_ after the last detection
     GridView grid_{}; ///< the frame's grid, once populated
 
@@ -403,9 +404,11 @@ GridView Pipeline<Exec>::populate() {
 template <class Exec>
 std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
     // Items are numbered in 32 bits (ResumePoint): a scene too large for that searches its tets whole.
-    const bool split = tets_.size() * Exec::search_layer_parts * Exec::search_block_parts <= 0xffffffffu;
-    const std::uint32_t layer_parts = split ? Exec::search_layer_parts : 1u;
-    const std::uint32_t block_parts = split ? Exec::search_block_parts : 1u;
+    const std::uint32_t layer_parts_wanted = Exec::search_layer_parts(self_collision_, tets_.size());
+    const std::uint32_t block_parts_wanted = Exec::search_block_parts(self_collision_, tets_.size());
+    const bool split = tets_.size() * layer_parts_wanted * block_parts_wanted <= 0xffffffffu;
+    const std::uint32_t layer_parts = split ? layer_parts_wanted : 1u;
+    const std::uint32_t block_parts = split ? block_parts_wanted : 1u;
     const std::size_t parts = std::size_t{layer_parts} * block_parts;
     const std::size_t all_items = tets_.size() * parts, resume_room = tets_.size();
     for (auto& points : resume_points_) points.resize_discard(resume_room);
@@ -695,6 +698,8 @@ void Pipeline<Exec>::start(const std::vector<PositionUpload>& uploads, const std
     clock_.mark(frame_start);
     for (const PositionUpload& u : uploads) exec_.upload(positions_.data() + u.first, u.positions, u.count);
     exec_.upload(pair_enabled_.data(), pair_enabled.data(), pair_enabled.size());
+    self_collision_ = false;
+    for (std::size_t o = 0, objects = object_boxes_.size(); o < objects; ++o) self_collision_ |= pair_enabled[o * objects + o] != 0;
     enqueue_frame();
 }
 
