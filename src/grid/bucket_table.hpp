@@ -193,7 +193,8 @@ KDET_HD inline std::uint32_t claim_bucket(const GridView& g, CellCoord cell) {
             h.next = no_bucket;
             h.tail = slot;
             atomic_store_release(&h.state, ready);
-            const std::uint32_t order = atomic_fetch_add(g.cells_claimed, 1u);
+            // One counter for every cell claimed: on a GPU the claims of a warp take one atomic.
+            const std::uint32_t order = atomic_fetch_add_gathered(g.cells_claimed, 1u);
             g.claimed_slots[order] = slot;
             return slot;
         }
@@ -299,7 +300,9 @@ KDET_HD inline void gather_cell(const GridView& g, std::uint32_t order, const Ob
     std::uint32_t total = 0;
     for (std::uint32_t b = g.claimed_slots[order]; b != no_bucket; b = g.headers[b].next)
         total += g.headers[b].count < g.bucket_capacity ? g.headers[b].count : g.bucket_capacity;
-    const std::uint32_t first = atomic_fetch_add(g.entries_used, total);
+    // One counter for every list: on a GPU a warp's lists take one atomic (each claimed cell took
+    // its own, and they queued on the one address).
+    const std::uint32_t first = atomic_fetch_add_gathered(g.entries_used, total);
     if (first > g.entry_capacity || total > g.entry_capacity - first) {
         atomic_fetch_or(g.failure, static_cast<std::uint32_t>(grid_entries_full));
         main.count = 0;

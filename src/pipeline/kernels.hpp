@@ -274,8 +274,9 @@ struct TetSizeKernel {
         vec3 v[4];
         load_tet(scene, static_cast<std::uint32_t>(t), v);
         info.layer = 0;
+        // A scene fills a few of the bins: on a GPU a warp's adds to one bin take one atomic.
         if (t % spacing_sample == 1 && scene.tet_object[t - 1] == scene.tet_object[t])
-            atomic_fetch_add(&spacing_octaves[float_octave(tet_spacing(info.box, scene.info[t - 1].box))], 1u);
+            atomic_fetch_add_gathered(&spacing_octaves[float_octave(tet_spacing(info.box, scene.info[t - 1].box))], 1u);
         scene.planes[t] = tet_planes(v);
         const float longest = longest_edge(v);
         const SphereDiameterBounds bounds = sphere_diameter_bounds(longest);
