@@ -47,9 +47,12 @@ for program in "$bundle"/kdet*; do
     xargs -r cp -Ln -t "$bundle/lib/"
 done
 # The device tool carries 64 MiB with the working tree: the programs go without their symbols (Nsight
-# Compute names the kernels from the device code); with several older builds, drop what a call does not
-# run (the sort-and-sweep peer, the tests) until `du` below and the tree fit.
+# Compute names the kernels from the device code) and packed with xz, about a third of their size
+# (scripts/gpu-session.sh unpacks them; by hand there: `xz -dc .gpu-bundle/kdet.xz >/tmp/kdet`). With
+# many older builds, drop what a call does not run (the sort-and-sweep peer, the tests) until `du`
+# below and the tree fit.
 strip "$bundle"/kdet*
+xz -T0 -6 "$bundle"/kdet*
 git -C "$repo" log -1 --format='built at commit %H %s' >"$bundle/commit.txt"
 git -C "$repo" status --short --untracked-files=no >>"$bundle/commit.txt"
 tar -C "$data_dir" -cJf "$bundle/models.tar.xz" .

@@ -30,13 +30,18 @@ for part in "$@"; do
   esac
 done
 work="$(mktemp -d)"
-mkdir -p "$out" "$work/models" "$work/cache" "$work/bench"
+bin="$work/bin" # the bundle's programs, unpacked
+mkdir -p "$out" "$work/models" "$work/cache" "$work/bench" "$bin"
 tar -C "$work/models" -xJf "$bundle/models.tar.xz"
 tar -C "$work/cache" -xJf "$bundle/cache.tar.xz"
+for packed in "$bundle"/kdet*.xz; do
+  program="$bin/$(basename "$packed" .xz)"
+  xz -dc "$packed" >"$program" && chmod +x "$program"
+done
 export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export KDET_DATA_DIR="$work/models" KDET_CACHE_DIR="$work/cache"
-kdet="$bundle/kdet"
-tests="$bundle/kdet_tests"
+kdet="$bin/kdet"
+tests="$bin/kdet_tests"
 sanitizer="$(command -v compute-sanitizer || ls /usr/local/cuda*/bin/compute-sanitizer 2>/dev/null | head -1)"
 nsight_compute="$(command -v ncu || ls /usr/local/cuda*/bin/ncu /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -1)"
 
@@ -102,7 +107,7 @@ for part in "$@"; do
     done
     ;;
   peer)
-    step peer 150 "$bundle/kdet_gpu_vs_sweep" --csv "$work/peer.csv"
+    step peer 150 "$bin/kdet_gpu_vs_sweep" --csv "$work/peer.csv"
     ;;
   profile)
     for case in "armadillos-r4-self-yes armadillos -r 4 -s yes --frames 80:81" \
@@ -129,7 +134,7 @@ for part in "$@"; do
     done
     ;;
   compare)
-    others=$(cd "$bundle" && ls kdet-* 2>/dev/null)
+    others=$(cd "$bin" && ls kdet-* 2>/dev/null)
     for round in 1 2; do
       for program in $others kdet; do
         for case in "procedural-100k procedural --tets 100000 -s no --frames 55:65" \
@@ -141,7 +146,7 @@ for part in "$@"; do
           "procedural-1m procedural --tets 1000000 -s no --frames 59:61" \
           "procedural-4m procedural --tets 4000000 -s no --frames 59:61"; do
           read -r name arguments <<<"$case"
-          step "compare-$round-$program-$name" 30 "$bundle/$program" bench $arguments -n 3 --backend cuda --quiet \
+          step "compare-$round-$program-$name" 30 "$bin/$program" bench $arguments -n 3 --backend cuda --quiet \
             -d "$work/compare/$program-$round"
         done
       done
@@ -155,7 +160,7 @@ for part in "$@"; do
 done
 
 ls "$work/bench"/*.csv >/dev/null 2>&1 && python3 "$repo/python/kdet_summary.py" "$work/bench" >/dev/null 2>&1
-tar -C "$work" --exclude=models --exclude=cache -czf "$out/gpu-session.tar.gz" .
+tar -C "$work" --exclude=models --exclude=cache --exclude=bin -czf "$out/gpu-session.tar.gz" .
 [[ -f "$work/peer.log" ]] && tail -15 "$work/peer.log"
 grep -h "FAILED\|PASSED\|ERROR SUMMARY\|RACECHECK SUMMARY" "$work"/*.log 2>/dev/null | sort | uniq -c | head -40
 cat "$out/steps.txt"
