@@ -136,6 +136,20 @@ public:
         for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
     }
 
+    /// @brief for_each for a stage whose neighbouring items write to the same places (populating, where
+    /// tets next to each other in the storage order share most of their cells): each thread takes runs
+    /// of consecutive items, eight per thread in all (at least 256 items each), still shared out
+    /// dynamically. With for_each's chunks of 256 the threads inserted into the same cells at once,
+    /// contending for their buckets' lines and interleaving their ids, which then left most of the
+    /// cells' lists to be sorted.
+    template <class F>
+    void for_each_in_runs(std::uint64_t n, const F& f) const {
+        const auto count = static_cast<std::int64_t>(n);
+        const std::int64_t run = std::max<std::int64_t>(256, count / (8 * std::int64_t{threads_}));
+#pragma omp parallel for schedule(dynamic, run) num_threads(threads_) if (count > 512)
+        for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
+    }
+
     /// @brief Consecutive keys per work item of a stage that appends what it finds: a batch's worth, so
     /// that a thread appends them with one atomic (threads contend for the one counter). More would
     /// leave small stages too few items to share (64 ran a resolution-4 scene's narrow phase on one

@@ -256,6 +256,13 @@ public:
         cuda_check(cudaGetLastError(), "kernel launch");
     }
 
+    /// @brief for_each: on the GPU a thread takes one item whatever its neighbours write (the CPU's
+    /// threads share out long runs instead).
+    template <class F>
+    void for_each_in_runs(std::uint64_t n, const F& f) const {
+        for_each(n, f);
+    }
+
     /// @brief Runs f(i) for every i below the count in device memory (at most `capacity`), divided by
     /// `per_item` (rounded up) when each item takes that many: a stage whose size an earlier stage
     /// counted is launched without the host reading the count. The grid covers at most counted_blocks
