@@ -435,9 +435,10 @@ struct PopulateKernel {
 
 /// @brief Stage 2, after populating: one work item per main bucket, the i-th for the cell claimed
 /// i-th (GridView::claimed_slots; the items past the claimed cells record empty lists); copies each
-/// cell's ids into one contiguous list (gather_cell), sorted next by the execution layer. Cells claimed
-/// one after the other belong to neighbouring tets, so the lists it writes stay close together in
-/// memory, as do the lists a tet's search reads.
+/// cell's ids into one contiguous list (gather_cell), sorted next by the execution layer. Each thread
+/// claims cells for neighbouring tets one after the other, so the lists this writes stay close
+/// together in memory, as do the lists a tet's search reads (the CPU's threads, each populating a run
+/// of tets of its own, interleave their claims).
 struct GatherCellsKernel {
     SceneView scene;
     GridView grid;
