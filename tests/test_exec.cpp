@@ -52,25 +52,31 @@ TEST(CpuSort, SortsTheCountedKeysOfEveryWidthAndLeavesNoKeyOut) {
     std::mt19937_64 random(11);
     // Small counts take the comparison sort, larger ones the radix passes, on up to `threads` slices
     // of at least 32k keys (100,003 keys: three slices of unequal size on three threads); pair keys
-    // leave bits 20-31 zero (a pass every key shares), 64 bits use every digit.
+    // leave bits 20-31 zero (a pass every key shares, or, told so, bits the passes skip: then digits
+    // span the gap), 64 bits use every digit.
+    struct Width {
+        int bits, low_word_bits;
+    };
     for (const int threads : {1, 2, 3})
         for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{100003}})
-            for (const int bits : {1, 11, 12, 33, 52, 64}) {
+            for (const Width w : {Width{1, 32}, Width{11, 32}, Width{12, 32}, Width{33, 32}, Width{52, 32}, Width{52, 20},
+                                  Width{49, 17}, Width{38, 0}, Width{64, 32}}) {
                 DetectorOptions options;
                 options.threads = threads;
                 const CpuExec exec(options);
                 std::vector<std::uint64_t> keys(n + 5, 0x5555u); // 5 slots past the count, not sorted
                 for (std::size_t i = 0; i < n; ++i) {
-                    std::uint64_t key = bits == 64 ? random() : random() & ((std::uint64_t{1} << bits) - 1);
-                    if (bits == 52) key &= ~(std::uint64_t{0xfff} << 20);
+                    std::uint64_t key = w.bits == 64 ? random() : random() & ((std::uint64_t{1} << w.bits) - 1);
+                    if (w.bits == 52) key &= ~(std::uint64_t{0xfff} << 20);
+                    if (w.bits > 32) key &= ~(((std::uint64_t{1} << 32) - 1) & ~((std::uint64_t{1} << w.low_word_bits) - 1));
                     keys[i] = key;
                 }
                 std::vector<std::uint64_t> expected(keys.begin(), keys.begin() + static_cast<std::ptrdiff_t>(n));
                 std::sort(expected.begin(), expected.end());
                 const unsigned long long count = n;
-                exec.sort(keys.data(), keys.size(), &count, bits);
+                exec.sort(keys.data(), keys.size(), &count, w.bits, w.low_word_bits);
                 EXPECT_TRUE(std::equal(expected.begin(), expected.end(), keys.begin()))
-                    << n << " keys of " << bits << " bits, " << threads << " threads";
+                    << n << " keys of " << w.bits << " bits (low word " << w.low_word_bits << "), " << threads << " threads";
             }
 }
 

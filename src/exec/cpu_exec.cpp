@@ -13,10 +13,10 @@ namespace kdet {
 CpuExec::CpuExec(const DetectorOptions& options)
     : threads_(options.threads > 0 ? options.threads : omp_get_max_threads()) {}
 
-void CpuExec::sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
+void CpuExec::sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits, int low_word_bits) const {
     const std::size_t n = std::min<std::size_t>(capacity, *count);
     if (sort_scratch_.size() < n) sort_scratch_.resize_discard(n);
-    radix_sort(keys, n, bits, sort_scratch_.data(), threads_);
+    radix_sort(keys, n, bits, sort_scratch_.data(), threads_, 0, low_word_bits);
 }
 
 void CpuExec::sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t, const std::uint32_t* begin,

@@ -182,9 +182,10 @@ public:
     }
 
     /// @brief Sorts the first min(*count, capacity) keys ascending (the count in the backend's memory);
-    /// keys after them up to `capacity` may change. Every key is below 2^bits, which shortens the
-    /// radix sort (one pass per 11 bits here, per 8 in CUB's).
-    void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const;
+    /// keys after them up to `capacity` may change. Every key is below 2^bits and its low word below
+    /// 2^low_word_bits, which shortens the radix sort (one pass per 12 bits used here, per 8 bits
+    /// below 2^bits in CUB's).
+    void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits, int low_word_bits = 32) const;
 
     /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
     /// sorted ascending (the grid's lists by id); the lists are disjoint and lie within the first

@@ -292,9 +292,11 @@ public:
 
     /// @brief Sorts the first min(*count, capacity) keys ascending, the count in device memory; every key
     /// is below 2^bits, so the radix passes stop there. The host does not know the count, so all
-    /// `capacity` keys are sorted, those after the count set to all ones first: they sort last.
+    /// `capacity` keys are sorted, those after the count set to all ones first: they sort last (and
+    /// fill their low words, so the passes cannot skip the low word's unused bits as the CPU's do).
     /// The double-buffer form needs `capacity` spare keys and no copy of the keys inside CUB's scratch.
-    void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
+    void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits,
+              int /*low_word_bits*/ = 32) const {
         if (capacity < 2) return;
         for_each(capacity, PadKeysKernel{keys, count});
         sort_keys(keys, capacity, bits);

@@ -10,10 +10,12 @@ namespace kdet {
 
 /// @brief Sorts keys[0, n) ascending by their bits [first_bit, bits), every key below 2^bits, stably
 /// (keys equal in those bits keep their order; with first_bit 0, simply ascending): least significant
-/// digit first, 11 bits a pass, a pass skipped where every key has the same digit; `scratch` holds n
-/// keys. Up to `threads` threads count and move a slice of the keys each. Small inputs go to a
-/// comparison sort.
-void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch, int threads, int first_bit = 0);
+/// digit first, at most 12 bits a pass, a pass skipped where every key has the same digit; `scratch`
+/// holds n keys. Keys with a value in each word (pair keys) may say that their low word is below
+/// 2^low_word_bits (then first_bit must be 0): the passes skip the low word's unused bits. Up to
+/// `threads` threads count and move a slice of the keys each. Small inputs go to a comparison sort.
+void radix_sort(std::uint64_t* keys, std::size_t n, int bits, std::uint64_t* scratch, int threads, int first_bit = 0,
+                int low_word_bits = 32);
 
 /// @brief Bits of a key whose high word (from bit 32 on) holds a value below `high_values`: every such
 /// key is below 2^bits, so a radix sort can stop there.

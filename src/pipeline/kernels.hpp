@@ -96,6 +96,8 @@ KDET_HD inline std::uint64_t proven_pair_key(std::uint32_t t, std::uint32_t u) {
 }
 /// @brief Bits a pair key of tet ids below tet_count needs: the lower id fills the high word.
 inline int pair_key_bits(std::uint32_t tet_count) { return high_word_key_bits(tet_count); }
+/// @brief Bits of a pair key's low word (the higher id) that a tet id below tet_count can set.
+inline int pair_key_low_word_bits(std::uint32_t tet_count) { return pair_key_bits(tet_count) - 32; }
 KDET_HD inline std::uint32_t key_first(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
 KDET_HD inline std::uint32_t key_second(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xffffffffu); }
 

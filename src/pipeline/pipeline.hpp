@@ -519,8 +519,9 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     });
     clock_.mark(narrow_phase_done);
     // The keys hold the caller's ids, which are below the tet count.
-    exec_.sort(out_keys_.data(), out_keys_.size(), &c->colliding_pairs,
-               pair_key_bits(static_cast<std::uint32_t>(tets_.size())));
+    const auto tet_count = static_cast<std::uint32_t>(tets_.size());
+    exec_.sort(out_keys_.data(), out_keys_.size(), &c->colliding_pairs, pair_key_bits(tet_count),
+               pair_key_low_word_bits(tet_count));
     clock_.mark(sorted);
     if (options_.contacts) {
         resize_filled(out_contacts_, pairs_window_, Contact{});
