@@ -81,8 +81,10 @@ constexpr float k_plane_min_edge_ratio = 0x1p-20f;
 /// the four faces are evaluated together (vector instructions on the CPU).
 struct TetPlanes {
     float nx[4], ny[4], nz[4]; ///< unit normal of face k (opposite vertex k), pointing away from vertex k; 0 if unused
-    float offset[4];           ///< the tet's highest projection onto normal k, relative to origin
-    vec3 origin;               ///< the tet's vertex 0
+    float offset[4];           ///< the tet's highest projection onto normal k, relative to vertex 0
+    /// The tet's vertices, beside its planes: the pre-test reads the other tet's from here, where
+    /// loading them through its indices took two dependent cache misses.
+    vec3 vertex[4];
     float longest;             ///< longest edge
     float separation_scale[4]; ///< face k's separation margin is separation_scale[k] * L^2; infinite for an
                                ///< unused face
@@ -93,7 +95,7 @@ struct TetPlanes {
 /// @brief The face planes of tet v.
 KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     TetPlanes p;
-    p.origin = v[0];
+    for (int k = 0; k < 4; ++k) p.vertex[k] = v[k];
     const vec3 q[4] = {make_vec3(0.0f, 0.0f, 0.0f), v[1] - v[0], v[2] - v[0], v[3] - v[0]};
     float largest = 0.0f;
     for (int i = 1; i < 4; ++i) largest = max_f(largest, max_f(fabsf(q[i].x), max_f(fabsf(q[i].y), fabsf(q[i].z))));
@@ -166,7 +168,7 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
 
 /// @brief Signed distance of point w beyond each face plane k of p.
 KDET_HD inline void plane_distances(const TetPlanes& p, vec3 w, float distance[4]) {
-    const vec3 r = w - p.origin;
+    const vec3 r = w - p.vertex[0];
     KDET_VECTOR_LOOP
     for (int k = 0; k < 4; ++k) distance[k] = p.nx[k] * r.x + p.ny[k] * r.y + p.nz[k] * r.z - p.offset[k];
 }

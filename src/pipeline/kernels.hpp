@@ -663,25 +663,22 @@ struct FindCandidatesKernel {
         std::uint32_t t;
         SpreadIndices tet;
         std::uint32_t object;
-        vec3 vertices[4];
-        TetPlanes planes;
+        TetPlanes planes; ///< t's, its vertices included
         unsigned long long rejected;
         KDET_HD void operator()(const GridEntry& e) {
+            // u's indices are loaded only for a pair within one object, whose tets sharing a vertex
+            // are skipped.
             const std::uint32_t u = e.id();
-            // u's vertices (and, from another object, its indices) are loaded only for the pairs that
-            // u's planes do not separate. The loader only reads the indices: when it also wrote them,
-            // they lived on the stack, stored and reloaded for every pair.
-            if (e.object == object) {
-                const TetIndices other = scene->tets[u];
-                if (!share_vertex(tet, other)) pretest(u, [&](vec3 w[4]) { load_vertices(*scene, other, w); });
-            } else {
-                pretest(u, [&](vec3 w[4]) { load_tet(*scene, u, w); });
-            }
+            if (e.object != object || !share_vertex(tet, scene->tets[u])) pretest(u);
         }
-        /// The face-plane pre-test of (t, u); writes the pair unless it is proven separated.
-        template <class LoadU>
-        KDET_HD void pretest(std::uint32_t u, const LoadU& load_u) {
-            const PlaneVerdict verdict = face_plane_pretest_loading(planes, vertices, scene->planes[u], load_u, false);
+        /// The face-plane pre-test of (t, u); writes the pair unless it is proven separated. u's
+        /// vertices are read (from beside its planes) only when its planes do not separate the pair.
+        KDET_HD void pretest(std::uint32_t u) {
+            const TetPlanes& other = scene->planes[u];
+            const auto load_u = [&other](vec3 w[4]) {
+                for (int k = 0; k < 4; ++k) w[k] = other.vertex[k];
+            };
+            const PlaneVerdict verdict = face_plane_pretest_loading(planes, planes.vertex, other, load_u, false);
             if (verdict == PlaneVerdict::separated) {
                 ++rejected;
                 return;
@@ -706,8 +703,7 @@ struct FindCandidatesKernel {
             return;
         }
         KeyBatch batch(&out, already_stored);
-        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], {}, scene.planes[t], 0};
-        load_tet(scene, t, emit.vertices);
+        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], scene.planes[t], 0};
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
         batch.flush();
