@@ -131,9 +131,7 @@ public:
     template <class F>
     void for_each(std::uint64_t n, const F& f, std::uint32_t work_per_item = 1) const {
         const auto count = static_cast<std::int64_t>(n);
-        const std::int64_t chunk = std::max<std::int64_t>(1, 256 / std::int64_t{work_per_item});
-#pragma omp parallel for schedule(dynamic, chunk) num_threads(threads_) if (count * work_per_item > 512)
-        for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
+        for_each_in_chunks(count, std::max<std::int64_t>(1, 256 / std::int64_t{work_per_item}), count * work_per_item > 512, f);
     }
 
     /// @brief for_each for a stage whose neighbouring items write to the same places (populating, where
@@ -145,9 +143,7 @@ public:
     template <class F>
     void for_each_in_runs(std::uint64_t n, const F& f) const {
         const auto count = static_cast<std::int64_t>(n);
-        const std::int64_t run = std::max<std::int64_t>(256, count / (8 * std::int64_t{threads_}));
-#pragma omp parallel for schedule(dynamic, run) num_threads(threads_) if (count > 512)
-        for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
+        for_each_in_chunks(count, std::max<std::int64_t>(256, count / (8 * std::int64_t{threads_})), count > 512, f);
     }
 
     /// @brief Consecutive keys per work item of a stage that appends what it finds: a batch's worth, so
@@ -287,6 +283,14 @@ public:
     std::string device_name() const;
 
 private:
+    /// @brief f(i) for i in [0, count), shared out in dynamic chunks of `chunk` items, on one thread
+    /// unless `parallel`.
+    template <class F>
+    void for_each_in_chunks(std::int64_t count, std::int64_t chunk, bool parallel, const F& f) const {
+#pragma omp parallel for schedule(dynamic, chunk) num_threads(threads_) if (parallel)
+        for (std::int64_t i = 0; i < count; ++i) f(static_cast<std::uint64_t>(i));
+    }
+
     struct PendingDownload {
         void* host;
         const void* device;

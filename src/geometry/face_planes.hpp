@@ -269,34 +269,22 @@ KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float
 /// @brief What the face planes prove about two tets whose boxes overlap.
 enum class PlaneVerdict { unsure, separated, intersecting };
 
-/// @brief The face-plane pre-test of tets a and b (with their planes pa and pb), where `load_b(w)`
-/// writes b's four vertices to w: b's planes go first, and b's vertices are loaded only when they do
-/// not separate the pair. In the grid's pairs b is the larger tet, whose faces separate more pairs
-/// (the bunny cases: 70-76 % of the pairs, against 45-48 % by a's). With `separation_only`, an
-/// intersection is not looked for (the caller only rejects).
-template <class LoadB>
-KDET_HD inline PlaneVerdict face_plane_pretest_loading(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
-                                                       const LoadB& load_b, bool separation_only) {
+/// @brief The face-plane pre-test of tets a and b (with their planes pa and pb): b's planes go first,
+/// and b's vertices are read only when they do not separate the pair (the grid's pairs read them from
+/// beside b's planes, TetPlanes::vertex). In the grid's pairs b is the larger tet, whose faces
+/// separate more pairs (the bunny cases: 70-76 % of the pairs, against 45-48 % by a's). With
+/// `separation_only`, an intersection is not looked for (the caller only rejects).
+KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
+                                               const vec3 b[4], bool separation_only) {
     const float longest = max_f(pa.longest, pb.longest), longest2 = longest * longest;
     const PlaneSides a_by_b = plane_sides(pb, a, longest2);
     if (a_by_b.separated) return PlaneVerdict::separated;
-    vec3 b[4];
-    load_b(b);
     const PlaneSides b_by_a = plane_sides(pa, b, longest2);
     if (b_by_a.separated) return PlaneVerdict::separated;
     if (separation_only) return PlaneVerdict::unsure;
     if (b_by_a.inside || a_by_b.inside || edges_pass_inside(pa, b, longest2) || edges_pass_inside(pb, a, longest2))
         return PlaneVerdict::intersecting;
     return PlaneVerdict::unsure;
-}
-
-/// @brief face_plane_pretest_loading with b's vertices at hand.
-KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
-                                               const vec3 b[4], bool separation_only) {
-    const auto copy_b = [b](vec3 w[4]) {
-        for (int k = 0; k < 4; ++k) w[k] = b[k];
-    };
-    return face_plane_pretest_loading(pa, a, pb, copy_b, separation_only);
 }
 
 } // namespace kdet

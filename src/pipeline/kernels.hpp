@@ -118,12 +118,11 @@ KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint
 template <NarrowPhase Test>
 KDET_HD inline bool candidate_collides(const SceneView& s, std::uint32_t first, std::uint32_t second,
                                        bool& exact_stage) {
-    vec3 a[4], b[4];
-    load_tet(s, first, a);
-    load_tet(s, second, b);
-    const PlaneVerdict verdict = face_plane_pretest(s.planes[first], a, s.planes[second], b, false);
+    // A grid method's pair: both tets' planes, and their vertices beside them, are this frame's.
+    const TetPlanes &pa = s.planes[first], &pb = s.planes[second];
+    const PlaneVerdict verdict = face_plane_pretest(pa, pa.vertex, pb, pb.vertex, false);
     if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
-    return tets_intersect_as<Test>(a, b, exact_stage, true);
+    return tets_intersect_as<Test>(pa.vertex, pb.vertex, exact_stage, true);
 }
 
 /// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, and
@@ -671,14 +670,10 @@ struct FindCandidatesKernel {
             const std::uint32_t u = e.id();
             if (e.object != object || !share_vertex(tet, scene->tets[u])) pretest(u);
         }
-        /// The face-plane pre-test of (t, u); writes the pair unless it is proven separated. u's
-        /// vertices are read (from beside its planes) only when its planes do not separate the pair.
+        /// The face-plane pre-test of (t, u); writes the pair unless it is proven separated.
         KDET_HD void pretest(std::uint32_t u) {
             const TetPlanes& other = scene->planes[u];
-            const auto load_u = [&other](vec3 w[4]) {
-                for (int k = 0; k < 4; ++k) w[k] = other.vertex[k];
-            };
-            const PlaneVerdict verdict = face_plane_pretest_loading(planes, planes.vertex, other, load_u, false);
+            const PlaneVerdict verdict = face_plane_pretest(planes, planes.vertex, other, other.vertex, false);
             if (verdict == PlaneVerdict::separated) {
                 ++rejected;
                 return;
