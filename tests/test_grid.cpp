@@ -317,7 +317,7 @@ struct SizedTets {
         objects.assign(count, 0u);
         infos.resize(count);
         planes.resize(count);
-        scene = SceneView{positions.data(), tets.data(), objects.data(), infos.data(), planes.data(), &self,
+        scene = SceneView{positions.data(), tets.data(), objects.data(), infos.data(), planes.data(), nullptr, &self,
                           &checked, &everywhere_box, count, 1};
         DetectorOptions options;
         options.threads = threads;

@@ -13,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <random>
 #include <set>
 #include <string>
@@ -159,6 +161,51 @@ TEST(Pipeline, NearTouchingPairsGetEachTestsOwnAnswer) {
         grid.method = Method::kdet_no_pairs;
         EXPECT_EQ(run({pairs.first, pairs.second}, false, grid).colliding, flags_of(oracle.pairs, oracle.colliding))
             << to_string(narrow);
+    }
+}
+
+TEST(Pipeline, PairsThatOnlyAnEdgeAxisSeparatesGetEachTestsOwnAnswer) {
+    // Two wedges whose nearest edges cross at a gap along their common normal, which no face axis
+    // shows: sat_no_edges reports every such pair, the other tests none. The normal is turned onto each
+    // slab direction (slabs.hpp), with a few spins about it, so that the slabs separate what the boxes
+    // cannot: the grid methods must reject the pairs with them for every test but sat_no_edges.
+    const double directions[8][3] = {{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}, {1, 1, 0}, {1, -1, 0}, {1, 0, 1}, {1, 0, -1}};
+    TetMesh first, second;
+    std::size_t count = 0;
+    for (const auto& direction : directions)
+        for (int spin = 0; spin < 4; ++spin)
+            for (double gap : {0.05, 0.2, 0.5, 0.9}) {
+                // A frame (u, v, n) with n along the direction, turned by `spin` about it.
+                const double length = std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
+                const double n[3] = {direction[0] / length, direction[1] / length, direction[2] / length};
+                const double helper[3] = {std::fabs(n[0]) < 0.9 ? 1.0 : 0.0, std::fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+                double u[3] = {helper[1] * n[2] - helper[2] * n[1], helper[2] * n[0] - helper[0] * n[2], helper[0] * n[1] - helper[1] * n[0]};
+                const double u_length = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+                for (double& c : u) c /= u_length;
+                const double w[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+                const double angle = 0.4 * spin, cs = std::cos(angle), sn = std::sin(angle);
+                const double centre[3] = {10.0 * static_cast<double>(count % 16), 10.0 * static_cast<double>(count / 16), 0.0};
+                auto place = [&](TetMesh& mesh, std::initializer_list<std::array<double, 3>> corners) {
+                    for (const auto& p : corners) {
+                        const double a = cs * p[0] - sn * p[1], b = sn * p[0] + cs * p[1];
+                        for (int c = 0; c < 3; ++c) mesh.positions.push_back(centre[c] + a * u[c] + b * w[c] + p[2] * n[c]);
+                    }
+                    for (std::uint32_t k = 0; k < 4; ++k) mesh.tets.push_back(static_cast<std::uint32_t>(4 * count) + k);
+                };
+                place(first, {{-1, 0, 0}, {1, 0, 0}, {0, -1, -1}, {0, 1, -1}});
+                place(second, {{0, -1, gap}, {0, 1, gap}, {-1, 0, 1 + gap}, {1, 0, 1 + gap}});
+                ++count;
+            }
+    for (NarrowPhase narrow : test::every_narrow_phase_test()) {
+        DetectorOptions brute = with_method(Method::brute_force_loop), grid = with_method(Method::kdet);
+        brute.narrow_phase = grid.narrow_phase = narrow;
+        const Outcome oracle = run({first, second}, false, brute);
+        const Outcome found = run({first, second}, false, grid);
+        EXPECT_EQ(found.pairs, oracle.pairs) << to_string(narrow);
+        const bool reports_them = narrow == NarrowPhase::sat_no_edges;
+        EXPECT_EQ(oracle.pairs.size(), reports_them ? count : 0u) << to_string(narrow);
+        EXPECT_EQ(found.counts.candidates, count) << to_string(narrow);
+        EXPECT_EQ(found.counts.unique_candidates, reports_them ? count : 0u) << to_string(narrow);
     }
 }
 

@@ -53,7 +53,7 @@ struct StageTimes {
 /// @brief Sizes of one detection.
 struct FrameCounts {
     std::uint64_t candidates = 0;        ///< candidate pairs found (boxes overlap, not adjacent), each once
-    std::uint64_t unique_candidates = 0; ///< of which the face-plane pre-test could not reject: the narrow phase runs on these
+    std::uint64_t unique_candidates = 0; ///< of which the pre-test (slabs, face planes) could not reject: the narrow phase runs on these
     std::uint64_t colliding_pairs = 0;
     std::uint64_t colliding_tets = 0;    ///< tets flagged as colliding, all objects together
     std::uint64_t exact_stage_pairs = 0; ///< NarrowPhase::exact: pairs its float filter left to the exact stage

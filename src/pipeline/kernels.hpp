@@ -5,6 +5,7 @@
 
 #include "geometry/enclosing_sphere.hpp"
 #include "geometry/face_planes.hpp"
+#include "geometry/slabs.hpp"
 #include "geometry/tet_intersect.hpp"
 #include "exec/radix_sort.hpp"
 #include "grid/bucket_table.hpp"
@@ -38,6 +39,9 @@ struct SceneView {
     const std::uint32_t* tet_object;
     TetInfo* info;
     TetPlanes* planes; ///< per tet, for the pre-test; computed for the tets that can collide this frame
+    /// Per tet, for the pre-test, computed with the planes; null where the narrow phase's test may call
+    /// far-apart pairs intersecting (sat_no_edges, see slabs.hpp): no pair is rejected by them then.
+    TetSlabs* slabs;
     const std::uint8_t* pair_active; ///< [object_count * object_count]; diagonal = self-collision
     const std::uint32_t* checked_objects; ///< [object_count] object_bit of every object a is checked against
     const Aabb* object_boxes;
@@ -279,6 +283,7 @@ struct TetSizeKernel {
         if (t % spacing_sample == 1 && scene.tet_object[t - 1] == scene.tet_object[t])
             atomic_fetch_add_gathered(&spacing_octaves[float_octave(tet_spacing(info.box, scene.info[t - 1].box))], 1u);
         scene.planes[t] = tet_planes(v);
+        if (scene.slabs) scene.slabs[t] = tet_slabs(v, scene.planes[t].longest);
         const float longest = longest_edge(v);
         const SphereDiameterBounds bounds = sphere_diameter_bounds(longest);
         const std::uint32_t lower = float_to_ordered(bounds.lower), upper = float_to_ordered(bounds.upper);
@@ -627,10 +632,11 @@ struct KeyBatch {
     }
 };
 
-/// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the face-plane pre-test cannot
-/// prove separated (those it can are only counted): a rejected pair is never written, sorted or
-/// loaded again. A pair it proves intersecting is written as a proven_pair_key, so that the narrow
-/// phase neither repeats the pre-test nor runs the test on it. A tet whose keys did not all fit leaves a ResumePoint instead of counting its
+/// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the pre-test (the slabs where the
+/// scene has them, then the face planes) cannot prove separated (those it can are only counted): a
+/// rejected pair is never written, sorted or loaded again. A pair the face planes prove intersecting is
+/// written as a proven_pair_key, so that the narrow phase neither repeats the pre-test nor runs the
+/// test on it. A tet whose keys did not all fit leaves a ResumePoint instead of counting its
 /// rejections; a rerun after growing (`resume_from` set) visits only those tets.
 struct FindCandidatesKernel {
     SceneView scene;
@@ -663,11 +669,18 @@ struct FindCandidatesKernel {
         SpreadIndices tet;
         std::uint32_t object;
         TetPlanes planes; ///< t's, its vertices included
+        TetSlabs slabs;   ///< t's, where the scene has them
         unsigned long long rejected;
         KDET_HD void operator()(const GridEntry& e) {
+            const std::uint32_t u = e.id();
+            // First the slabs, whose 64 bytes separate about half of the pairs (slabs.hpp); tets that
+            // share a vertex touch, so the slabs never separate them.
+            if (scene->slabs && slabs_separate(slabs, scene->slabs[u])) {
+                ++rejected;
+                return;
+            }
             // u's indices are loaded only for a pair within one object, whose tets sharing a vertex
             // are skipped.
-            const std::uint32_t u = e.id();
             if (e.object != object || !share_vertex(tet, scene->tets[u])) pretest(u);
         }
         /// The face-plane pre-test of (t, u); writes the pair unless it is proven separated.
@@ -698,7 +711,8 @@ struct FindCandidatesKernel {
             return;
         }
         KeyBatch batch(&out, already_stored);
-        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], scene.planes[t], 0};
+        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], scene.planes[t],
+                  scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
         batch.flush();

@@ -96,6 +96,7 @@ public:
         exec_.upload(vertex_user_id_.data(), topology.vertex_user_id.data(), topology.vertex_count);
         info_.resize_discard(tets);
         planes_.resize_discard(tets);
+        slabs_.resize_discard(tets);
         colliding_.resize_discard(tets);
         user_colliding_.resize_discard(tets);
         const std::size_t objects = topology.object_tet_begin.size() - 1;
@@ -135,7 +136,7 @@ public:
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
                user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() + vertex_user_id_.capacity_bytes() +
                staged_positions_.capacity_bytes() +
-               info_.capacity_bytes() + planes_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
+               info_.capacity_bytes() + planes_.capacity_bytes() + slabs_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
                grid_bytes() + counters_.capacity_bytes() +
@@ -161,7 +162,9 @@ public:
 
 private:
     SceneView scene_view() {
-        return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), pair_active_.data(),
+        // sat_no_edges calls pairs intersecting that only an edge axis separates, however far apart.
+        TetSlabs* slabs = options_.narrow_phase == NarrowPhase::sat_no_edges ? nullptr : slabs_.data();
+        return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), slabs, pair_active_.data(),
                          checked_objects_.data(), object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
                          static_cast<std::uint32_t>(object_boxes_.size())};
     }
@@ -226,6 +229,7 @@ private:
     buffer<vec3> staged_positions_; ///< handed over on the device, current once a frame found them finite
     buffer<TetInfo> info_;
     buffer<TetPlanes> planes_;
+    buffer<TetSlabs> slabs_;
     buffer<std::uint32_t> colliding_;      ///< per stored tet
     buffer<std::uint32_t> user_colliding_; ///< per tet in the caller's numbering
     buffer<std::uint32_t> run_objects_;    ///< per run of tets of one object (stage 1's reduction)
