@@ -206,6 +206,9 @@ TEST(Pipeline, PairsThatOnlyAnEdgeAxisSeparatesGetEachTestsOwnAnswer) {
         EXPECT_EQ(oracle.pairs.size(), reports_them ? count : 0u) << to_string(narrow);
         EXPECT_EQ(found.counts.candidates, count) << to_string(narrow);
         EXPECT_EQ(found.counts.unique_candidates, reports_them ? count : 0u) << to_string(narrow);
+        grid.method = Method::kdet_no_pairs;
+        EXPECT_EQ(run({first, second}, false, grid).colliding, flags_of(oracle.pairs, oracle.colliding))
+            << to_string(narrow);
     }
 }
 

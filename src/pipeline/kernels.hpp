@@ -118,11 +118,13 @@ KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint
 }
 
 /// @brief The decision for a pair whose boxes overlap and that is not adjacent (first < second): the
-/// face-plane pre-test where it is sure (the answer the test gives, see face_planes.hpp), else the test.
+/// pre-test where it is sure (the slabs where the scene has them, then the face planes; the answer the
+/// test gives, see slabs.hpp and face_planes.hpp), else the test.
 template <NarrowPhase Test>
 KDET_HD inline bool candidate_collides(const SceneView& s, std::uint32_t first, std::uint32_t second,
                                        bool& exact_stage) {
-    // A grid method's pair: both tets' planes, and their vertices beside them, are this frame's.
+    // A grid method's pair: both tets' slabs, planes and the vertices beside them are this frame's.
+    if (s.slabs && slabs_separate(s.slabs[first], s.slabs[second])) return false;
     const TetPlanes &pa = s.planes[first], &pb = s.planes[second];
     const PlaneVerdict verdict = face_plane_pretest(pa, pa.vertex, pb, pb.vertex, false);
     if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
