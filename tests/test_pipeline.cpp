@@ -175,7 +175,7 @@ TEST(Pipeline, PairsThatOnlyAnEdgeAxisSeparatesGetEachTestsOwnAnswer) {
     for (const auto& direction : directions)
         for (int spin = 0; spin < 4; ++spin)
             for (double gap : {0.05, 0.2, 0.5, 0.9}) {
-                // A frame (u, v, n) with n along the direction, turned by `spin` about it.
+                // A frame (u, w, n) with n along the direction, turned by `spin` about it.
                 const double length = std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
                 const double n[3] = {direction[0] / length, direction[1] / length, direction[2] / length};
                 const double helper[3] = {std::fabs(n[0]) < 0.9 ? 1.0 : 0.0, std::fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};

@@ -52,7 +52,7 @@ double largest_slab_gap(const vec3 a[4], const vec3 b[4]) {
 
 TetSlabs slabs_of(const vec3 v[4]) { return tet_slabs(v, static_cast<float>(longest_edge(v))); }
 
-/// The direction along which only the widened slabs separate the pair, or -1.
+/// The first direction along which the widened slabs are disjoint, or -1.
 int separating_direction(const TetSlabs& a, const TetSlabs& b) {
     for (int d = 0; d < slab_directions; ++d)
         if (a.hi[d] < b.lo[d] || b.hi[d] < a.lo[d]) return d;
