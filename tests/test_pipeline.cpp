@@ -172,17 +172,18 @@ TEST(Pipeline, PairsThatOnlyAnEdgeAxisSeparatesGetEachTestsOwnAnswer) {
     const double directions[8][3] = {{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}, {1, 1, 0}, {1, -1, 0}, {1, 0, 1}, {1, 0, -1}};
     TetMesh first, second;
     std::size_t count = 0;
-    for (const auto& direction : directions)
+    for (const auto& direction : directions) {
+        // A frame (u, w, n) with n along the direction.
+        const double length = std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
+        const double n[3] = {direction[0] / length, direction[1] / length, direction[2] / length};
+        const double helper[3] = {std::fabs(n[0]) < 0.9 ? 1.0 : 0.0, std::fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+        double u[3] = {helper[1] * n[2] - helper[2] * n[1], helper[2] * n[0] - helper[0] * n[2], helper[0] * n[1] - helper[1] * n[0]};
+        const double u_length = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        for (double& c : u) c /= u_length;
+        const double w[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
         for (int spin = 0; spin < 4; ++spin)
             for (double gap : {0.05, 0.2, 0.5, 0.9}) {
-                // A frame (u, w, n) with n along the direction, turned by `spin` about it.
-                const double length = std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
-                const double n[3] = {direction[0] / length, direction[1] / length, direction[2] / length};
-                const double helper[3] = {std::fabs(n[0]) < 0.9 ? 1.0 : 0.0, std::fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
-                double u[3] = {helper[1] * n[2] - helper[2] * n[1], helper[2] * n[0] - helper[0] * n[2], helper[0] * n[1] - helper[1] * n[0]};
-                const double u_length = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-                for (double& c : u) c /= u_length;
-                const double w[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+                // The wedges turned by `spin` about n.
                 const double angle = 0.4 * spin, cs = std::cos(angle), sn = std::sin(angle);
                 const double centre[3] = {10.0 * static_cast<double>(count % 16), 10.0 * static_cast<double>(count / 16), 0.0};
                 auto place = [&](TetMesh& mesh, std::initializer_list<std::array<double, 3>> corners) {
@@ -196,6 +197,7 @@ TEST(Pipeline, PairsThatOnlyAnEdgeAxisSeparatesGetEachTestsOwnAnswer) {
                 place(second, {{0, -1, gap}, {0, 1, gap}, {-1, 0, 1 + gap}, {1, 0, 1 + gap}});
                 ++count;
             }
+    }
     for (NarrowPhase narrow : test::every_narrow_phase_test()) {
         DetectorOptions brute = with_method(Method::brute_force_loop), grid = with_method(Method::kdet);
         brute.narrow_phase = grid.narrow_phase = narrow;

@@ -20,6 +20,11 @@ using Point = std::array<double, 3>;
 constexpr double k_directions[slab_directions][3] = {{1, 1, 1},  {1, 1, -1}, {1, -1, 1}, {-1, 1, 1},
                                                      {1, 1, 0},  {1, -1, 0}, {1, 0, 1},  {1, 0, -1}};
 
+double direction_length(int d) {
+    return std::sqrt(k_directions[d][0] * k_directions[d][0] + k_directions[d][1] * k_directions[d][1] +
+                     k_directions[d][2] * k_directions[d][2]);
+}
+
 double along(const vec3& v, int d) {
     return k_directions[d][0] * v.x + k_directions[d][1] * v.y + k_directions[d][2] * v.z; // exact in double
 }
@@ -43,9 +48,7 @@ double largest_slab_gap(const vec3 a[4], const vec3 b[4]) {
             lo_a = std::min(lo_a, along(a[k], d)), hi_a = std::max(hi_a, along(a[k], d));
             lo_b = std::min(lo_b, along(b[k], d)), hi_b = std::max(hi_b, along(b[k], d));
         }
-        const double length = std::sqrt(k_directions[d][0] * k_directions[d][0] + k_directions[d][1] * k_directions[d][1] +
-                                         k_directions[d][2] * k_directions[d][2]);
-        gap = std::max(gap, std::max(lo_b - hi_a, lo_a - hi_b) / length);
+        gap = std::max(gap, std::max(lo_b - hi_a, lo_a - hi_b) / direction_length(d));
     }
     return gap;
 }
@@ -71,8 +74,7 @@ TEST(Slabs, SeparateOnlyPairsFartherApartThanTheMarginAtAnyDistanceFromTheOrigin
         for (int n = 0; n < 20000; ++n) {
             const double size = std::exp2(20.0 * unit(rng) - 10.0);
             const int d = n % slab_directions;
-            const double length = std::sqrt(k_directions[d][0] * k_directions[d][0] +
-                                            k_directions[d][1] * k_directions[d][1] + k_directions[d][2] * k_directions[d][2]);
+            const double length = direction_length(d);
             Point centre{offset * size * unit(rng), offset * size * unit(rng), offset * size * unit(rng)};
             std::array<Point, 4> pa, pb;
             for (auto* tet : {&pa, &pb})
