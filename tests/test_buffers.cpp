@@ -38,6 +38,21 @@ TEST(HostBuffer, ShrinkingKeepsTheMemory) {
     EXPECT_EQ(buffer.capacity_bytes(), 100u * sizeof(std::uint32_t));
 }
 
+TEST(HostBuffer, HoldsOverAlignedRowsOnTheirAlignmentAtEverySize) {
+    // Rows aligned beyond what malloc promises (the grid's block bounds, the slabs): small buffers come
+    // from the general allocator, large ones from huge pages; each size must keep the alignment.
+    struct alignas(64) Row {
+        float lanes[16];
+    };
+    for (std::size_t n : {std::size_t{1}, std::size_t{3}, std::size_t{1000}, std::size_t{40000}}) {
+        for (int attempt = 0; attempt < 8; ++attempt) {
+            HostBuffer<Row> buffer;
+            buffer.resize_discard(n);
+            EXPECT_EQ(reinterpret_cast<std::uintptr_t>(buffer.data()) % alignof(Row), 0u) << n << " rows";
+        }
+    }
+}
+
 TEST(GrownCapacity, KeepsWhatSufficesAndOtherwiseGrowsByAQuarterAtLeast) {
     EXPECT_EQ(grown_capacity(0, 1000, 1u << 30), 1000u);        // the first sizing: what is asked for
     EXPECT_EQ(grown_capacity(1000, 1000, 1u << 30), 1000u);     // enough: unchanged

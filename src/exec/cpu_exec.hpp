@@ -35,8 +35,9 @@ struct Free {
     void operator()(void* p) const { std::free(p); }
 };
 
-/// Uninitialised memory for `count` objects of `size` bytes; throws std::bad_alloc when it cannot.
-inline void* allocate(std::size_t count, std::size_t size) {
+/// Uninitialised memory for `count` objects of `size` bytes aligned to `alignment` (a power of two);
+/// throws std::bad_alloc when it cannot.
+inline void* allocate(std::size_t count, std::size_t size, std::size_t alignment) {
     if (count > std::numeric_limits<std::size_t>::max() / size) throw std::bad_alloc();
     const std::size_t bytes = count * size;
     void* p = nullptr;
@@ -46,6 +47,8 @@ inline void* allocate(std::size_t count, std::size_t size) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
         if (p) madvise(p, rounded, MADV_HUGEPAGE); // advice only: failing it is harmless
 #endif
+    } else if (alignment > alignof(std::max_align_t)) {
+        p = std::aligned_alloc(alignment, (std::max<std::size_t>(bytes, 1) + alignment - 1) / alignment * alignment);
     } else {
         p = std::malloc(bytes == 0 ? 1 : bytes);
     }
@@ -69,7 +72,7 @@ public:
         if (n > capacity_) {
             data_.reset();
             size_ = capacity_ = 0;
-            data_.reset(static_cast<T*>(host_memory::allocate(n, sizeof(T))));
+            data_.reset(static_cast<T*>(host_memory::allocate(n, sizeof(T), alignof(T))));
             capacity_ = n;
         }
         size_ = n;
