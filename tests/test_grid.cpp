@@ -591,7 +591,7 @@ TEST(BucketTable, AScanVisitsExactlyTheMatchingEntriesOfItsRangeWhereverTheRange
             for (std::uint32_t end = begin + 1; end <= n; end += 5) {
                 const Aabb query{{window[0], 0.5f, 0.5f}, {window[1], 0.6f, 0.6f}};
                 SeenIds seen;
-                grid_for_each_in_entries(c.view, begin, end, query, 0u, seen);
+                grid_for_each_in_entries(c.view, begin, end, query, any_object, 0u, seen);
                 std::vector<std::uint32_t> expected;
                 for (std::uint32_t k = begin; k < end; ++k)
                     if (static_cast<float>(k) + 0.5f >= window[0] && static_cast<float>(k) <= window[1]) expected.push_back(k);
@@ -612,12 +612,12 @@ TEST(BucketTable, AScanSharedByPartsReadsEachBlockInExactlyOnePart) {
     const Aabb query{{10.2f, 0.5f, 0.5f}, {141.7f, 0.6f, 0.6f}};
     for (const auto& [begin, end] : {std::pair{0u, n}, std::pair{5u, 71u}, std::pair{63u, 66u}, std::pair{17u, 140u}}) {
         SeenIds whole;
-        grid_for_each_in_entries(c.view, begin, end, query, 0u, whole);
+        grid_for_each_in_entries(c.view, begin, end, query, any_object, 0u, whole);
         for (std::uint32_t parts : {1u, 2u, 4u, 8u}) {
             std::vector<std::uint32_t> together;
             for (std::uint32_t part = 0; part < parts; ++part) {
                 SeenIds seen;
-                grid_for_each_in_entries(c.view, begin, end, query, 0u, seen, group_blocks_of_part(part, parts));
+                grid_for_each_in_entries(c.view, begin, end, query, any_object, 0u, seen, group_blocks_of_part(part, parts));
                 for (std::uint32_t id : seen.ids) EXPECT_EQ(id / entry_block % parts, part) << id;
                 together.insert(together.end(), seen.ids.begin(), seen.ids.end());
             }
@@ -757,13 +757,57 @@ TEST(BucketTable, ACellHoldingNoneOfTheObjectsAskedForIsSkippedUnread) {
         grid_for_each_in_cell(c.view, cell, 0u, objects, everywhere, 0u, count);
         return count.n;
     };
-    EXPECT_EQ(visited(mixed, object_bit(5)), 12u);
+    // The lists lie in claim order: mixed's ids 0-11 in entries 0-11, so its first block (ids 0-7) holds
+    // both objects and its second (ids 8-11, then alone's) only object 3, which a query for object 5
+    // skips (AScanSkipsTheBlocksHoldingNoneOfTheObjectsAskedFor).
+    EXPECT_EQ(visited(mixed, object_bit(5)), 8u);
     EXPECT_EQ(visited(mixed, object_bit(3)), 12u);
     EXPECT_EQ(visited(mixed, object_bit(7)), 0u);
     EXPECT_EQ(visited(alone, object_bit(5)), 0u);
     EXPECT_EQ(visited(alone, object_bit(5) | object_bit(3)), 6u);
     EXPECT_EQ(visited(alone, object_bit(35)), 6u);
     EXPECT_EQ(visited(alone, any_object), 6u);
+}
+
+TEST(BucketTable, AScanSkipsTheBlocksHoldingNoneOfTheObjectsAskedFor) {
+    // One list of 150 entries (list_along_x's boxes) whose objects come in runs of random length, as a
+    // list of several objects' tets does (an object's tets are consecutive ids), with a few strays,
+    // objects up to 40 so that bits wrap (object_bit). Every entry of the range whose box overlaps the
+    // query is visited exactly when its block holds an entry of a wanted object; so every overlapping
+    // entry of a wanted object is.
+    constexpr std::uint32_t n = 150;
+    std::mt19937 rng(29);
+    const auto pick = [&rng](std::uint32_t below) { return static_cast<std::uint32_t>(rng() % below); };
+    std::vector<std::uint32_t> object_of(n);
+    for (std::uint32_t k = 0, object = 0; k < n; ++k) {
+        if (pick(9) == 0) object = pick(41);
+        object_of[k] = pick(23) == 0 ? pick(41) : object;
+    }
+    TestTable table(64, 4, 64, 32, HashFunction::djb2);
+    for (std::uint32_t i = 0; i < n; ++i) ASSERT_NE(grid_insert(table.view, CellCoord{2, 3, 4, 0}, i, 0u), no_bucket);
+    const auto c = table.compacted(n, [&](std::uint32_t id) {
+        const float x = static_cast<float>(id);
+        return GridEntry{Aabb{{x, 0.0f, 0.0f}, {x + 0.5f, 1.0f, 1.0f}}, id, object_of[id]};
+    });
+    ASSERT_EQ(c.failure, 0u);
+    const auto block_holds = [&](std::uint32_t block, std::uint32_t objects) {
+        for (std::uint32_t k = block * entry_block; k < std::min(n, (block + 1) * entry_block); ++k)
+            if (object_bit(object_of[k]) & objects) return true;
+        return false;
+    };
+    for (int trial = 0; trial < 300; ++trial) {
+        const std::uint32_t begin = pick(n), end = begin + 1 + pick(n - begin);
+        const float from = static_cast<float>(pick(160)) - 5.0f, to = from + static_cast<float>(pick(60));
+        const std::uint32_t objects = trial % 10 == 0 ? any_object : object_bit(pick(41)) | (trial % 3 ? 0u : object_bit(pick(41)));
+        const Aabb query{{from, 0.5f, 0.5f}, {to, 0.6f, 0.6f}};
+        SeenIds seen;
+        grid_for_each_in_entries(c.view, begin, end, query, objects, 0u, seen);
+        std::vector<std::uint32_t> expected;
+        for (std::uint32_t k = begin; k < end; ++k)
+            if (static_cast<float>(k) + 0.5f >= from && static_cast<float>(k) <= to && block_holds(k / entry_block, objects))
+                expected.push_back(k);
+        ASSERT_EQ(seen.ids, expected) << "trial " << trial;
+    }
 }
 
 TEST(BucketCapacity, AutomaticIsFourTimesTheMeanIdsPerCellRoundedUpToAPowerOfTwoFrom4To32) {

@@ -57,6 +57,9 @@ KDET_HD inline std::uint32_t object_bit(std::uint32_t object) { return 1u << (ob
 /// @brief The mask of a query that is checked against every object.
 constexpr std::uint32_t any_object = ~0u;
 
+/// @brief The object bits (object_bit) of objects 0 to count - 1 together.
+KDET_HD inline std::uint32_t all_object_bits(std::uint32_t count) { return count >= 32u ? any_object : (1u << count) - 1u; }
+
 /// @brief Bits of an id as the buckets and lists store it; above them, the axes along which the id's
 /// box starts in the cell (bit a: its first cell along axis a is this one), which decides the cell
 /// a pair is reported from. Tet ids stay below 2^grid_id_bits (Detector checks).
@@ -122,10 +125,15 @@ static_assert(bound_group * entry_block == 64 && bound_group <= 32, "a group's e
 
 /// @brief The bounds of bound_group consecutive blocks of entries (group g: blocks [g * bound_group,
 /// (g + 1) * bound_group)), each field a row with a lane per block, so that a query tests the bounds
-/// of a whole group at once (see grid_for_each_in_entries).
-struct BlockBoundGroup {
+/// of a whole group at once (see grid_for_each_in_entries): the box around the block's boxes and the
+/// objects its entries belong to (object_bit of each). A list holds its ids in order, and an object's
+/// tets are consecutive ids, so most blocks hold one object's entries, which a query checked only
+/// against other objects skips unread (half the entries of two objects that overlap). Aligned to cache
+/// lines: unaligned, the 224 bytes spread the box rows, which every query reads, over a fourth line.
+struct alignas(64) BlockBoundGroup {
     float lo[3][bound_group];
     float hi[3][bound_group];
+    std::uint32_t objects[bound_group];
 };
 
 /// @brief Where a tet sits in the cells of its own layer, so that its queries there need neither a
@@ -352,14 +360,18 @@ KDET_HD inline void bound_entry_block(const GridView& g, std::uint32_t block, st
     const std::uint32_t begin = block * entry_block;
     if (begin >= used) return;
     const std::uint32_t end = used - begin < entry_block ? used : begin + entry_block;
-    Aabb bound = load_entry(g, begin).box;
+    const GridEntry first = load_entry(g, begin);
+    Aabb bound = first.box;
+    std::uint32_t objects = object_bit(first.object);
     for (std::uint32_t k = begin + 1; k < end; ++k) {
-        const Aabb box = load_entry(g, k).box;
-        bound.lo = min_v(bound.lo, box.lo);
-        bound.hi = max_v(bound.hi, box.hi);
+        const GridEntry e = load_entry(g, k);
+        bound.lo = min_v(bound.lo, e.box.lo);
+        bound.hi = max_v(bound.hi, e.box.hi);
+        objects |= object_bit(e.object);
     }
     BlockBoundGroup& group = g.block_bounds[block / bound_group];
     set_lane_box(group.lo, group.hi, block % bound_group, bound);
+    group.objects[block % bound_group] = objects;
 }
 
 /// @brief The bound of block `block`, as bound_entry_block stored it.
@@ -368,12 +380,19 @@ KDET_HD inline Aabb block_bound(const GridView& g, std::uint32_t block) {
     return lane_box(group.lo, group.hi, block % bound_group);
 }
 
-/// @brief The blocks of a group whose bounds overlap `box`, as a mask (bit i for lane i), every lane
+/// @brief The blocks of a group whose bounds overlap `box` and that hold an entry of one of `objects`
+/// (object_bit of each; any_object reads no block's objects), as a mask (bit i for lane i), every lane
 /// computed without a branch (see matching_lanes); the caller masks the blocks outside its list.
-KDET_HD KDET_ALWAYS_INLINE std::uint32_t overlapping_blocks(const BlockBoundGroup& g, const Aabb& box) {
+KDET_HD KDET_ALWAYS_INLINE std::uint32_t overlapping_blocks(const BlockBoundGroup& g, const Aabb& box, std::uint32_t objects) {
     std::uint32_t lanes[bound_group];
-    KDET_VECTOR_LOOP
-    for (std::uint32_t i = 0; i < bound_group; ++i) lanes[i] = lane_overlaps(g.lo, g.hi, i, box) ? ~0u : 0u;
+    if (objects == any_object) {
+        KDET_VECTOR_LOOP
+        for (std::uint32_t i = 0; i < bound_group; ++i) lanes[i] = lane_overlaps(g.lo, g.hi, i, box) ? ~0u : 0u;
+    } else {
+        KDET_VECTOR_LOOP
+        for (std::uint32_t i = 0; i < bound_group; ++i)
+            lanes[i] = lane_overlaps(g.lo, g.hi, i, box) & ((g.objects[i] & objects) != 0u) ? ~0u : 0u;
+    }
     return lane_bits(lanes);
 }
 
@@ -429,13 +448,14 @@ KDET_HD constexpr std::uint32_t group_blocks_of_part(std::uint32_t part, std::ui
 
 /// @brief Calls visit(entry) for every entry k in [begin, end) of the compacted lists (begin < end) whose
 /// box overlaps `box` and whose start bits include `required_starts` (see GridEntry::starts), in the
-/// blocks of each group that `group_blocks` names; the entries of a block whose bound misses `box` are
-/// not read. A group of blocks at a time: its bounds tested at once, its matches gathered into one mask
-/// and visited in one loop, where a branch per block on its bound and a loop per block over its matches
-/// each mispredicted about once a block.
+/// blocks of each group that `group_blocks` names; the entries of a block whose bound misses `box`, or
+/// which holds none of the `objects` (object_bit of each, or any_object), are not read. The visitor
+/// checks the entry's object itself. A group of blocks at a time: its bounds tested at once, its
+/// matches gathered into one mask and visited in one loop, where a branch per block on its bound and a
+/// loop per block over its matches each mispredicted about once a block.
 template <class Visitor>
 KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t begin, std::uint32_t end, const Aabb& box,
-                                             std::uint32_t required_starts, Visitor& visit,
+                                             std::uint32_t objects, std::uint32_t required_starts, Visitor& visit,
                                              std::uint32_t group_blocks = all_group_blocks) {
     // Copies: the visitor's stores might alias them for all the compiler knows, which would have
     // every block reload the box and spread it over the vector lanes again.
@@ -449,7 +469,7 @@ KDET_HD inline void grid_for_each_in_entries(const GridView& g, std::uint32_t be
         // per query): the range's ends within the group by selects, then bit_range.
         const std::uint32_t blocks_before = first_block > group_block ? first_block - group_block : 0u;
         const std::uint32_t blocks_in_range = last_block - group_block < bound_group ? last_block - group_block + 1 : bound_group;
-        std::uint32_t passing = overlapping_blocks(bounds[group], query) & group_blocks &
+        std::uint32_t passing = overlapping_blocks(bounds[group], query, objects) & group_blocks &
                                 static_cast<std::uint32_t>(bit_range(blocks_before, blocks_in_range));
         std::uint64_t matches = 0;
         while (passing) {
@@ -491,7 +511,7 @@ KDET_HD inline void grid_for_each_in_cell(const GridView& g, CellCoord cell, std
         else
             high = middle;
     }
-    if (begin < end) grid_for_each_in_entries(g, begin, end, box, required_starts, visit, group_blocks);
+    if (begin < end) grid_for_each_in_entries(g, begin, end, box, objects, required_starts, visit, group_blocks);
 }
 
 /// @brief grid_for_each_in_cell on cell `index` of tet `id`'s own cells (OwnCells) with first_id
@@ -508,7 +528,7 @@ KDET_HD inline void grid_for_each_after_own_entry(const GridView& g, std::uint32
     if ((h.state >> 1) != g.stamp || !(h.objects & objects)) return;
     const std::uint32_t first = h.first_entry, end = first + h.count;
     const std::uint32_t begin = row.after[index] > first ? row.after[index] : first;
-    if (begin < end) grid_for_each_in_entries(g, begin, end, box, required_starts, visit, group_blocks);
+    if (begin < end) grid_for_each_in_entries(g, begin, end, box, objects, required_starts, visit, group_blocks);
 }
 
 } // namespace kdet

@@ -536,7 +536,10 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     if (self.layer < 0 || *grid.failure) return;
     const std::uint32_t object = scene.tet_object[t];
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
-    const std::uint32_t checked_objects = scene.checked_objects[object];
+    // A tet checked against every object filters none: any_object spares its scans the blocks' objects.
+    const std::uint32_t checked_objects = scene.checked_objects[object] == all_object_bits(scene.object_count)
+                                              ? any_object
+                                              : scene.checked_objects[object];
     ObjectFilter<Visitor> filter{checked_against, &visit};
     const std::uint32_t group_blocks = group_blocks_of_part(part.block, part.blocks);
     for (int layer = self.layer + static_cast<int>(part.layer); layer < params.layer_count;
