@@ -248,12 +248,14 @@ TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
 }
 
 /// The CPU backend with its work divided as the GPU's is: the candidate search split into parts by
-/// layers and by blocks of each list (SearchPart) and the grid's plan in small chunks (Exec::plan_chunk).
-template <std::uint32_t LayerParts, std::uint32_t BlockParts, std::uint32_t PlanChunk>
+/// layers and by blocks of each list (SearchPart), a tet per search item (or TetsPerItem), and the
+/// grid's plan in small chunks (Exec::plan_chunk).
+template <std::uint32_t LayerParts, std::uint32_t BlockParts, std::uint32_t PlanChunk, std::uint32_t TetsPerItem = 1>
 struct GpuShapedExec : CpuExec {
     using CpuExec::CpuExec;
     static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return LayerParts; }
     static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return BlockParts; }
+    static constexpr std::uint32_t search_tets_per_item = TetsPerItem;
     static constexpr std::uint32_t plan_chunk = PlanChunk;
 };
 
@@ -295,10 +297,13 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
             Pipeline<GpuShapedExec<1, 8, 256>> by_blocks(options);
             Pipeline<GpuShapedExec<4, 2, 16>> like_cuda(options); // CudaExec's
             Pipeline<GpuShapedExec<2, 4, 16>> like_cuda_without_self(options); // CudaExec's for small scenes without self-collision
-            const FrameResult expected = run_pipeline(whole, meshes, self);
+            // Runs of 7 tets, split by layers: runs end inside objects and the last one is short.
+            Pipeline<GpuShapedExec<3, 1, 256, 7>> odd_runs(options);
+            const FrameResult expected = run_pipeline(whole, meshes, self); // runs of CpuExec::search_tets_per_item
             ASSERT_GT(expected.pairs.size(), 20u);
             for (PipelineBase* split : {static_cast<PipelineBase*>(&by_layers), static_cast<PipelineBase*>(&by_blocks),
-                                        static_cast<PipelineBase*>(&like_cuda), static_cast<PipelineBase*>(&like_cuda_without_self)}) {
+                                        static_cast<PipelineBase*>(&like_cuda), static_cast<PipelineBase*>(&like_cuda_without_self),
+                                        static_cast<PipelineBase*>(&odd_runs)}) {
                 const FrameResult got = run_pipeline(*split, meshes, self);
                 EXPECT_EQ(got.pairs, expected.pairs) << "capacity " << capacity;
                 EXPECT_EQ(got.colliding, expected.colliding);

@@ -161,6 +161,11 @@ public:
     static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
     static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
 
+    /// @brief Consecutive tets per work item of the candidate search: a thread appends their keys and
+    /// adds their rejections with one atomic per run, where one item per tet took two on counters that
+    /// share a cache line, which the two threads passed back and forth (soup 100k: 6-9 % of a frame).
+    static constexpr std::uint32_t search_tets_per_item = 32;
+
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): many, since an item
     /// adds its counts with a few atomics and bounds the cells by what its previous tet covered.
     static constexpr std::uint32_t plan_chunk = 256;

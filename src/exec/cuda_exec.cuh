@@ -231,6 +231,10 @@ public:
         return split_by_blocks(self_collision, tets) ? 4 : 2;
     }
 
+    /// @brief Consecutive tets per work item of the candidate search: one, a thread's search is long
+    /// enough (its appends are gathered per warp).
+    static constexpr std::uint32_t search_tets_per_item = 1;
+
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): few, since a thread
     /// walks its tets in series (256 took 0.2-0.33 ms on an H200, a tenth of the frame's kernels);
     /// the plan's bound on the cells loosens a little (each item counts its first tet's cells whole).

@@ -641,8 +641,10 @@ struct KeyBatch {
 /// scene has them, then the face planes) cannot prove separated (those it can are only counted): a
 /// rejected pair is never written, sorted or loaded again. A pair the face planes prove intersecting is
 /// written as a proven_pair_key, so that the narrow phase neither repeats the pre-test nor runs the
-/// test on it. A tet whose keys did not all fit leaves a ResumePoint instead of counting its
-/// rejections; a rerun after growing (`resume_from` set) visits only those tets.
+/// test on it. An item searches a run of tets_per_item consecutive tets (SearchPart's share of each)
+/// and appends their keys and adds their rejections together. An item whose keys did not all fit
+/// leaves a ResumePoint instead of counting its rejections; a rerun after growing (`resume_from` set)
+/// runs only those items.
 struct FindCandidatesKernel {
     SceneView scene;
     GridView grid;
@@ -654,13 +656,14 @@ struct FindCandidatesKernel {
     ResumePoint* stopped;           ///< [stopped_capacity] where the items that did not fit stopped
     std::uint32_t* stopped_count;   ///< items that stopped, also those past the capacity (not recorded)
     std::uint32_t stopped_capacity;
-    /// Work items per tet (SearchPart): layer_parts x block_parts, item (l * tets + t) * block_parts + b
-    /// searching layer part l and block part b of tet t. The block parts of a tet are neighbouring
-    /// items, which walk the same cells in step and read neighbouring blocks; the layer parts are far
-    /// apart, so that a scene whose tets sit on one or two layers leaves whole warps of later layer
-    /// parts idle, not lanes of every warp.
+    /// Work items per run of tets (SearchPart): layer_parts x block_parts, item (l * runs + r) *
+    /// block_parts + b searching layer part l and block part b of the tets of run r. The block parts of
+    /// a run are neighbouring items, which walk the same cells in step and read neighbouring blocks;
+    /// the layer parts are far apart, so that a scene whose tets sit on one or two layers leaves whole
+    /// warps of later layer parts idle, not lanes of every warp.
     std::uint32_t layer_parts;
     std::uint32_t block_parts;
+    std::uint32_t tets_per_item; ///< Exec::search_tets_per_item: tets [r * tets_per_item, ...) make run r
     /// A frame that resumes the items that did not fit (a first frame): such an item stops searching at
     /// once, since its resumption searches again. Otherwise it searches on, counting the room the
     /// whole frame needs, so that a single rerun fits.
@@ -702,13 +705,20 @@ struct FindCandidatesKernel {
         KDET_HD bool finished() const { return stop_when_full && batch->stopped; }
     };
 
+    /// @brief The runs of tets that items are made of (the last one may be shorter).
+    KDET_HD static std::uint32_t run_count(std::uint32_t tets, std::uint32_t tets_per_item) {
+        return tets / tets_per_item + (tets % tets_per_item ? 1u : 0u);
+    }
+
     KDET_HD void operator()(std::uint64_t i) const {
         const auto item = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
-        const std::uint32_t tet_part = item / block_parts;
-        const std::uint32_t t = tet_part % scene.tet_count;
-        const SearchPart part{tet_part / scene.tet_count, layer_parts, item % block_parts, block_parts};
-        const int layer = scene.info[t].layer;
-        if (layer < 0 || layer + static_cast<int>(part.layer) >= params->layer_count) return;
+        const std::uint32_t run_part = item / block_parts;
+        const std::uint32_t runs = run_count(scene.tet_count, tets_per_item);
+        const std::uint32_t first = run_part % runs * tets_per_item;
+        const std::uint32_t end = scene.tet_count - first < tets_per_item ? scene.tet_count : first + tets_per_item;
+        const SearchPart part{run_part / runs, layer_parts, item % block_parts, block_parts};
+        const GridParams grid_params = *params;
+        const std::uint32_t layers = *layer_mask;
         const std::uint32_t already_stored = resume_from ? resume_from[i].stored : 0u;
         // Once a first frame's buffer is full, an item that has not started would only search until
         // its first batch and then search again after the buffer grows: it waits for that at once.
@@ -717,16 +727,21 @@ struct FindCandidatesKernel {
             return;
         }
         KeyBatch batch(&out, already_stored);
-        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], scene.planes[t],
-                  scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
-        const GridParams grid_params = *params;
-        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
+        unsigned long long run_rejected = 0;
+        for (std::uint32_t t = first; t < end && !(stop_when_full && batch.stopped); ++t) {
+            const int layer = scene.info[t].layer;
+            if (layer < 0 || layer + static_cast<int>(part.layer) >= grid_params.layer_count) continue;
+            Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], scene.planes[t],
+                      scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
+            for_each_larger_neighbour(scene, grid, grid_params, layers, t, emit, part);
+            run_rejected += emit.rejected;
+        }
         batch.flush();
         if (batch.stopped) {
             record_stop(ResumePoint{item, batch.stored});
             return;
         }
-        if (emit.rejected) atomic_fetch_add_gathered(rejected, emit.rejected);
+        if (run_rejected) atomic_fetch_add_gathered(rejected, run_rejected);
     }
 
     KDET_HD void record_stop(const ResumePoint& point) const {

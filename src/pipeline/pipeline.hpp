@@ -414,7 +414,9 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
     const std::uint32_t layer_parts = split ? layer_parts_wanted : 1u;
     const std::uint32_t block_parts = split ? block_parts_wanted : 1u;
     const std::size_t parts = std::size_t{layer_parts} * block_parts;
-    const std::size_t all_items = tets_.size() * parts, resume_room = tets_.size();
+    const std::uint32_t tets_per_item = Exec::search_tets_per_item;
+    const std::size_t runs = FindCandidatesKernel::run_count(static_cast<std::uint32_t>(tets_.size()), tets_per_item);
+    const std::size_t all_items = runs * parts, resume_room = tets_.size();
     for (auto& points : resume_points_) points.resize_discard(resume_room);
     std::size_t items = all_items;
     std::size_t first_slot = 0; ///< where this run's keys start in the buffer
@@ -426,7 +428,8 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         exec_.for_each(items, FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected,
                                                    resume_from, stopped, &c->stopped_items,
                                                    static_cast<std::uint32_t>(resume_room), layer_parts, block_parts,
-                                                   !pairs_sized_});
+                                                   tets_per_item, !pairs_sized_},
+                       tets_per_item);
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
         if (!after.stopped_items) return after;
