@@ -641,10 +641,12 @@ struct KeyBatch {
 /// scene has them, then the face planes) cannot prove separated (those it can are only counted): a
 /// rejected pair is never written, sorted or loaded again. A pair the face planes prove intersecting is
 /// written as a proven_pair_key, so that the narrow phase neither repeats the pre-test nor runs the
-/// test on it. An item searches a run of tets_per_item consecutive tets (SearchPart's share of each)
-/// and appends their keys and adds their rejections together. An item whose keys did not all fit
-/// leaves a ResumePoint instead of counting its rejections; a rerun after growing (`resume_from` set)
-/// runs only those items.
+/// test on it. An item searches a run of TetsPerItem consecutive tets (SearchPart's share of each)
+/// and appends their keys and adds their rejections together (Exec::search_tets_per_item: a constant,
+/// so that the GPU's item of one tet keeps no loop). An item whose keys did not all fit leaves a
+/// ResumePoint instead of counting its rejections; a rerun after growing (`resume_from` set) runs
+/// only those items.
+template <std::uint32_t TetsPerItem>
 struct FindCandidatesKernel {
     SceneView scene;
     GridView grid;
@@ -663,7 +665,6 @@ struct FindCandidatesKernel {
     /// warps of later layer parts idle, not lanes of every warp.
     std::uint32_t layer_parts;
     std::uint32_t block_parts;
-    std::uint32_t tets_per_item; ///< Exec::search_tets_per_item: tets [r * tets_per_item, ...) make run r
     /// A frame that resumes the items that did not fit (a first frame): such an item stops searching at
     /// once, since its resumption searches again. Otherwise it searches on, counting the room the
     /// whole frame needs, so that a single rerun fits.
@@ -705,20 +706,20 @@ struct FindCandidatesKernel {
         KDET_HD bool finished() const { return stop_when_full && batch->stopped; }
     };
 
-    /// @brief The runs of tets that items are made of (the last one may be shorter).
-    KDET_HD static std::uint32_t run_count(std::uint32_t tets, std::uint32_t tets_per_item) {
-        return tets / tets_per_item + (tets % tets_per_item ? 1u : 0u);
-    }
+    /// @brief The runs of tets that items are made of (tets [r * TetsPerItem, ...) make run r; the last
+    /// one may be shorter).
+    KDET_HD static std::uint32_t run_count(std::uint32_t tets) { return tets / TetsPerItem + (tets % TetsPerItem ? 1u : 0u); }
 
     KDET_HD void operator()(std::uint64_t i) const {
         const auto item = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
         const std::uint32_t run_part = item / block_parts;
-        const std::uint32_t runs = run_count(scene.tet_count, tets_per_item);
-        const std::uint32_t first = run_part % runs * tets_per_item;
-        const std::uint32_t end = scene.tet_count - first < tets_per_item ? scene.tet_count : first + tets_per_item;
+        const std::uint32_t runs = run_count(scene.tet_count);
+        const std::uint32_t first = run_part % runs * TetsPerItem;
+        const std::uint32_t end = scene.tet_count - first < TetsPerItem ? scene.tet_count : first + TetsPerItem;
         const SearchPart part{run_part / runs, layer_parts, item % block_parts, block_parts};
-        const GridParams grid_params = *params;
-        const std::uint32_t layers = *layer_mask;
+        // An item of one tet (the GPU's) that the search skips returns before it touches the buffer's
+        // count, and searches without a loop: a run's loop cost the GPU's kernel about 30 registers.
+        if (TetsPerItem == 1 && !searched(first, part)) return;
         const std::uint32_t already_stored = resume_from ? resume_from[i].stored : 0u;
         // Once a first frame's buffer is full, an item that has not started would only search until
         // its first batch and then search again after the buffer grows: it waits for that at once.
@@ -728,13 +729,11 @@ struct FindCandidatesKernel {
         }
         KeyBatch batch(&out, already_stored);
         unsigned long long run_rejected = 0;
-        for (std::uint32_t t = first; t < end && !(stop_when_full && batch.stopped); ++t) {
-            const int layer = scene.info[t].layer;
-            if (layer < 0 || layer + static_cast<int>(part.layer) >= grid_params.layer_count) continue;
-            Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], scene.planes[t],
-                      scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
-            for_each_larger_neighbour(scene, grid, grid_params, layers, t, emit, part);
-            run_rejected += emit.rejected;
+        if (TetsPerItem == 1) {
+            run_rejected = search(first, part, batch);
+        } else {
+            for (std::uint32_t t = first; t < end && !(stop_when_full && batch.stopped); ++t)
+                if (searched(t, part)) run_rejected += search(t, part, batch);
         }
         batch.flush();
         if (batch.stopped) {
@@ -742,6 +741,21 @@ struct FindCandidatesKernel {
             return;
         }
         if (run_rejected) atomic_fetch_add_gathered(rejected, run_rejected);
+    }
+
+    /// @brief Whether tet t has a share of the search in `part`: it is gridded, and it has layers there.
+    KDET_HD bool searched(std::uint32_t t, const SearchPart& part) const {
+        const int layer = scene.info[t].layer;
+        return layer >= 0 && layer + static_cast<int>(part.layer) < params->layer_count;
+    }
+
+    /// @brief Tet t's share of the search, its keys into `batch`; returns the pairs it rejected.
+    KDET_HD unsigned long long search(std::uint32_t t, const SearchPart& part, KeyBatch& batch) const {
+        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], scene.planes[t],
+                  scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
+        const GridParams grid_params = *params;
+        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
+        return emit.rejected;
     }
 
     KDET_HD void record_stop(const ResumePoint& point) const {

@@ -414,8 +414,9 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
     const std::uint32_t layer_parts = split ? layer_parts_wanted : 1u;
     const std::uint32_t block_parts = split ? block_parts_wanted : 1u;
     const std::size_t parts = std::size_t{layer_parts} * block_parts;
-    const std::uint32_t tets_per_item = Exec::search_tets_per_item;
-    const std::size_t runs = FindCandidatesKernel::run_count(static_cast<std::uint32_t>(tets_.size()), tets_per_item);
+    constexpr std::uint32_t tets_per_item = Exec::search_tets_per_item;
+    using Search = FindCandidatesKernel<tets_per_item>;
+    const std::size_t runs = Search::run_count(static_cast<std::uint32_t>(tets_.size()));
     const std::size_t all_items = runs * parts, resume_room = tets_.size();
     for (auto& points : resume_points_) points.resize_discard(resume_room);
     std::size_t items = all_items;
@@ -425,10 +426,9 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         FrameCounters* c = counters_.data();
         ResumePoint* stopped = resume_points_[run % 2].data();
         const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
-        exec_.for_each(items, FindCandidatesKernel{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected,
-                                                   resume_from, stopped, &c->stopped_items,
-                                                   static_cast<std::uint32_t>(resume_room), layer_parts, block_parts,
-                                                   tets_per_item, !pairs_sized_},
+        exec_.for_each(items, Search{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected, resume_from, stopped,
+                                     &c->stopped_items, static_cast<std::uint32_t>(resume_room), layer_parts, block_parts,
+                                     !pairs_sized_},
                        tets_per_item);
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
