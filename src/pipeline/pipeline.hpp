@@ -20,26 +20,29 @@
 namespace kdet {
 
 /// @brief What the kernels of a frame count and compute for the stages after them, in the backend's
-/// memory; the host reads it once, when the frame is done.
+/// memory; the host reads it once, when the frame is done. The counters that work items add to as
+/// they go (appends, claimed cells, rejections) each have a cache line of their own, apart from the
+/// values every item reads (the grid's failure bits, its geometry): sharing one, the CPU's threads
+/// passed the line back and forth on every add and read.
 struct FrameCounters {
-    unsigned long long candidates; ///< appended (counts past the buffer's end)
+    alignas(64) unsigned long long candidates; ///< appended (counts past the buffer's end)
     unsigned long long candidate_padding; ///< of which slots hold no_pair_key (see KeyAppender)
-    unsigned long long tests_run;
-    unsigned long long rejected; ///< candidate pairs the face-plane pre-test proved separated
-    unsigned long long exact_stage_pairs; ///< pairs that reached the exact stage of NarrowPhase::exact
+    alignas(64) unsigned long long tests_run;
+    alignas(64) unsigned long long rejected; ///< candidate pairs the face-plane pre-test proved separated
+    alignas(64) unsigned long long colliding_pairs; ///< appended (counts past the window's end)
+    alignas(64) std::uint32_t cells_claimed;
+    alignas(64) std::uint32_t grid_entries; ///< entries of the compacted cells
+    alignas(64) std::uint32_t overflow_used;
+    alignas(64) unsigned long long exact_stage_pairs; ///< pairs that reached the exact stage of NarrowPhase::exact
     /// Brute force's own count of those; the narrow phase tests its colliding pairs again, and that
     /// count (exact_stage_pairs) is the one reported, as for the other methods.
     unsigned long long brute_force_exact_stage;
-    unsigned long long colliding_pairs;   ///< appended (counts past the window's end)
     unsigned long long colliding_tets;
     unsigned long long involved_tets; ///< tets of the objects in a pair checked this frame
     std::uint32_t stopped_items; ///< ResumePoints the candidate search left (items, not tets): its buffer was full
     std::uint32_t grid_failure;
-    std::uint32_t overflow_used;
     std::uint32_t layer_mask;
     std::uint32_t first_non_finite_vertex; ///< lowest staged vertex found non-finite, or no_vertex
-    std::uint32_t cells_claimed;
-    std::uint32_t grid_entries; ///< entries of the compacted cells
     std::uint32_t object_runs; ///< runs of tets of one object, i.e. non-empty objects
     std::uint32_t min_size; ///< float_to_ordered, over the relevant tets
     std::uint32_t max_size;
