@@ -172,12 +172,12 @@ private:
                          static_cast<std::uint32_t>(object_boxes_.size())};
     }
     template <class T>
-    void fill(buffer<T>& b, T value) {
+    void fill(buffer<T>& b, const T& value) {
         exec_.for_each(b.size(), FillKernel<T>{b.data(), value});
     }
     /// Makes `b` hold n elements, all `value` when it had to change size (kept as they are otherwise).
     template <class T>
-    void resize_filled(buffer<T>& b, std::size_t n, T value) {
+    void resize_filled(buffer<T>& b, std::size_t n, const T& value) {
         if (b.size() == n) return;
         b.resize_discard(n);
         fill(b, value);
