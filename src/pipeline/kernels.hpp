@@ -766,7 +766,7 @@ struct FindCandidatesKernel {
 
 /// @brief The thesis's old method (algorithm 4.2): test inline and only flag colliding tets,
 /// skipping a pair when both tets are already flagged.
-template <NarrowPhase Test>
+template <NarrowPhase Test, std::uint32_t TetsPerItem>
 struct NoPairsKernel {
     SceneView scene;
     GridView grid;
@@ -798,12 +798,31 @@ struct NoPairsKernel {
         KDET_HD bool finished() const { return false; }
     };
 
+    /// @brief Items for `tets` tets: runs of TetsPerItem consecutive tets (Exec::search_tets_per_item, as
+    /// the candidate search's), whose counts are added once per run.
+    KDET_HD static std::uint64_t item_count(std::uint64_t tets) { return tets / TetsPerItem + (tets % TetsPerItem ? 1u : 0u); }
+
     KDET_HD void operator()(std::uint64_t i) const {
-        TestAndFlag visit{this, static_cast<std::uint32_t>(i), 0, 0};
-        const GridParams grid_params = *params;
-        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, visit.t, visit);
+        TestAndFlag visit{this, 0, 0, 0};
+        if (TetsPerItem == 1) {
+            visit.t = static_cast<std::uint32_t>(i);
+            search(visit);
+        } else {
+            const std::uint64_t first = i * TetsPerItem;
+            const std::uint64_t end = scene.tet_count - first < TetsPerItem ? scene.tet_count : first + TetsPerItem;
+            for (std::uint64_t t = first; t < end; ++t) {
+                visit.t = static_cast<std::uint32_t>(t);
+                search(visit);
+            }
+        }
         if (visit.tests) atomic_fetch_add(tests_run, visit.tests);
         if (visit.exact_stage) atomic_fetch_add(exact_stage_pairs, visit.exact_stage);
+    }
+
+    /// @brief The search of tet visit.t, its tests and exact stages added to visit's counts.
+    KDET_HD void search(TestAndFlag& visit) const {
+        const GridParams grid_params = *params;
+        for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, visit.t, visit);
     }
 };
 

@@ -582,9 +582,11 @@ void Pipeline<Exec>::enqueue_from(Rerun stage) {
             found = find_candidates(grid_);
         } else if (method == Method::kdet_no_pairs) {
             with_narrow_phase(options_.narrow_phase, [&](auto test) {
-                exec_.for_each(tets_.size(), NoPairsKernel<decltype(test)::value>{scene_view(), grid_, &c->params, &c->layer_mask,
-                                                                       colliding_.data(), &c->tests_run,
-                                                                       &c->exact_stage_pairs});
+                using Search = NoPairsKernel<decltype(test)::value, Exec::search_tets_per_item>;
+                exec_.for_each(Search::item_count(tets_.size()),
+                               Search{scene_view(), grid_, &c->params, &c->layer_mask, colliding_.data(), &c->tests_run,
+                                      &c->exact_stage_pairs},
+                               Exec::search_tets_per_item);
             });
         } else {
             if (candidates_.size() == 0)
