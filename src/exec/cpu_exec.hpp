@@ -161,9 +161,10 @@ public:
     static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
     static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
 
-    /// @brief Consecutive tets per work item of the candidate search: a thread appends their keys and
-    /// adds their rejections with one atomic per run, where one item per tet took two on counters that
-    /// share a cache line, which the two threads passed back and forth (soup 100k: 6-9 % of a frame).
+    /// @brief Consecutive tets per work item of the grid's searches (the candidates', kdet_no_pairs'): a
+    /// thread appends their keys and adds their counts with one atomic per run, where an item per tet
+    /// added to counters that both threads passed back and forth (soup 100k: 6-9 % of a frame in the
+    /// VM's slow phase).
     static constexpr std::uint32_t search_tets_per_item = 32;
 
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): many, since an item

@@ -231,7 +231,7 @@ public:
         return split_by_blocks(self_collision, tets) ? 4 : 2;
     }
 
-    /// @brief Consecutive tets per work item of the candidate search: one, a thread's search is long
+    /// @brief Consecutive tets per work item of the grid's searches: one, a thread's search is long
     /// enough (its appends are gathered per warp).
     static constexpr std::uint32_t search_tets_per_item = 1;
 
