@@ -43,7 +43,8 @@ struct SceneView {
     /// far-apart pairs intersecting (sat_no_edges, see slabs.hpp): no pair is rejected by them then.
     TetSlabs* slabs;
     const std::uint8_t* pair_active; ///< [object_count * object_count]; diagonal = self-collision
-    const std::uint32_t* checked_objects; ///< [object_count] object_bit of every object a is checked against
+    /// [object_count] object_bit of every object a is checked against; any_object when that is all of them
+    const std::uint32_t* checked_objects;
     const Aabb* object_boxes;
     std::uint32_t tet_count;
     std::uint32_t object_count;
@@ -210,7 +211,8 @@ struct ObjectCullingKernel {
             if (on) checked |= object_bit(b);
             involved = involved || on;
         }
-        checked_objects[a] = checked;
+        // Checked against every object, a tet filters none: any_object spares its scans the blocks' objects.
+        checked_objects[a] = checked == all_object_bits(object_count) ? any_object : checked;
         if (!involved) return;
         const Aabb& box = object_boxes[a];
         for (int axis = 0; axis < 3; ++axis) {
@@ -536,10 +538,7 @@ KDET_HD inline void for_each_larger_neighbour(const SceneView& scene, const Grid
     if (self.layer < 0 || *grid.failure) return;
     const std::uint32_t object = scene.tet_object[t];
     const std::uint8_t* checked_against = scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count;
-    // A tet checked against every object filters none: any_object spares its scans the blocks' objects.
-    const std::uint32_t checked_objects = scene.checked_objects[object] == all_object_bits(scene.object_count)
-                                              ? any_object
-                                              : scene.checked_objects[object];
+    const std::uint32_t checked_objects = scene.checked_objects[object];
     ObjectFilter<Visitor> filter{checked_against, &visit};
     const std::uint32_t group_blocks = group_blocks_of_part(part.block, part.blocks);
     for (int layer = self.layer + static_cast<int>(part.layer); layer < params.layer_count;
@@ -637,6 +636,18 @@ struct KeyBatch {
     }
 };
 
+/// @brief The runs of consecutive tets that the grid's searches take per work item
+/// (Exec::search_tets_per_item): how many there are for `tets` tets, and the tets [first, end) of run r
+/// (the last run may be shorter).
+template <std::uint32_t TetsPerItem>
+struct TetRuns {
+    KDET_HD static std::uint32_t count(std::uint32_t tets) { return tets / TetsPerItem + (tets % TetsPerItem ? 1u : 0u); }
+    KDET_HD static std::uint32_t first(std::uint32_t r) { return r * TetsPerItem; }
+    KDET_HD static std::uint32_t end(std::uint32_t r, std::uint32_t tets) {
+        return tets - first(r) < TetsPerItem ? tets : first(r) + TetsPerItem;
+    }
+};
+
 /// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the pre-test (the slabs where the
 /// scene has them, then the face planes) cannot prove separated (those it can are only counted): a
 /// rejected pair is never written, sorted or loaded again. A pair the face planes prove intersecting is
@@ -706,16 +717,12 @@ struct FindCandidatesKernel {
         KDET_HD bool finished() const { return stop_when_full && batch->stopped; }
     };
 
-    /// @brief The runs of tets that items are made of (tets [r * TetsPerItem, ...) make run r; the last
-    /// one may be shorter).
-    KDET_HD static std::uint32_t run_count(std::uint32_t tets) { return tets / TetsPerItem + (tets % TetsPerItem ? 1u : 0u); }
-
     KDET_HD void operator()(std::uint64_t i) const {
         const auto item = resume_from ? resume_from[i].item : static_cast<std::uint32_t>(i);
         const std::uint32_t run_part = item / block_parts;
-        const std::uint32_t runs = run_count(scene.tet_count);
-        const std::uint32_t first = run_part % runs * TetsPerItem;
-        const std::uint32_t end = scene.tet_count - first < TetsPerItem ? scene.tet_count : first + TetsPerItem;
+        using Runs = TetRuns<TetsPerItem>;
+        const std::uint32_t runs = Runs::count(scene.tet_count), run = run_part % runs;
+        const std::uint32_t first = Runs::first(run), end = Runs::end(run, scene.tet_count);
         const SearchPart part{run_part / runs, layer_parts, item % block_parts, block_parts};
         // An item of one tet (the GPU's) that the search skips returns before it touches the buffer's
         // count, and searches without a loop: a run's loop cost the GPU's kernel about 30 registers.
@@ -765,7 +772,8 @@ struct FindCandidatesKernel {
 };
 
 /// @brief The thesis's old method (algorithm 4.2): test inline and only flag colliding tets,
-/// skipping a pair when both tets are already flagged.
+/// skipping a pair when both tets are already flagged. An item searches a run of TetsPerItem tets
+/// (TetRuns) and adds its counts once.
 template <NarrowPhase Test, std::uint32_t TetsPerItem>
 struct NoPairsKernel {
     SceneView scene;
@@ -798,20 +806,15 @@ struct NoPairsKernel {
         KDET_HD bool finished() const { return false; }
     };
 
-    /// @brief Items for `tets` tets: runs of TetsPerItem consecutive tets (Exec::search_tets_per_item, as
-    /// the candidate search's), whose counts are added once per run.
-    KDET_HD static std::uint64_t item_count(std::uint64_t tets) { return tets / TetsPerItem + (tets % TetsPerItem ? 1u : 0u); }
-
     KDET_HD void operator()(std::uint64_t i) const {
         TestAndFlag visit{this, 0, 0, 0};
         if (TetsPerItem == 1) {
             visit.t = static_cast<std::uint32_t>(i);
             search(visit);
         } else {
-            const std::uint64_t first = i * TetsPerItem;
-            const std::uint64_t end = scene.tet_count - first < TetsPerItem ? scene.tet_count : first + TetsPerItem;
-            for (std::uint64_t t = first; t < end; ++t) {
-                visit.t = static_cast<std::uint32_t>(t);
+            const auto run = static_cast<std::uint32_t>(i);
+            for (std::uint32_t t = TetRuns<TetsPerItem>::first(run); t < TetRuns<TetsPerItem>::end(run, scene.tet_count); ++t) {
+                visit.t = t;
                 search(visit);
             }
         }

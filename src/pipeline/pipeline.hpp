@@ -28,7 +28,7 @@ struct FrameCounters {
     alignas(64) unsigned long long candidates; ///< appended (counts past the buffer's end)
     unsigned long long candidate_padding; ///< of which slots hold no_pair_key (see KeyAppender)
     alignas(64) unsigned long long tests_run;
-    alignas(64) unsigned long long rejected; ///< candidate pairs the face-plane pre-test proved separated
+    alignas(64) unsigned long long rejected; ///< candidate pairs the pre-test (slabs, face planes) proved separated
     alignas(64) unsigned long long colliding_pairs; ///< appended (counts past the window's end)
     alignas(64) std::uint32_t cells_claimed;
     alignas(64) std::uint32_t grid_entries; ///< entries of the compacted cells
@@ -419,7 +419,7 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
     const std::size_t parts = std::size_t{layer_parts} * block_parts;
     constexpr std::uint32_t tets_per_item = Exec::search_tets_per_item;
     using Search = FindCandidatesKernel<tets_per_item>;
-    const std::size_t runs = Search::run_count(static_cast<std::uint32_t>(tets_.size()));
+    const std::size_t runs = TetRuns<tets_per_item>::count(static_cast<std::uint32_t>(tets_.size()));
     const std::size_t all_items = runs * parts, resume_room = tets_.size();
     for (auto& points : resume_points_) points.resize_discard(resume_room);
     std::size_t items = all_items;
@@ -583,7 +583,7 @@ void Pipeline<Exec>::enqueue_from(Rerun stage) {
         } else if (method == Method::kdet_no_pairs) {
             with_narrow_phase(options_.narrow_phase, [&](auto test) {
                 using Search = NoPairsKernel<decltype(test)::value, Exec::search_tets_per_item>;
-                exec_.for_each(Search::item_count(tets_.size()),
+                exec_.for_each(TetRuns<Exec::search_tets_per_item>::count(static_cast<std::uint32_t>(tets_.size())),
                                Search{scene_view(), grid_, &c->params, &c->layer_mask, colliding_.data(), &c->tests_run,
                                       &c->exact_stage_pairs},
                                Exec::search_tets_per_item);
