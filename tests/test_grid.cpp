@@ -400,16 +400,19 @@ float cell_size0_of_row(float edge, float pitch, std::uint32_t count) {
     return params.cell_size0;
 }
 
-TEST(GridParams, CellsAreNeverSmallerThanTheTetsSpacing) {
-    // Tets far apart: c0 is their spacing rounded up to a power of two, and every tet shares layer 0.
-    EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000), 4.0f);
-    EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000), 0.5f);
-    // Tets overlapping their neighbours (as a mesh's tets touch theirs): c0 is the tets' sphere (0.0122),
-    // since a spacing of 0.004 counts as at most 0.0078.
+TEST(GridParams, CellsSpanAFewOfTheTetsSpacings) {
+    static_assert(cell_spacings == 4.0f, "the sizes below are four spacings");
+    // Tets far apart: c0 is four times their spacing rounded up to a power of two, and every tet
+    // shares layer 0.
+    EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000), 16.0f);
+    EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000), 2.0f);
+    // Tets overlapping their neighbours (as a mesh's tets touch theirs): a spacing of 0.001 counts as
+    // at most 0.00195, and four of those stay below the tets' sphere (0.0122), which is c0.
     const float regular_sphere = 0.01f * std::sqrt(1.5f);
-    EXPECT_NEAR(cell_size0_of_row(0.01f, 0.004f, 1000), regular_sphere, 1e-4f);
-    // A spacing of 0.009 counts as up to 0.0156, above the sphere: layer 0's cells grow to it.
-    EXPECT_EQ(cell_size0_of_row(0.01f, 0.009f, 1000), 0.015625f);
+    EXPECT_NEAR(cell_size0_of_row(0.01f, 0.001f, 1000), regular_sphere, 1e-4f);
+    // A spacing of 0.004 counts as up to 0.0078, four of which exceed the sphere: layer 0's cells grow
+    // to them.
+    EXPECT_EQ(cell_size0_of_row(0.01f, 0.004f, 1000), 0.03125f);
     // Too few tets to sample a spacing: the smallest sphere.
     EXPECT_NEAR(cell_size0_of_row(0.01f, 3.0f, 1), regular_sphere, 1e-4f);
 }

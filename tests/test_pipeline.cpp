@@ -334,17 +334,28 @@ TEST(Pipeline, OrdinaryInputGrowsNoBuffer) {
 }
 
 TEST(Pipeline, SparseScenesGetSmallBucketsAndTheSameAnswer) {
-    // Tets whose sizes span three decades, a few to a cell (the grid's cells are never smaller than
-    // the tets' spacing): the automatic bucket capacity (16 here) shrinks the table's id storage, and
-    // the answer is the one of any fixed capacity.
-    const TetMesh a = random_soup(20000, 40.0, 3.0, 51), b = random_soup(20000, 40.0, 3.0, 52);
+    // A dense cloud of small tets, which sets the tets' spacing and so the cells of layer 0 (each
+    // holds dozens of them), beside fewer large tets far apart, each alone in the cells it overlaps
+    // on its higher layer: most occupied cells hold one id, so the automatic bucket capacity (8 here)
+    // shrinks the table's id storage, and the answer is the one of any fixed capacity.
+    const auto cloud = [](std::size_t count, double extent, double size, unsigned seed) {
+        TetMesh mesh = random_soup(count, 1.0, 0.0, seed); // tets of size 0.2 in a unit cube
+        for (double& x : mesh.positions) x *= extent;
+        for (std::size_t t = 0; t < count; ++t) {
+            double* corner = &mesh.positions[12 * t];
+            for (int k = 1; k < 4; ++k)
+                for (int a = 0; a < 3; ++a) corner[3 * k + a] = corner[a] + (corner[3 * k + a] - corner[a]) * size / (0.2 * extent);
+        }
+        return mesh;
+    };
+    const TetMesh dust = cloud(12000, 1.0, 0.02, 51), boulders = cloud(10000, 400.0, 2.0, 52);
     DetectorOptions automatic = with_method(Method::kdet), fixed = automatic;
     fixed.bucket_capacity = 32;
-    const Outcome small = run({a, b}, true, automatic), large = run({a, b}, true, fixed);
+    const Outcome small = run({dust, boulders}, true, automatic), large = run({dust, boulders}, true, fixed);
     ASSERT_GT(small.pairs.size(), 100u);
     EXPECT_EQ(small.pairs, large.pairs);
     EXPECT_EQ(small.counts.buffer_regrows, 0u);
-    EXPECT_EQ(small.counts.grid_bucket_capacity, 16u);
+    EXPECT_EQ(small.counts.grid_bucket_capacity, 8u);
     EXPECT_EQ(large.counts.grid_bucket_capacity, 32u);
     EXPECT_LT(10 * small.grid_bytes, 9 * large.grid_bytes); // at least 10 % less
 }

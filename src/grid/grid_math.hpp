@@ -25,7 +25,7 @@ constexpr int cell_coordinate_bits = 19;
 /// @brief The frame's grid geometry, chosen from the scene (see choose_grid_params).
 struct GridParams {
     vec3 origin;        ///< lower corner of the region that is gridded
-    float cell_size0;   ///< c0: the smallest tet size among the gridded tets, or their spacing (GridParamsKernel)
+    float cell_size0;   ///< c0: the smallest tet size among the gridded tets, or a few of their spacings (GridParamsKernel)
     float inv_cell_size0;
     int layer_count;    ///< layers 0 .. layer_count-1
 };

@@ -303,17 +303,24 @@ struct TetSizeKernel {
     }
 };
 
+/// @brief How many of the tets' spacings (median_spacing) layer 0's cells span at least, so that a
+/// cell holds dozens of tets: a query's visit of a cell costs far more than reading an entry of its
+/// list (soup 100k: about 120 cycles a visit, 2.3 an entry read), and the block bounds skip most of a
+/// large cell's entries. With 1 instead of 4, the frames of soup 100k took 37 ms against 28, those
+/// of the thesis scenes at resolution 4 with self-collision 9-15 % longer (docs/performance.md).
+constexpr float cell_spacings = 4.0f;
+
 /// @brief Stage 1, grid methods only, one work item: the grid's geometry from the relevant tets' sizes
 /// and spacings (TetSizeKernel) and the region (ObjectCullingKernel), written where the later kernels
-/// read it. c0 is the smallest size, so the smallest tets sit on layer 0, unless the tets lie farther
-/// apart than that: then c0 is their median spacing (rounded up to a power of two), and every smaller
-/// tet shares layer 0. Cells smaller than the spacing each hold about one tet (a sparse soup of small
-/// tets), and every such tet costs inserts into cells of its own and lookups of empty cells on each
-/// of the many layers above it; in a mesh, whose tets touch, the spacing is about the typical tet's
-/// size, and only the layers of its few smallest tets merge. The spacing is measured along the
-/// storage order, which is spatial (SceneTopology): a tet's predecessor is one of its neighbours.
-/// Enough layers to hold the largest, capped at max_grid_layers. No relevant tet: no layer, nothing
-/// is gridded.
+/// read it. c0 is the smallest size, so the smallest tets sit on layer 0, unless the tets lie closer
+/// together than that: then c0 is cell_spacings times their median spacing (rounded up to a power of
+/// two), and every smaller tet shares layer 0. Cells about the spacing's size each hold about one tet
+/// (a sparse soup of small tets), and every such tet costs inserts into cells of its own and lookups
+/// on each of the many layers above it; in a mesh, whose tets touch, the spacing is about the typical
+/// tet's size, so most of its tets share layer 0, each in one or two cells per axis. The spacing is
+/// measured along the storage order, which is spatial (SceneTopology): a tet's predecessor is one of
+/// its neighbours. Enough layers to hold the largest, capped at max_grid_layers. No relevant tet: no
+/// layer, nothing is gridded.
 struct GridParamsKernel {
     const std::uint32_t* min_size; ///< float_to_ordered
     const std::uint32_t* max_size;
@@ -329,7 +336,7 @@ struct GridParamsKernel {
         const float dmin = ordered_to_float(*min_size), dmax = ordered_to_float(*max_size);
         // Zero-size tets (allowed only when the caller asked for degenerate input) must not make c0 zero.
         const float floor_size = max_f(dmax * 1e-6f, FLT_MIN * 1e6f);
-        const float c0 = max_f(max_f(dmin, floor_size), median_spacing(spacing_octaves));
+        const float c0 = max_f(max_f(dmin, floor_size), cell_spacings * median_spacing(spacing_octaves));
         int layers = 1;
         for (float top = c0; layers < max_grid_layers && top < dmax; top *= 2.0f) ++layers;
         const vec3 origin{ordered_to_float(region->lo[0]), ordered_to_float(region->lo[1]),
