@@ -39,8 +39,8 @@ TEST(HostBuffer, ShrinkingKeepsTheMemory) {
 }
 
 TEST(HostBuffer, HoldsOverAlignedRowsOnTheirAlignmentAtEverySize) {
-    // Rows aligned beyond what malloc promises (the grid's block bounds, the slabs): small buffers come
-    // from the general allocator, large ones from huge pages; each size must keep the alignment.
+    // Rows aligned beyond what malloc promises (the grid's block bounds, the slabs), in buffers of
+    // every size: each must keep the alignment.
     struct alignas(64) Row {
         float lanes[16];
     };

@@ -18,36 +18,24 @@
 #include <utility>
 #include <vector>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 namespace kdet {
 
 namespace host_memory {
-
-/// Buffers this large are placed on 2 MiB boundaries and, on Linux, asked to be backed by huge
-/// pages: the grid's table and lists are read at random, and with 4 KiB pages a large table misses
-/// the TLB on nearly every lookup (where transparent huge pages are "always", this changes nothing).
-constexpr std::size_t huge_page = std::size_t{2} << 20;
 
 struct Free {
     void operator()(void* p) const { std::free(p); }
 };
 
 /// Uninitialised memory for `count` objects of `size` bytes aligned to `alignment` (a power of two);
-/// throws std::bad_alloc when it cannot.
+/// throws std::bad_alloc when it cannot. Plain pages, no huge-page advice: since layer 0's cells hold
+/// dozens of tets the frames take at most 3 % longer without it, where a one-off query's first touch
+/// of fresh memory took up to 1.5 times as long with it in a VM that returns free memory to its host
+/// (docs/performance.md).
 inline void* allocate(std::size_t count, std::size_t size, std::size_t alignment) {
     if (count > std::numeric_limits<std::size_t>::max() / size) throw std::bad_alloc();
     const std::size_t bytes = count * size;
     void* p = nullptr;
-    if (bytes >= huge_page) {
-        const std::size_t rounded = (bytes + huge_page - 1) / huge_page * huge_page;
-        p = std::aligned_alloc(huge_page, rounded);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-        if (p) madvise(p, rounded, MADV_HUGEPAGE); // advice only: failing it is harmless
-#endif
-    } else if (alignment > alignof(std::max_align_t)) {
+    if (alignment > alignof(std::max_align_t)) {
         p = std::aligned_alloc(alignment, (std::max<std::size_t>(bytes, 1) + alignment - 1) / alignment * alignment);
     } else {
         p = std::malloc(bytes == 0 ? 1 : bytes);
