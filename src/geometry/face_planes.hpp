@@ -103,12 +103,18 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     frexpf(largest, &exponent);
     // Scaled by a power of two, edges keep their exact directions and ratios, and their squares stay normal.
     const float scale = times_power_of_two(1.0f, -exponent);
-    vec3 e[4];
-    for (int i = 0; i < 4; ++i) e[i] = q[i] * scale;
+    // Corner k relative to vertex 0 as rows, one lane a corner (q, and e scaled), from which the faces'
+    // corners below are lane rotations: built from the tet's vec3s, they went through the stack.
+    float qx[4], qy[4], qz[4], ex[4], ey[4], ez[4];
+    KDET_VECTOR_LOOP
+    for (int k = 0; k < 4; ++k) {
+        qx[k] = q[k].x, qy[k] = q[k].y, qz[k] = q[k].z;
+        ex[k] = q[k].x * scale, ey[k] = q[k].y * scale, ez[k] = q[k].z * scale;
+    }
     float longest2 = 0.0f, shortest2 = 3.4e38f;
     for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j) {
-            const float l2 = length_squared(e[j] - e[i]);
+            const float l2 = length_squared(make_vec3(ex[j] - ex[i], ey[j] - ey[i], ez[j] - ez[i]));
             longest2 = max_f(longest2, l2);
             shortest2 = min_f(shortest2, l2);
         }
@@ -121,14 +127,9 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     const float solidity_margin = k_plane_margin / (sqrtf(shortest2) * unscale) * p.longest * p.longest;
     // Face k (opposite vertex k) has the corners a, b, c = e[k+1], e[k+2], e[k+3] (mod 4); as rows, so
     // that the four faces are computed side by side, each lane without a branch.
-    float ax[4], ay[4], az[4], bx[4], by[4], bz[4], cx[4], cy[4], cz[4], dx[4], dy[4], dz[4], qx[4], qy[4], qz[4];
-    for (int k = 0; k < 4; ++k) {
-        ax[k] = e[(k + 1) & 3].x, ay[k] = e[(k + 1) & 3].y, az[k] = e[(k + 1) & 3].z;
-        bx[k] = e[(k + 2) & 3].x, by[k] = e[(k + 2) & 3].y, bz[k] = e[(k + 2) & 3].z;
-        cx[k] = e[(k + 3) & 3].x, cy[k] = e[(k + 3) & 3].y, cz[k] = e[(k + 3) & 3].z;
-        dx[k] = e[k].x, dy[k] = e[k].y, dz[k] = e[k].z;
-        qx[k] = q[k].x, qy[k] = q[k].y, qz[k] = q[k].z;
-    }
+    const float ax[4] = {ex[1], ex[2], ex[3], ex[0]}, ay[4] = {ey[1], ey[2], ey[3], ey[0]}, az[4] = {ez[1], ez[2], ez[3], ez[0]};
+    const float bx[4] = {ex[2], ex[3], ex[0], ex[1]}, by[4] = {ey[2], ey[3], ey[0], ey[1]}, bz[4] = {ez[2], ez[3], ez[0], ez[1]};
+    const float cx[4] = {ex[3], ex[0], ex[1], ex[2]}, cy[4] = {ey[3], ey[0], ey[1], ey[2]}, cz[4] = {ez[3], ez[0], ez[1], ez[2]};
     std::uint32_t solid_faces[4];
     KDET_VECTOR_LOOP
     for (int k = 0; k < 4; ++k) {
@@ -150,11 +151,12 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
         const float sine = sqrtf(n2 / (lf * lg)) * (1.0f - 0x1p-10f);
         const float separation_scale = (k_plane_sine_margin / sine + k_plane_edge_margin) / (sqrtf(min_f(lf, lg)) * unscale);
         n = n * (1.0f / sqrtf(n2));
-        const vec3 d{dx[k], dy[k], dz[k]};
+        const vec3 d{ex[k], ey[k], ez[k]};
         const bool flip = dot(n, d - a) > 0.0f;
         n = vec3{flip ? -n.x : n.x, flip ? -n.y : n.y, flip ? -n.z : n.z};
         // q[0] projects to 0.
-        const float offset = max_f(max_f(max_f(0.0f, dot(n, q[1])), dot(n, q[2])), dot(n, q[3]));
+        const float offset = max_f(max_f(max_f(0.0f, dot(n, vec3{qx[1], qy[1], qz[1]})), dot(n, vec3{qx[2], qy[2], qz[2]})),
+                                   dot(n, vec3{qx[3], qy[3], qz[3]}));
         p.nx[k] = face_used ? n.x : 0.0f;
         p.ny[k] = face_used ? n.y : 0.0f;
         p.nz[k] = face_used ? n.z : 0.0f;
