@@ -307,7 +307,7 @@ struct TetSizeKernel {
 /// cell holds dozens of tets: a query's visit of a cell costs far more than reading an entry of its
 /// list (soup 100k: about 120 cycles a visit, 2.3 an entry read), and the block bounds skip most of a
 /// large cell's entries. With 1 instead of 4, the frames of soup 100k took 37 ms against 28, those
-/// of the thesis scenes at resolution 4 with self-collision 9-15 % longer (docs/performance.md).
+/// of the thesis scenes at resolution 4 with self-collision 10-15 % longer (docs/performance.md).
 constexpr float cell_spacings = 4.0f;
 
 /// @brief Stage 1, grid methods only, one work item: the grid's geometry from the relevant tets' sizes
