@@ -367,7 +367,7 @@ TEST(GridPlan, PutsEveryTetOnItsSpheresLayerThoughSizingLeavesMostSpheresUncompu
     GridParams params{};
     // No spacing counted: c0 is the smallest size (these tets lie far apart; see the spacing test).
     const std::vector<std::uint32_t> no_spacing(float_octaves, 0u);
-    GridParamsKernel{&min_size, &max_size, no_spacing.data(), &region, &params}(0);
+    GridParamsKernel{&min_size, &max_size, no_spacing.data(), &region, &params, CpuExec::grid_cell_spacings}(0);
     EXPECT_EQ(params.cell_size0, dmin);
     unsigned long long entries[max_grid_layers] = {}, cells[max_grid_layers] = {};
     std::uint32_t mask = 0;
@@ -384,8 +384,8 @@ TEST(GridPlan, PutsEveryTetOnItsSpheresLayerThoughSizingLeavesMostSpheresUncompu
 }
 
 /// The grid's c0 for regular tets of edge `edge` on a row along x, one every `pitch`, as the
-/// pipeline's sizing kernels choose it.
-float cell_size0_of_row(float edge, float pitch, std::uint32_t count) {
+/// pipeline's sizing kernels choose it with cells of at least `cell_spacings` spacings.
+float cell_size0_of_row(float edge, float pitch, std::uint32_t count, float cell_spacings) {
     std::vector<vec3> positions;
     for (std::uint32_t t = 0; t < count; ++t) {
         const vec3 at{pitch * static_cast<float>(t), 0.0f, 0.0f};
@@ -396,25 +396,35 @@ float cell_size0_of_row(float edge, float pitch, std::uint32_t count) {
     const OrderedBox region{{float_to_ordered(0.0f), float_to_ordered(0.0f), float_to_ordered(0.0f)},
                             {float_to_ordered(pitch * static_cast<float>(count)), float_to_ordered(4 * edge), float_to_ordered(4 * edge)}};
     GridParams params{};
-    GridParamsKernel{&sized.min_size, &sized.max_size, sized.spacing.data(), &region, &params}(0);
+    GridParamsKernel{&sized.min_size, &sized.max_size, sized.spacing.data(), &region, &params, cell_spacings}(0);
     return params.cell_size0;
 }
 
 TEST(GridParams, CellsSpanAFewOfTheTetsSpacings) {
-    static_assert(cell_spacings == 4.0f, "the sizes below are four spacings");
+    static_assert(CpuExec::grid_cell_spacings == 4.0f, "the sizes below are four spacings");
+    const float four = CpuExec::grid_cell_spacings;
     // Tets far apart: c0 is four times their spacing rounded up to a power of two, and every tet
     // shares layer 0.
-    EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000), 16.0f);
-    EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000), 2.0f);
+    EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000, four), 16.0f);
+    EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000, four), 2.0f);
     // Tets overlapping their neighbours (as a mesh's tets touch theirs): a spacing of 0.001 counts as
     // at most 0.00195, and four of those stay below the tets' sphere (0.0122), which is c0.
     const float regular_sphere = 0.01f * std::sqrt(1.5f);
-    EXPECT_NEAR(cell_size0_of_row(0.01f, 0.001f, 1000), regular_sphere, 1e-4f);
+    EXPECT_NEAR(cell_size0_of_row(0.01f, 0.001f, 1000, four), regular_sphere, 1e-4f);
     // A spacing of 0.004 counts as up to 0.0078, four of which exceed the sphere: layer 0's cells grow
     // to them.
-    EXPECT_EQ(cell_size0_of_row(0.01f, 0.004f, 1000), 0.03125f);
+    EXPECT_EQ(cell_size0_of_row(0.01f, 0.004f, 1000, four), 0.03125f);
     // Too few tets to sample a spacing: the smallest sphere.
-    EXPECT_NEAR(cell_size0_of_row(0.01f, 3.0f, 1), regular_sphere, 1e-4f);
+    EXPECT_NEAR(cell_size0_of_row(0.01f, 3.0f, 1, four), regular_sphere, 1e-4f);
+}
+
+TEST(GridParams, CellsOfOneSpacingAreTheSpacingOrTheSmallestSphere) {
+    // The GPU's cells (CudaExec::grid_cell_spacings) span one spacing: the spacing rounded up to a
+    // power of two where the tets lie apart, the smallest sphere where the spacing is below it.
+    EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000, 1.0f), 4.0f);
+    EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000, 1.0f), 0.5f);
+    const float regular_sphere = 0.01f * std::sqrt(1.5f);
+    EXPECT_NEAR(cell_size0_of_row(0.01f, 0.004f, 1000, 1.0f), regular_sphere, 1e-4f);
 }
 
 TEST(GridParams, MedianSpacingIsTheMiddleSamplesBinsUpperEnd) {

@@ -248,15 +248,18 @@ TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
 }
 
 /// The CPU backend with its work divided as the GPU's is: the candidate search split into parts by
-/// layers and by blocks of each list (SearchPart), a tet per search item (or TetsPerItem), and the
-/// grid's plan in small chunks (Exec::plan_chunk).
-template <std::uint32_t LayerParts, std::uint32_t BlockParts, std::uint32_t PlanChunk, std::uint32_t TetsPerItem = 1>
+/// layers and by blocks of each list (SearchPart), a tet per search item (or TetsPerItem), the
+/// grid's plan in small chunks (Exec::plan_chunk), and layer 0's cells CellSpacings spacings wide
+/// (Exec::grid_cell_spacings).
+template <std::uint32_t LayerParts, std::uint32_t BlockParts, std::uint32_t PlanChunk, std::uint32_t TetsPerItem = 1,
+          std::uint32_t CellSpacings = 4>
 struct GpuShapedExec : CpuExec {
     using CpuExec::CpuExec;
     static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return LayerParts; }
     static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return BlockParts; }
     static constexpr std::uint32_t search_tets_per_item = TetsPerItem;
     static constexpr std::uint32_t plan_chunk = PlanChunk;
+    static constexpr float grid_cell_spacings = static_cast<float>(CellSpacings);
 };
 
 /// One frame of `pipeline` over `meshes`, every object against the others and, with `self`, itself;
@@ -295,8 +298,9 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
             Pipeline<CpuExec> whole(options);
             Pipeline<GpuShapedExec<3, 1, 1>> by_layers(options);
             Pipeline<GpuShapedExec<1, 8, 256>> by_blocks(options);
-            Pipeline<GpuShapedExec<4, 2, 16>> like_cuda(options); // CudaExec's
-            Pipeline<GpuShapedExec<2, 4, 16>> like_cuda_without_self(options); // CudaExec's for small scenes without self-collision
+            Pipeline<GpuShapedExec<4, 2, 16, 1, 1>> like_cuda(options); // CudaExec's, cells one spacing wide
+            // CudaExec's for small scenes without self-collision
+            Pipeline<GpuShapedExec<2, 4, 16, 1, 1>> like_cuda_without_self(options);
             // Runs of 7 tets, split by layers: runs end inside objects and the last one is short.
             Pipeline<GpuShapedExec<3, 1, 256, 7>> odd_runs(options);
             const FrameResult expected = run_pipeline(whole, meshes, self); // runs of CpuExec::search_tets_per_item

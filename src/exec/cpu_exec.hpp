@@ -155,6 +155,14 @@ public:
     /// VM's slow phase).
     static constexpr std::uint32_t search_tets_per_item = 32;
 
+    /// @brief How many of the tets' spacings layer 0's cells span at least (GridParamsKernel), so that
+    /// a cell holds dozens of tets: a query's visit of a cell costs far more than reading an entry of
+    /// its list (soup 100k: about 120 cycles a visit, 2.3 an entry read), and the block bounds skip most
+    /// of a large cell's entries. With 1 instead of 4, the frames of soup 100k took 37 ms against 28,
+    /// those of the thesis scenes at resolution 4 with self-collision 10-15 % longer
+    /// (docs/performance.md).
+    static constexpr float grid_cell_spacings = 4.0f;
+
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): many, since an item
     /// adds its counts with a few atomics and bounds the cells by what its previous tet covered.
     static constexpr std::uint32_t plan_chunk = 256;

@@ -235,6 +235,13 @@ public:
     /// enough (its appends are gathered per warp).
     static constexpr std::uint32_t search_tets_per_item = 1;
 
+    /// @brief How many of the tets' spacings layer 0's cells span at least (GridParamsKernel): one, the
+    /// spacing. A thread scans a tet's lists and a thread gathers each cell's list, so the longer lists
+    /// of larger cells keep a warp's other threads waiting; on an H100, four spacings (the CPU's
+    /// choice) made procedural 100k's frames 2.0-2.1 -> 3.0 ms and the resolution-4 scenes without
+    /// self-collision 4-30 % longer (docs/performance.md).
+    static constexpr float grid_cell_spacings = 1.0f;
+
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): few, since a thread
     /// walks its tets in series (256 took 0.2-0.33 ms on an H200, a tenth of the frame's kernels);
     /// the plan's bound on the cells loosens a little (each item counts its first tet's cells whole).

@@ -303,21 +303,15 @@ struct TetSizeKernel {
     }
 };
 
-/// @brief How many of the tets' spacings (median_spacing) layer 0's cells span at least, so that a
-/// cell holds dozens of tets: a query's visit of a cell costs far more than reading an entry of its
-/// list (soup 100k: about 120 cycles a visit, 2.3 an entry read), and the block bounds skip most of a
-/// large cell's entries. With 1 instead of 4, the frames of soup 100k took 37 ms against 28, those
-/// of the thesis scenes at resolution 4 with self-collision 10-15 % longer (docs/performance.md).
-constexpr float cell_spacings = 4.0f;
-
 /// @brief Stage 1, grid methods only, one work item: the grid's geometry from the relevant tets' sizes
 /// and spacings (TetSizeKernel) and the region (ObjectCullingKernel), written where the later kernels
 /// read it. c0 is the smallest size, so the smallest tets sit on layer 0, unless the tets lie closer
-/// together than that: then c0 is cell_spacings times their median spacing (rounded up to a power of
-/// two), and every smaller tet shares layer 0. Cells about the spacing's size each hold about one tet
-/// (a sparse soup of small tets), and every such tet costs inserts into cells of its own and lookups
-/// on each of the many layers above it; in a mesh, whose tets touch, the spacing is about the typical
-/// tet's size, so most of its tets share layer 0, each in one or two cells per axis. The spacing is
+/// together than that: then c0 is `cell_spacings` (Exec::grid_cell_spacings) times their median
+/// spacing, rounded up to a power of two, and every smaller tet shares layer 0. Cells about the
+/// spacing's size each hold about one tet (a sparse soup of small tets), and every such tet costs
+/// inserts into cells of its own and lookups on each of the many layers above it; in a mesh, whose
+/// tets touch, the spacing is about the typical tet's size, so most of its tets share layer 0, each in
+/// one or two cells per axis. The spacing is
 /// measured along the storage order, which is spatial (SceneTopology): a tet's predecessor is one of
 /// its neighbours. Enough layers to hold the largest, capped at max_grid_layers. No relevant tet: no
 /// layer, nothing is gridded.
@@ -327,6 +321,7 @@ struct GridParamsKernel {
     const std::uint32_t* spacing_octaves; ///< TetSizeKernel's
     const OrderedBox* region;
     GridParams* params;
+    float cell_spacings; ///< how many spacings layer 0's cells span at least
 
     KDET_HD void operator()(std::uint64_t) const {
         if (*min_size == float_to_ordered(INFINITY)) {
