@@ -73,5 +73,25 @@ TEST(GrownCapacity, KeepsWhatSufficesAndOtherwiseGrowsByAQuarterAtLeast) {
     EXPECT_LE(growths, 6u);
 }
 
+TEST(RerunCapacity, KeepsWhatSufficesAndOtherwiseAtLeastDoubles) {
+    EXPECT_EQ(rerun_capacity(0, 1000), 1250u);       // the first sizing: a quarter over the need
+    EXPECT_EQ(rerun_capacity(1000, 1000), 1000u);    // enough: unchanged
+    EXPECT_EQ(rerun_capacity(1000, 10), 1000u);      // never shrinks
+    EXPECT_EQ(rerun_capacity(1000, 1001), 2000u);    // a little more: twice as much
+    EXPECT_EQ(rerun_capacity(1000, 5000), 6250u);    // much more: a quarter over the need
+    // A need that grows by a fifth a frame (a deepening overlap) for 40 frames outgrows the buffer
+    // every few frames, not every frame, and the buffer stays within twice the need.
+    std::uint64_t capacity = 1000, growths = 0;
+    double need = 1000.0;
+    for (int frame = 0; frame < 40; ++frame, need *= 1.2) {
+        const std::uint64_t grown = rerun_capacity(capacity, static_cast<std::uint64_t>(need));
+        growths += grown != capacity;
+        capacity = grown;
+        EXPECT_GE(capacity, static_cast<std::uint64_t>(need));
+        EXPECT_LE(capacity, 2 * static_cast<std::uint64_t>(need) + 1);
+    }
+    EXPECT_LE(growths, 11u);
+}
+
 } // namespace
 } // namespace kdet

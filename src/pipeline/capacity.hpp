@@ -17,4 +17,15 @@ constexpr std::uint64_t grown_capacity(std::uint64_t current, std::uint64_t want
     return std::min(limit, std::max(wanted, current + current / 4));
 }
 
+/// @brief The capacity a buffer of `current` elements grows to when a frame outgrew it and runs again
+/// from the stage that fills it: unchanged while it suffices, else `wanted` and a quarter more, and
+/// at least twice `current`. A scene whose overlap deepens needs more every frame (the thesis's
+/// pass-through: a fifth more candidates each frame as the objects sink into each other), so a
+/// quarter over the need ran out within a frame or two, and each time the frame's search ran again;
+/// doubling makes that happen a logarithmic number of times, for at most twice the largest need.
+constexpr std::uint64_t rerun_capacity(std::uint64_t current, std::uint64_t wanted) {
+    if (wanted <= current) return current;
+    return std::max(wanted + wanted / 4, 2 * current);
+}
+
 } // namespace kdet

@@ -681,13 +681,13 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
         grid_again = c.grid_failure != 0;
     }
     if (c.candidates > candidates_.size()) {
-        candidates_.resize_discard(c.candidates + c.candidates / 4);
+        candidates_.resize_discard(rerun_capacity(candidates_.size(), c.candidates));
         candidates_again = true;
     }
     bool pairs_again = false;
     if (options_.method != Method::kdet_no_pairs) {
         if (c.colliding_pairs > pairs_window_) {
-            pairs_window_ = c.colliding_pairs + c.colliding_pairs / 4;
+            pairs_window_ = rerun_capacity(pairs_window_, c.colliding_pairs);
             pairs_again = true;
         } else if (c.colliding_pairs * 4 < pairs_window_ && pairs_window_ > 4096) {
             // Far fewer pairs than room: the GPU sorts the whole window, so it shrinks (memory stays).
