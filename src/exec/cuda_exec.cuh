@@ -237,9 +237,11 @@ public:
 
     /// @brief How many of the tets' spacings layer 0's cells span at least (GridParamsKernel): one, the
     /// spacing. A thread scans a tet's lists and a thread gathers each cell's list, so the longer lists
-    /// of larger cells keep a warp's other threads waiting; on an H100, four spacings (the CPU's
-    /// choice) made procedural 100k's frames 2.0-2.1 -> 3.0 ms and the resolution-4 scenes without
-    /// self-collision 4-30 % longer (docs/performance.md).
+    /// of larger cells keep a warp's other threads waiting: on an H100, four spacings (the CPU's
+    /// choice) made procedural 100k's frames 2.0 -> 3.0 ms, the resolution-4 scenes without
+    /// self-collision 11-27 % longer and procedural 8M with self-collision take 38 GB instead of 9,
+    /// while two spacings ran as one (bench/results/gpu-h100, 73fd55f). With self-collision, four
+    /// shortened two of the three resolution-4 scenes by 7-9 %.
     static constexpr float grid_cell_spacings = 1.0f;
 
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): few, since a thread
