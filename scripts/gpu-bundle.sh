@@ -7,8 +7,9 @@
 #
 # usage: scripts/gpu-bundle.sh [COMMIT ...]
 #   builds build-gpu/ (preset cuda) and fills .gpu-bundle/; each COMMIT's kdet is built too (from a
-#   worktree, into build-gpu-COMMIT/, kept for the next time) and bundled as kdet-COMMIT, which the
-#   session's `compare` part runs against the bundle's kdet
+#   worktree in $TMPDIR/kdet-bundle-worktrees, into build-gpu-COMMIT/, both kept for the next time;
+#   `git worktree prune` after deleting that folder) and bundled as kdet-COMMIT, which the session's
+#   `compare` part runs against the bundle's kdet
 # then, with the device tool, one call that runs the parts it needs, e.g.:
 #   run(command="KDET_GPU_DEADLINE=500 bash scripts/gpu-session.sh tests sanitizers r4 peer scaling",
 #       carry=[".gpu-bundle"])
@@ -33,12 +34,16 @@ mkdir -p "$bundle/lib"
 cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bundle/"
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"
-  worktree="$(mktemp -d)/kdet-$short"
-  git -C "$repo" worktree add --detach "$worktree" "$short" >/dev/null
+  # Kept, like the build folder, at the same path every time: the build's CMake cache names its
+  # source folder, and files checked out again would all look newer than their objects.
+  worktree="${TMPDIR:-/tmp}/kdet-bundle-worktrees/kdet-$short"
+  [[ -d "$worktree" ]] || git -C "$repo" worktree add --detach "$worktree" "$short" >/dev/null
+  # A folder kept from a build of another source folder (older forms of this script) starts afresh.
+  cache="$repo/build-gpu-$short/CMakeCache.txt"
+  [[ ! -f "$cache" ]] || grep -qx "CMAKE_HOME_DIRECTORY:INTERNAL=$worktree" "$cache" || rm -rf "$repo/build-gpu-$short"
   (cd "$worktree" && cmake --preset cuda -B "$repo/build-gpu-$short" >/dev/null)
   cmake --build "$repo/build-gpu-$short" -j"$(nproc)" --target kdet_cli
   cp "$repo/build-gpu-$short/kdet" "$bundle/kdet-$short"
-  git -C "$repo" worktree remove --force "$worktree"
 done
 # Libraries beyond glibc (and its libdl, libpthread, librt), libstdc++, libgcc and libgomp, which the
 # device image has; older builds of kdet linked the viewer's too.

@@ -11,7 +11,7 @@
 #            occupancy, divergence and cache hits, and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
 #   compare  the bundle's kdet against the other builds it holds as kdet-NAME (scripts/gpu-bundle.sh
-#            COMMIT ... puts them there), two alternating rounds on eight cases
+#            COMMIT ... puts them there), two alternating rounds on eleven cases
 #   matrix   the thesis benchmark matrix (scripts/run-thesis-matrix.sh) until the deadline
 # usage: scripts/gpu-session.sh PART [PART ...]   (e.g. tests r4 sanitizers scaling)
 # Settings: KDET_GPU_DEADLINE, seconds after which no step starts and running ones are stopped [500].
@@ -139,6 +139,9 @@ for part in "$@"; do
       for program in $others kdet; do
         for case in "procedural-100k procedural --tets 100000 -s no --frames 55:65" \
           "armadillos-r4-self armadillos -r 4 -s yes --frames 70:99" \
+          "buddha_and_armadillo-r4-self buddha_and_armadillo -r 4 -s yes --frames 70:99" \
+          "bunny_and_planck-r4-self bunny_and_planck -r 4 -s yes --frames 70:99" \
+          "procedural-100k-self procedural --tets 100000 -s yes --frames 55:65" \
           "armadillos-r4 armadillos -r 4 -s no --frames 70:99" \
           "buddha_and_armadillo-r4 buddha_and_armadillo -r 4 -s no --frames 70:99" \
           "bunny_and_planck-r4 bunny_and_planck -r 4 -s no --frames 70:99" \
