@@ -3,6 +3,7 @@
 /// @brief How the detector's buffers grow when a frame needs more room than they have.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace kdet {
@@ -26,6 +27,20 @@ constexpr std::uint64_t grown_capacity(std::uint64_t current, std::uint64_t want
 constexpr std::uint64_t rerun_capacity(std::uint64_t current, std::uint64_t wanted) {
     if (wanted <= current) return current;
     return std::max(wanted + wanted / 4, 2 * current);
+}
+
+/// @brief The colliding pairs' window when the candidates outgrew their buffer: the narrow phase
+/// decided only the `candidates_fitted` that fit and found `pairs_found` colliding among them; the
+/// window gets room for as many pairs per candidate over the buffer's new `candidate_capacity`, and
+/// never shrinks here. The frame runs its search and narrow phase again for the candidates anyway,
+/// so the window grows in that rerun instead of outgrowing in one of its own a frame or two later
+/// (in a deepening overlap the pairs grow with the candidates).
+inline std::uint64_t pairs_window_for_candidates(std::uint64_t window, std::uint64_t pairs_found,
+                                                 std::uint64_t candidates_fitted, std::uint64_t candidate_capacity) {
+    if (candidates_fitted == 0) return window;
+    const double room = std::ceil(static_cast<double>(pairs_found) / static_cast<double>(candidates_fitted) *
+                                  static_cast<double>(candidate_capacity));
+    return std::max(window, static_cast<std::uint64_t>(room));
 }
 
 } // namespace kdet

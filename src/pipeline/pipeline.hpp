@@ -680,13 +680,16 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
         size_grid(c);
         grid_again = c.grid_failure != 0;
     }
-    if (c.candidates > candidates_.size()) {
-        candidates_.resize_discard(rerun_capacity(candidates_.size(), c.candidates));
+    const std::size_t candidates_fitted = candidates_.size();
+    if (c.candidates > candidates_fitted) {
+        candidates_.resize_discard(rerun_capacity(candidates_fitted, c.candidates));
         candidates_again = true;
     }
     bool pairs_again = false;
     if (options_.method != Method::kdet_no_pairs) {
-        if (c.colliding_pairs > pairs_window_) {
+        if (candidates_again) {
+            pairs_window_ = pairs_window_for_candidates(pairs_window_, c.colliding_pairs, candidates_fitted, candidates_.size());
+        } else if (c.colliding_pairs > pairs_window_) {
             pairs_window_ = rerun_capacity(pairs_window_, c.colliding_pairs);
             pairs_again = true;
         } else if (c.colliding_pairs * 4 < pairs_window_ && pairs_window_ > 4096) {
