@@ -311,10 +311,9 @@ struct TetSizeKernel {
 /// spacing's size each hold about one tet (a sparse soup of small tets), and every such tet costs
 /// inserts into cells of its own and lookups on each of the many layers above it; in a mesh, whose
 /// tets touch, the spacing is about the typical tet's size, so most of its tets share layer 0, each in
-/// one or two cells per axis. The spacing is
-/// measured along the storage order, which is spatial (SceneTopology): a tet's predecessor is one of
-/// its neighbours. Enough layers to hold the largest, capped at max_grid_layers. No relevant tet: no
-/// layer, nothing is gridded.
+/// one or two cells per axis. The spacing is measured along the storage order, which is spatial
+/// (SceneTopology): a tet's predecessor is one of its neighbours. Enough layers to hold the largest,
+/// capped at max_grid_layers. No relevant tet: no layer, nothing is gridded.
 struct GridParamsKernel {
     const std::uint32_t* min_size; ///< float_to_ordered
     const std::uint32_t* max_size;

@@ -307,7 +307,7 @@ void Pipeline<Exec>::grid_geometry() {
     exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size, &c->min_upper_size, &c->max_lower_size,
                                                  c->spacing_octaves});
     exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, c->spacing_octaves, &c->region, &c->params,
-                                                   Exec::grid_cell_spacings});
+                                       Exec::grid_cell_spacings});
     constexpr std::uint32_t chunk = Exec::plan_chunk;
     exec_.for_each((tets_.size() + chunk - 1) / chunk,
                    GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask}, chunk);
