@@ -93,18 +93,17 @@ TEST(RerunCapacity, KeepsWhatSufficesAndOtherwiseAtLeastDoubles) {
     EXPECT_LE(growths, 11u);
 }
 
-TEST(PairsWindowForCandidates, GivesThePairsTheCandidatesNewRoom) {
-    // 300 of the 1,000 candidates that fit collide; the buffer grows to 2,500: room for 750 pairs.
-    EXPECT_EQ(pairs_window_for_candidates(400, 300, 1000, 2500), 750u);
-    EXPECT_EQ(pairs_window_for_candidates(1000, 300, 1000, 2500), 1000u); // never shrinks here
-    EXPECT_EQ(pairs_window_for_candidates(400, 1, 3, 10), 400u);          // rounds up, not below the window
-    EXPECT_EQ(pairs_window_for_candidates(2, 1, 3, 10), 4u);
-    EXPECT_EQ(pairs_window_for_candidates(400, 0, 0, 2500), 400u);        // nothing fitted: nothing to go by
-    // A deepening overlap (pass_through_armadillos r2 on the CPU): candidates 311,057 outran a buffer of
-    // 262,144 whose 208,249 pairs had filled the window; the rerun's window holds the 280,032 pairs
-    // of the next frames, which a window grown only for its own overflow ran out of a frame later.
+TEST(PairsWindowForCandidates, GrowsByTheCandidatesFactor) {
+    EXPECT_EQ(pairs_window_for_candidates(400, 1000, 2500), 1000u);   // the candidates grew 2.5 times
+    EXPECT_EQ(pairs_window_for_candidates(1, 3, 10), 4u);             // rounds up
+    EXPECT_EQ(pairs_window_for_candidates(400, 1000, 1000), 400u);    // no growth: unchanged
+    EXPECT_EQ(pairs_window_for_candidates(400, 0, 2500), 400u);       // no buffer before: nothing to go by
+    // A deepening overlap (pass_through_armadillos r2 on the CPU): 311,057 candidates outran a buffer
+    // of 262,144 whose pairs had filled a window of 262,144; the window of the candidates' rerun holds
+    // the 280,032 pairs of the next frames, where a window grown only for its own overflow ran out a
+    // frame later.
     const std::uint64_t capacity = rerun_capacity(262144, 311057);
-    EXPECT_GE(pairs_window_for_candidates(262144, 208249, 262144, capacity), 280032u);
+    EXPECT_GE(pairs_window_for_candidates(262144, 262144, capacity), 280032u);
 }
 
 } // namespace

@@ -29,18 +29,19 @@ constexpr std::uint64_t rerun_capacity(std::uint64_t current, std::uint64_t want
     return std::max(wanted + wanted / 4, 2 * current);
 }
 
-/// @brief The colliding pairs' window when the candidates outgrew their buffer: the narrow phase
-/// decided only the `candidates_fitted` that fit and found `pairs_found` colliding among them; the
-/// window gets room for as many pairs per candidate over the buffer's new `candidate_capacity`, and
-/// never shrinks here. The frame runs its search and narrow phase again for the candidates anyway,
-/// so the window grows in that rerun instead of outgrowing in one of its own a frame or two later
-/// (in a deepening overlap the pairs grow with the candidates).
-inline std::uint64_t pairs_window_for_candidates(std::uint64_t window, std::uint64_t pairs_found,
-                                                 std::uint64_t candidates_fitted, std::uint64_t candidate_capacity) {
-    if (candidates_fitted == 0) return window;
-    const double room = std::ceil(static_cast<double>(pairs_found) / static_cast<double>(candidates_fitted) *
-                                  static_cast<double>(candidate_capacity));
-    return std::max(window, static_cast<std::uint64_t>(room));
+/// @brief The colliding pairs' window when the candidates outgrew their buffer of
+/// `candidate_capacity_before` keys and it grew to `candidate_capacity`: the window grows by the same
+/// factor (never shrinks here). The frame runs its search and narrow phase again for the candidates
+/// anyway, so the window grows in that rerun instead of outgrowing in one of its own a frame or two
+/// later (in a deepening overlap the pairs grow with the candidates). Only sizes go in: which of the
+/// candidates fitted, and so how many pairs the narrow phase found among them, depends on how the
+/// threads shared the work, and the detector's memory would too.
+inline std::uint64_t pairs_window_for_candidates(std::uint64_t window, std::uint64_t candidate_capacity_before,
+                                                 std::uint64_t candidate_capacity) {
+    if (candidate_capacity_before == 0) return window;
+    const double grown = std::ceil(static_cast<double>(window) / static_cast<double>(candidate_capacity_before) *
+                                   static_cast<double>(candidate_capacity));
+    return std::max(window, static_cast<std::uint64_t>(grown));
 }
 
 } // namespace kdet
