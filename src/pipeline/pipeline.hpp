@@ -688,6 +688,7 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
     bool pairs_again = false;
     if (options_.method != Method::kdet_no_pairs) {
         if (candidates_again) {
+            // The rerun decides every candidate again: the window grows with them, in it.
             pairs_window_ = pairs_window_for_candidates(pairs_window_, candidates_fitted, candidates_.size());
         } else if (c.colliding_pairs > pairs_window_) {
             pairs_window_ = rerun_capacity(pairs_window_, c.colliding_pairs);
