@@ -813,8 +813,9 @@ struct NoPairsKernel {
             visit.t = static_cast<std::uint32_t>(i);
             search(visit);
         } else {
+            using Runs = TetRuns<TetsPerItem>;
             const auto run = static_cast<std::uint32_t>(i);
-            for (std::uint32_t t = TetRuns<TetsPerItem>::first(run); t < TetRuns<TetsPerItem>::end(run, scene.tet_count); ++t) {
+            for (std::uint32_t t = Runs::first(run), end = Runs::end(run, scene.tet_count); t < end; ++t) {
                 visit.t = t;
                 search(visit);
             }
