@@ -38,10 +38,12 @@ for line in run.stderr.splitlines():
     m = re.search(r"Compiling entry function '(\S+)'", line)
     if m:
         plain = subprocess.run(["c++filt", m.group(1)], capture_output=True, text=True).stdout.strip()
-        k = re.search(r"for_each(?:_counted)?_kernel<kdet::(\w+)(?:<\(kdet::NarrowPhase\)(\d+)(?:, \w+)?>)?", plain)
+        k = re.search(r"for_each(?:_counted)?_kernel<kdet::(\w+)(?:<\(kdet::NarrowPhase\)(\d+)((?:, \w+)*)>)?", plain)
         tests = ["sat", "sat_no_edges", "sat_mtv", "gjk", "fast", "exact"]  # kdet::NarrowPhase's order
-        # CUB's own kernels are left out; a kernel per narrow-phase test is named with its test.
-        name = (k.group(1) + (f"<{tests[int(k.group(2))]}>" if k.group(2) else "")) if k else None
+        # CUB's own kernels are left out; a kernel per narrow-phase test is named with its test, and the
+        # narrow phase that runs the face planes (NarrowPhaseKernel's last argument) with ", planes".
+        planes = ", planes" if k and k.group(1) == "NarrowPhaseKernel" and (k.group(3) or "").endswith("true") else ""
+        name = (k.group(1) + (f"<{tests[int(k.group(2))]}{planes}>" if k.group(2) else "")) if k else None
     m = re.search(r"(\d+) bytes stack frame", line)
     if m:
         stack = m.group(1)
@@ -50,7 +52,7 @@ for line in run.stderr.splitlines():
         rows.append((name, int(m.group(1)), int(stack)))
         name = None
 print(f"sm_{arch}: per thread")
-print(f"{'kernel':36s} {'registers':>9s} {'stack bytes':>11s}")
+print(f"{'kernel':40s} {'registers':>9s} {'stack bytes':>11s}")
 for n, r, s in sorted(rows):
-    print(f"{n:36s} {r:9d} {s:11d}")
+    print(f"{n:40s} {r:9d} {s:11d}")
 EOF

@@ -155,6 +155,11 @@ public:
     /// VM's slow phase).
     static constexpr std::uint32_t search_tets_per_item = 32;
 
+    /// @brief The face-plane pre-test runs inside the candidate search, where the searching tet's
+    /// planes and its neighbours' data are in the thread's caches, so that only the pairs it cannot
+    /// decide are written.
+    static constexpr bool face_planes_in_search = true;
+
     /// @brief How many of the tets' spacings layer 0's cells span at least (GridParamsKernel), so that
     /// a cell holds dozens of tets: a query's visit of a cell costs far more than reading an entry of
     /// its list (soup 100k: about 120 cycles a visit, 2.3 an entry read), and the block bounds skip most

@@ -235,6 +235,12 @@ public:
     /// enough (its appends are gathered per warp).
     static constexpr std::uint32_t search_tets_per_item = 1;
 
+    /// @brief The face-plane pre-test runs in the narrow phase, a thread a pair, not inside the
+    /// candidate search: there a lane with a match ran it (a few hundred instructions) while the others
+    /// of its warp waited, 4.2 of 32 lanes busy on an H100 (armadillos r4 with self-collision, at
+    /// 73fd55f). The search writes the pairs the slabs leave, more keys for fuller warps.
+    static constexpr bool face_planes_in_search = false;
+
     /// @brief How many of the tets' spacings layer 0's cells span at least (GridParamsKernel): one, the
     /// spacing. A thread scans a tet's lists and a thread gathers each cell's list, so the longer lists
     /// of larger cells keep a warp's other threads waiting: on an H100, four spacings (the CPU's

@@ -273,10 +273,11 @@ enum class PlaneVerdict { unsure, separated, intersecting };
 
 /// @brief The face-plane pre-test of tets a and b (with their planes pa and pb): b's planes go first,
 /// and b's vertices are read only when they do not separate the pair (the grid's pairs read them from
-/// beside b's planes, TetPlanes::vertex). In the grid's pairs b is the larger tet, whose faces
-/// separate more pairs (the bunny cases: 70-76 % of the pairs, against 45-48 % by a's), and the smaller
-/// a's edges are the likelier to pass through it, so the host tries them first. With `separation_only`,
-/// an intersection is not looked for (the caller only rejects).
+/// beside b's planes, TetPlanes::vertex). In the candidate search's pairs b is the larger tet, whose
+/// faces separate more pairs (the bunny cases: 70-76 % of the pairs, against 45-48 % by a's), and the
+/// smaller a's edges are the likelier to pass through it, so they are tried first (the narrow phase,
+/// where the GPU runs the pre-test, takes a pair's tets in id order). With `separation_only`, an
+/// intersection is not looked for (the caller only rejects).
 KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
                                                const vec3 b[4], bool separation_only) {
     const float longest = max_f(pa.longest, pb.longest), longest2 = longest * longest;
@@ -286,18 +287,8 @@ KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a
     if (b_by_a.separated) return PlaneVerdict::separated;
     if (separation_only) return PlaneVerdict::unsure;
     if (b_by_a.inside || a_by_b.inside) return PlaneVerdict::intersecting;
-    // The same verdict in either order; on the GPU a's edges first took FindCandidatesKernel from 167 to
-    // 190 registers (sm_90), so it keeps b's first.
-#if defined(__CUDA_ARCH__)
-    constexpr bool smaller_edges_first = false;
-#else
-    constexpr bool smaller_edges_first = true;
-#endif
-    const TetPlanes& first_planes = smaller_edges_first ? pb : pa;
-    const TetPlanes& second_planes = smaller_edges_first ? pa : pb;
-    const vec3* first_edges = smaller_edges_first ? a : b;
-    const vec3* second_edges = smaller_edges_first ? b : a;
-    if (edges_pass_inside(first_planes, first_edges, longest2) || edges_pass_inside(second_planes, second_edges, longest2))
+    // The same verdict in either order; a's edges go first (see above).
+    if (edges_pass_inside(pb, a, longest2) || edges_pass_inside(pa, b, longest2))
         return PlaneVerdict::intersecting;
     return PlaneVerdict::unsure;
 }

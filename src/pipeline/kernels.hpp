@@ -118,18 +118,30 @@ KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint
     return tets_intersect_as<Test>(a, b, exact_stage, after_pretest);
 }
 
-/// @brief The decision for a pair whose boxes overlap and that is not adjacent (first < second): the
-/// pre-test where it is sure (the slabs where the scene has them, then the face planes; the answer the
-/// test gives, see slabs.hpp and face_planes.hpp), else the test.
+/// @brief The decision for a grid method's pair (first < second) whose boxes overlap, that is not
+/// adjacent and that the slabs did not separate: the face planes' verdict where they are sure (the
+/// answer the test gives, see face_planes.hpp), else the test. `planes_separate` is set when the
+/// planes proved the pair apart.
+template <NarrowPhase Test>
+KDET_HD inline bool planes_or_test_collide(const SceneView& s, std::uint32_t first, std::uint32_t second,
+                                           bool& exact_stage, bool& planes_separate) {
+    // Both tets' planes and the vertices beside them are this frame's.
+    const TetPlanes &pa = s.planes[first], &pb = s.planes[second];
+    const PlaneVerdict verdict = face_plane_pretest(pa, pa.vertex, pb, pb.vertex, false);
+    planes_separate = verdict == PlaneVerdict::separated;
+    if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
+    return tets_intersect_as<Test>(pa.vertex, pb.vertex, exact_stage, true);
+}
+
+/// @brief The decision for a grid method's pair whose boxes overlap and that is not adjacent (first <
+/// second): the pre-test where it is sure (the slabs where the scene has them, then the face planes;
+/// see slabs.hpp), else the test.
 template <NarrowPhase Test>
 KDET_HD inline bool candidate_collides(const SceneView& s, std::uint32_t first, std::uint32_t second,
                                        bool& exact_stage) {
-    // A grid method's pair: both tets' slabs, planes and the vertices beside them are this frame's.
     if (s.slabs && slabs_separate(s.slabs[first], s.slabs[second])) return false;
-    const TetPlanes &pa = s.planes[first], &pb = s.planes[second];
-    const PlaneVerdict verdict = face_plane_pretest(pa, pa.vertex, pb, pb.vertex, false);
-    if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
-    return tets_intersect_as<Test>(pa.vertex, pb.vertex, exact_stage, true);
+    bool planes_separate = false;
+    return planes_or_test_collide<Test>(s, first, second, exact_stage, planes_separate);
 }
 
 /// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, and
@@ -650,15 +662,16 @@ struct TetRuns {
 };
 
 /// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the pre-test (the slabs where the
-/// scene has them, then the face planes) cannot prove separated (those it can are only counted): a
-/// rejected pair is never written, sorted or loaded again. A pair the face planes prove intersecting is
-/// written as a proven_pair_key, so that the narrow phase neither repeats the pre-test nor runs the
-/// test on it. An item searches a run of TetsPerItem consecutive tets (SearchPart's share of each)
+/// scene has them, then, with FacePlanesInSearch, the face planes) cannot prove separated (those it
+/// can are only counted): a rejected pair is never written, sorted or loaded again. A pair the face
+/// planes prove intersecting is written as a proven_pair_key, so that the narrow phase neither
+/// repeats the pre-test nor runs the test on it. Without FacePlanesInSearch the narrow phase runs the
+/// face planes, a thread a pair (Exec::face_planes_in_search). An item searches a run of TetsPerItem consecutive tets (SearchPart's share of each)
 /// and appends their keys and adds their rejections together (Exec::search_tets_per_item: a constant,
 /// so that the GPU's item of one tet keeps no loop). An item whose keys did not all fit leaves a
 /// ResumePoint instead of counting its rejections; a rerun after growing (`resume_from` set) runs
 /// only those items.
-template <std::uint32_t TetsPerItem>
+template <std::uint32_t TetsPerItem, bool FacePlanesInSearch>
 struct FindCandidatesKernel {
     SceneView scene;
     GridView grid;
@@ -689,7 +702,7 @@ struct FindCandidatesKernel {
         std::uint32_t t;
         SpreadIndices tet;
         std::uint32_t object;
-        TetPlanes planes; ///< t's, its vertices included
+        TetPlanes planes; ///< t's, its vertices included (with FacePlanesInSearch)
         TetSlabs slabs;   ///< t's, where the scene has them
         unsigned long long rejected;
         KDET_HD void operator()(const GridEntry& e) {
@@ -703,7 +716,10 @@ struct FindCandidatesKernel {
                 ++rejected;
                 return;
             }
-            pretest(u);
+            if constexpr (FacePlanesInSearch)
+                pretest(u);
+            else
+                batch->push(pair_key(t, u));
         }
         /// The face-plane pre-test of (t, u); writes the pair unless it is proven separated.
         KDET_HD void pretest(std::uint32_t u) {
@@ -759,8 +775,8 @@ struct FindCandidatesKernel {
 
     /// @brief Tet t's share of the search, its keys into `batch`; returns the pairs it rejected.
     KDET_HD unsigned long long search(std::uint32_t t, const SearchPart& part, KeyBatch& batch) const {
-        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t], scene.planes[t],
-                  scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
+        Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t],
+                  FacePlanesInSearch ? scene.planes[t] : TetPlanes{}, scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
         return emit.rejected;
@@ -903,10 +919,11 @@ struct BruteForcePairsKernel {
 /// appends each colliding pair under the caller's tet ids (lower id first; sorted afterwards, so
 /// the order of appends does not matter). A proven_pair_key collides (the candidate search's pre-test
 /// proved it); every other pair, which the pre-test left undecided or never saw (brute force), gets
-/// the test. Work item i decides keys [i KeysPerItem, (i + 1) KeysPerItem) of the first
+/// the test, after the face planes with FacePlanesHere (the search did not run them: rejections are
+/// counted in `rejected`). Work item i decides keys [i KeysPerItem, (i + 1) KeysPerItem) of the first
 /// min(*key_count, key_capacity): with more than one, its pairs are appended a batch at a time (one
 /// atomic per batch where every pair would take one, all on the same counter).
-template <NarrowPhase Test, std::uint32_t KeysPerItem>
+template <NarrowPhase Test, std::uint32_t KeysPerItem, bool FacePlanesHere>
 struct NarrowPhaseKernel {
     SceneView scene;
     const std::uint64_t* keys;
@@ -916,16 +933,27 @@ struct NarrowPhaseKernel {
     const std::uint32_t* user_id; ///< [tets] stored id -> caller's global id
     KeyAppender out;
     unsigned long long* exact_stage_pairs;
+    unsigned long long* rejected; ///< with FacePlanesHere: the pairs the face planes proved separated
 
-    /// @brief Decides key k; true, with the pair under the caller's ids, when it collides.
-    KDET_HD bool decide(std::uint64_t k, std::uint64_t& pair) const {
+    /// @brief Decides key k; true, with the pair under the caller's ids, when it collides. Counts a
+    /// pair the face planes proved separated in `planes_rejected`.
+    KDET_HD bool decide(std::uint64_t k, std::uint64_t& pair, unsigned long long& planes_rejected) const {
         if (keys[k] == no_pair_key) return false;
         const std::uint32_t a = key_first(keys[k]), b = key_second(keys[k]);
         const std::uint32_t t = a < b ? a : b, u = a < b ? b : a;
         bool reached_exact = false;
-        // Edge axes first: the pre-test left this pair undecided, or brute force found it colliding
-        // (every axis runs then anyway).
-        const bool collides = a > b || test_pair<Test>(scene, t, u, reached_exact, true);
+        bool collides = a > b;
+        if (!collides) {
+            // Edge axes first: the pre-test left this pair undecided, or brute force found it colliding
+            // (every axis runs then anyway).
+            if constexpr (FacePlanesHere) {
+                bool planes_separate = false;
+                collides = planes_or_test_collide<Test>(scene, t, u, reached_exact, planes_separate);
+                planes_rejected += planes_separate ? 1u : 0u;
+            } else {
+                collides = test_pair<Test>(scene, t, u, reached_exact, true);
+            }
+        }
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
         if (!collides) return false;
         atomic_store_relaxed(&colliding[t], 1u);
@@ -936,17 +964,19 @@ struct NarrowPhaseKernel {
 
     KDET_HD void operator()(std::uint64_t item) const {
         std::uint64_t pair = 0;
+        unsigned long long planes_rejected = 0;
         if constexpr (KeysPerItem == 1) {
-            if (decide(item, pair)) out.push(pair);
+            if (decide(item, pair, planes_rejected)) out.push(pair);
         } else {
             const std::uint64_t count = *key_count < key_capacity ? *key_count : key_capacity;
             const std::uint64_t begin = item * KeysPerItem;
             const std::uint64_t end = count - begin < KeysPerItem ? count : begin + KeysPerItem;
             KeyBatch batch(&out);
             for (std::uint64_t k = begin; k < end; ++k)
-                if (decide(k, pair)) batch.push(pair);
+                if (decide(k, pair, planes_rejected)) batch.push(pair);
             batch.flush();
         }
+        if (FacePlanesHere && planes_rejected) atomic_fetch_add_gathered(rejected, planes_rejected);
     }
 };
 

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <type_traits>
 
 namespace kdet {
 
@@ -29,6 +30,9 @@ struct FrameCounters {
     unsigned long long candidate_padding; ///< of which slots hold no_pair_key (see KeyAppender)
     alignas(64) unsigned long long tests_run;
     alignas(64) unsigned long long rejected; ///< candidate pairs the pre-test (slabs, face planes) proved separated
+    /// Of the candidates written, those the face planes proved separated in the narrow phase (where the
+    /// search does not run them: Exec::face_planes_in_search)
+    alignas(64) unsigned long long rejected_after_search;
     alignas(64) unsigned long long colliding_pairs; ///< appended (counts past the window's end)
     alignas(64) std::uint32_t cells_claimed;
     alignas(64) std::uint32_t grid_entries; ///< entries of the compacted cells
@@ -419,7 +423,7 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
     const std::uint32_t block_parts = split ? block_parts_wanted : 1u;
     const std::size_t parts = std::size_t{layer_parts} * block_parts;
     constexpr std::uint32_t tets_per_item = Exec::search_tets_per_item;
-    using Search = FindCandidatesKernel<tets_per_item>;
+    using Search = FindCandidatesKernel<tets_per_item, Exec::face_planes_in_search>;
     const std::size_t runs = TetRuns<tets_per_item>::count(static_cast<std::uint32_t>(tets_.size()));
     const std::size_t all_items = runs * parts, resume_room = tets_.size();
     for (auto& points : resume_points_) points.resize_discard(resume_room);
@@ -520,13 +524,22 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     // filled once, so that no byte copied is undefined.
     resize_filled(out_keys_, pairs_window_, no_pair_key);
     const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
+    // The search's candidates still need their face planes where it did not run them; brute force's
+    // pairs need none (and have no planes).
+    const bool face_planes_here = !Exec::face_planes_in_search && options_.method == Method::kdet;
     with_narrow_phase(options_.narrow_phase, [&](auto test) {
         constexpr std::uint32_t per_item = Exec::keys_per_appending_item;
-        exec_.for_each_counted(&c->candidates, candidates_.size(),
-                               NarrowPhaseKernel<decltype(test)::value, per_item>{
-                                   scene_view(), candidates_.data(), &c->candidates, candidates_.size(),
-                                   colliding_.data(), user_id_.data(), out, &c->exact_stage_pairs},
-                               per_item);
+        const auto decide = [&](auto planes_here) {
+            exec_.for_each_counted(&c->candidates, candidates_.size(),
+                                   NarrowPhaseKernel<decltype(test)::value, per_item, decltype(planes_here)::value>{
+                                       scene_view(), candidates_.data(), &c->candidates, candidates_.size(), colliding_.data(),
+                                       user_id_.data(), out, &c->exact_stage_pairs, &c->rejected_after_search},
+                                   per_item);
+        };
+        if (face_planes_here)
+            decide(std::true_type{});
+        else
+            decide(std::false_type{});
     });
     clock_.mark(narrow_phase_done);
     // The keys hold the caller's ids, which are below the tet count.
@@ -648,6 +661,7 @@ void Pipeline<Exec>::enqueue_again(const FrameCounters& c, Rerun stage) {
         kept.brute_force_exact_stage = 0;
     }
     kept.exact_stage_pairs = 0;
+    kept.rejected_after_search = 0;
     kept.colliding_pairs = 0;
     kept.colliding_tets = 0;
     exec_.upload(counters_.data(), &kept, 1);
@@ -750,8 +764,8 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
     if (method == Method::kdet_no_pairs) {
         counts.candidates = counts.unique_candidates = c.tests_run;
     } else {
-        counts.unique_candidates = c.candidates - c.candidate_padding;
-        counts.candidates = counts.unique_candidates + c.rejected;
+        counts.unique_candidates = c.candidates - c.candidate_padding - c.rejected_after_search;
+        counts.candidates = counts.unique_candidates + c.rejected + c.rejected_after_search;
     }
     counts.exact_stage_pairs = c.exact_stage_pairs;
     counts.colliding_pairs = colliding_count_;
