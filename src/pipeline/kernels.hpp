@@ -666,11 +666,11 @@ struct TetRuns {
 /// can are only counted): a rejected pair is never written, sorted or loaded again. A pair the face
 /// planes prove intersecting is written as a proven_pair_key, so that the narrow phase neither
 /// repeats the pre-test nor runs the test on it. Without FacePlanesInSearch the narrow phase runs the
-/// face planes, a thread a pair (Exec::face_planes_in_search). An item searches a run of TetsPerItem consecutive tets (SearchPart's share of each)
-/// and appends their keys and adds their rejections together (Exec::search_tets_per_item: a constant,
-/// so that the GPU's item of one tet keeps no loop). An item whose keys did not all fit leaves a
-/// ResumePoint instead of counting its rejections; a rerun after growing (`resume_from` set) runs
-/// only those items.
+/// face planes, a thread a pair (Exec::face_planes_in_search). An item searches a run of TetsPerItem
+/// consecutive tets (SearchPart's share of each) and appends their keys and adds their rejections
+/// together (Exec::search_tets_per_item: a constant, so that the GPU's item of one tet keeps no loop).
+/// An item whose keys did not all fit leaves a ResumePoint instead of counting its rejections; a rerun
+/// after growing (`resume_from` set) runs only those items.
 template <std::uint32_t TetsPerItem, bool FacePlanesInSearch>
 struct FindCandidatesKernel {
     SceneView scene;

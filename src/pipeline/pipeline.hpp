@@ -524,9 +524,6 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     // filled once, so that no byte copied is undefined.
     resize_filled(out_keys_, pairs_window_, no_pair_key);
     const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
-    // The search's candidates still need their face planes where it did not run them; brute force's
-    // pairs need none (and have no planes).
-    const bool face_planes_here = !Exec::face_planes_in_search && options_.method == Method::kdet;
     with_narrow_phase(options_.narrow_phase, [&](auto test) {
         constexpr std::uint32_t per_item = Exec::keys_per_appending_item;
         const auto decide = [&](auto planes_here) {
@@ -536,10 +533,12 @@ void Pipeline<Exec>::narrow_phase_and_results() {
                                        user_id_.data(), out, &c->exact_stage_pairs, &c->rejected_after_search},
                                    per_item);
         };
-        if (face_planes_here)
-            decide(std::true_type{});
-        else
-            decide(std::false_type{});
+        // The search's candidates still need their face planes where it did not run them; brute force's
+        // pairs need none (and have no planes).
+        if constexpr (!Exec::face_planes_in_search) {
+            if (options_.method == Method::kdet) return decide(std::true_type{});
+        }
+        decide(std::false_type{});
     });
     clock_.mark(narrow_phase_done);
     // The keys hold the caller's ids, which are below the tet count.
