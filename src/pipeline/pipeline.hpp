@@ -324,6 +324,9 @@ void Pipeline<Exec>::grid_geometry() {
 /// buckets that racing threads waste; the compacted lists
 /// get room for the entries, which the plan counts exactly. All only grow, by a quarter at least
 /// (grown_capacity), so a scene that keeps its size sizes them once and a growing one a few times.
+/// @brief Overflow buckets the grid's pool holds at most.
+constexpr std::uint64_t max_overflow_buckets = std::uint64_t{1} << 30;
+
 template <class Exec>
 void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     const GridParams& params = plan.params;
@@ -351,10 +354,10 @@ void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     while (wanted_slots < 1.25 * cells && wanted_slots < (1u << 30)) wanted_slots *= 2;
     // A thread that loses the race to chain a full bucket leaves the bucket it took unused for the
     // frame: an eighth more (and 64) keeps such losses from failing the pass and running it again.
-    const double wanted_pool = std::min(std::ceil(1.125 * entries / capacity) + 64.0, static_cast<double>(1u << 30));
+    const double wanted_pool = std::min(std::ceil(1.125 * entries / capacity) + 64.0, static_cast<double>(max_overflow_buckets));
     slot_count_ = std::max(slot_count_, wanted_slots);
     overflow_capacity_ = static_cast<std::uint32_t>(
-        grown_capacity(overflow_capacity_, static_cast<std::uint64_t>(wanted_pool), std::uint64_t{1} << 30));
+        grown_capacity(overflow_capacity_, static_cast<std::uint64_t>(wanted_pool), max_overflow_buckets));
     // An eighth more than the plan's count: a deforming scene's cells gain entries from frame to frame,
     // and each time the lists outgrew their room the frame would run twice.
     const double wanted_entries = std::min(std::ceil(1.125 * entries), 4294967295.0);
@@ -688,8 +691,10 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
     bool grid_again = false, candidates_again = false;
     if (grid_method() && c.params.layer_count > 0) {
         if (c.grid_failure & grid_table_full) slot_count_ *= 2;
+        // The pool's count runs past its capacity when it fails, so it says what the frame needed.
         if (c.grid_failure & grid_overflow_pool_full)
-            overflow_capacity_ = std::max(overflow_capacity_ * 2, c.overflow_used);
+            overflow_capacity_ = static_cast<std::uint32_t>(
+                std::min(rerun_capacity(overflow_capacity_, c.overflow_used), max_overflow_buckets));
         size_grid(c);
         grid_again = c.grid_failure != 0;
     }
