@@ -219,7 +219,9 @@ public:
     /// step. Of 1 x 8, 2 x 4, 4 x 1, 4 x 2 and 4 x 4 on an H100 (docs/performance.md), 4 x 2 searched
     /// the resolution-4 scenes with self-collision fastest and the procedural scene from 400k tets on;
     /// without self-collision 2 x 4 searched the resolution-4 scenes 8-15 % faster, the pass-through
-    /// 17 %, and the procedural scene up to 200k tets a little faster. Both keep 8 items a tet.
+    /// 17 %, and the procedural scene up to 200k tets a little faster. Both keep 8 items a tet. With the
+    /// face planes out of the search (H200, f656abe), 4 x 4, 2 x 4, 4 x 8, 8 x 2 and 4 x 1 with
+    /// self-collision and 2 x 2 without were each slower somewhere and faster nowhere beyond 3 %.
     static constexpr std::size_t split_by_blocks_max_tets = 300000;
     static constexpr bool split_by_blocks(bool self_collision, std::size_t tets) {
         return !self_collision && tets <= split_by_blocks_max_tets;
@@ -238,7 +240,9 @@ public:
     /// @brief The face-plane pre-test runs in the narrow phase, a thread a pair, not inside the
     /// candidate search: there a lane with a match ran it (a few hundred instructions) while the others
     /// of its warp waited, 4.2 of 32 lanes busy on an H100 (armadillos r4 with self-collision, at
-    /// 73fd55f). The search writes the pairs the slabs leave, more keys for fuller warps.
+    /// 73fd55f). The search writes the pairs the slabs leave, more keys for fuller warps: on an H200
+    /// the frames became 17-22 % shorter with self-collision and 10-20 % without (its registers
+    /// 167 -> 96; f656abe against 8ff462c).
     static constexpr bool face_planes_in_search = false;
 
     /// @brief How many of the tets' spacings layer 0's cells span at least (GridParamsKernel): one, the
@@ -247,7 +251,8 @@ public:
     /// choice) made procedural 100k's frames 2.0 -> 3.0 ms, the resolution-4 scenes without
     /// self-collision 11-27 % longer and procedural 8M with self-collision take 38 GB instead of 9,
     /// while two spacings ran as one (bench/results/gpu-h100, 73fd55f). With self-collision, four
-    /// shortened two of the three resolution-4 scenes by 7-9 %.
+    /// shortened two of the three resolution-4 scenes by 7-9 % (on an H200 at f656abe all three by
+    /// 4-6 %, and procedural 100k's frames a half longer).
     static constexpr float grid_cell_spacings = 1.0f;
 
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): few, since a thread
