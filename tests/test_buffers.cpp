@@ -28,6 +28,18 @@ TEST(HostBuffer, AFailedGrowthLeavesAnEmptyBufferThatCanGrowAgain) {
     EXPECT_EQ(buffer.size(), 10u);
 }
 
+TEST(HostBuffer, TryResizeReportsAFailedGrowthInsteadOfThrowing) {
+    HostBuffer<std::uint64_t> buffer;
+    EXPECT_TRUE(buffer.try_resize_discard(1000));
+    EXPECT_EQ(buffer.size(), 1000u);
+    EXPECT_FALSE(buffer.try_resize_discard(std::numeric_limits<std::size_t>::max() / 4));
+    EXPECT_EQ(buffer.size(), 0u);
+    EXPECT_EQ(buffer.data(), nullptr);
+    EXPECT_TRUE(buffer.try_resize_discard(10));
+    ASSERT_NE(buffer.data(), nullptr);
+    EXPECT_EQ(buffer.size(), 10u);
+}
+
 TEST(HostBuffer, ShrinkingKeepsTheMemory) {
     HostBuffer<std::uint32_t> buffer;
     buffer.resize_discard(100);
@@ -91,6 +103,36 @@ TEST(RerunCapacity, KeepsWhatSufficesAndOtherwiseAtLeastDoubles) {
         EXPECT_LE(capacity, 2 * static_cast<std::uint64_t>(need) + 1);
     }
     EXPECT_LE(growths, 11u);
+}
+
+/// A buffer with room for at most `limit` elements, as memory near its end; counts its allocations.
+struct LimitedBuffer {
+    std::size_t limit, elements = 0, allocations = 0;
+    std::size_t size() const { return elements; }
+    bool try_resize_discard(std::size_t n) {
+        ++allocations;
+        elements = n <= limit ? n : 0;
+        return n <= limit;
+    }
+    void resize_discard(std::size_t n) {
+        if (!try_resize_discard(n)) throw std::bad_alloc();
+    }
+};
+
+TEST(GrowForRerun, TakesRerunCapacitysRoomWhereItFitsElseTheNeed) {
+    LimitedBuffer ample{100000, 1000};
+    grow_for_rerun(ample, 1001);
+    EXPECT_EQ(ample.size(), rerun_capacity(1000, 1001)); // twice as much
+    EXPECT_EQ(ample.allocations, 1u);
+    LimitedBuffer tight{1500, 1000};
+    grow_for_rerun(tight, 1001); // twice as much does not fit, the need does
+    EXPECT_EQ(tight.size(), 1001u);
+    grow_for_rerun(tight, 900); // enough room: nothing allocated
+    EXPECT_EQ(tight.size(), 1001u);
+    EXPECT_EQ(tight.allocations, 2u);
+    LimitedBuffer full{1000, 1000};
+    EXPECT_THROW(grow_for_rerun(full, 1001), std::bad_alloc); // not even the need
+    EXPECT_EQ(full.size(), 0u);
 }
 
 TEST(PairsWindowForCandidates, GrowsByTheCandidatesFactor) {

@@ -15,9 +15,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <string>
+#include <type_traits>
 
 namespace kdet {
 namespace {
@@ -264,28 +266,41 @@ struct GpuShapedExec : CpuExec {
     static constexpr bool face_planes_in_search = FacePlanesInSearch;
 };
 
-/// One frame of `pipeline` over `meshes`, every object against the others and, with `self`, itself;
-/// the tets and vertices stored in spatial order as Detector stores them (SceneTopology::add_object).
-FrameResult run_pipeline(PipelineBase& pipeline, const std::vector<TetMesh>& meshes, bool self) {
+/// Frames of `pipeline`, each over the meshes of one element of `frames` (the same tets, other
+/// positions), every object against the others and, with `self`, itself; the tets and vertices stored
+/// in spatial order as Detector stores them (SceneTopology::add_object). Returns the last frame's result.
+FrameResult run_frames(PipelineBase& pipeline, const std::vector<std::vector<TetMesh>>& frames, bool self) {
+    const auto float_positions = [](const std::vector<TetMesh>& meshes) {
+        std::vector<vec3> positions;
+        for (const TetMesh& mesh : meshes)
+            for (std::size_t v = 0; v < mesh.num_vertices(); ++v)
+                positions.push_back(vec3{static_cast<float>(mesh.positions[3 * v]), static_cast<float>(mesh.positions[3 * v + 1]),
+                                         static_cast<float>(mesh.positions[3 * v + 2])});
+        return positions;
+    };
+    const std::vector<TetMesh>& meshes = frames.front();
+    const std::vector<vec3> first_positions = float_positions(meshes);
     SceneTopology topology;
-    std::vector<vec3> positions;
-    for (const TetMesh& mesh : meshes) {
-        const std::uint32_t first_vertex = static_cast<std::uint32_t>(positions.size());
-        for (std::size_t v = 0; v < mesh.num_vertices(); ++v)
-            positions.push_back(vec3{static_cast<float>(mesh.positions[3 * v]), static_cast<float>(mesh.positions[3 * v + 1]),
-                                     static_cast<float>(mesh.positions[3 * v + 2])});
-        topology.add_object(positions.data() + first_vertex, static_cast<std::uint32_t>(mesh.num_vertices()), mesh.tets.data(),
-                            mesh.num_tets());
-    }
+    for (std::size_t o = 0, first_vertex = 0; o < meshes.size(); first_vertex += meshes[o].num_vertices(), ++o)
+        topology.add_object(first_positions.data() + first_vertex, static_cast<std::uint32_t>(meshes[o].num_vertices()),
+                            meshes[o].tets.data(), meshes[o].num_tets());
     pipeline.set_topology(topology);
-    std::vector<vec3> stored(positions.size());
-    topology.to_stored_order(0, topology.vertex_count, positions.data(), stored.data());
     std::vector<std::uint8_t> pair_enabled(meshes.size() * meshes.size(), 1);
     for (std::size_t o = 0; o < meshes.size(); ++o) pair_enabled[o * meshes.size() + o] = self ? 1 : 0;
-    pipeline.start({PositionUpload{0, stored.data(), topology.vertex_count}}, {}, pair_enabled);
     FrameResult result;
-    EXPECT_EQ(pipeline.finish(result), no_vertex);
+    for (const std::vector<TetMesh>& frame : frames) {
+        const std::vector<vec3> positions = float_positions(frame);
+        std::vector<vec3> stored(positions.size());
+        topology.to_stored_order(0, topology.vertex_count, positions.data(), stored.data());
+        pipeline.start({PositionUpload{0, stored.data(), topology.vertex_count}}, {}, pair_enabled);
+        EXPECT_EQ(pipeline.finish(result), no_vertex);
+    }
     return result;
+}
+
+/// One frame of `pipeline` over `meshes` (run_frames).
+FrameResult run_pipeline(PipelineBase& pipeline, const std::vector<TetMesh>& meshes, bool self) {
+    return run_frames(pipeline, {meshes}, self);
 }
 
 TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
@@ -327,6 +342,73 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
                 }
             }
         }
+    }
+}
+
+/// How many elements a buffer of CappedExec can hold, by their type: more fails as an allocation would.
+std::size_t key_buffer_cap = 0, contact_buffer_cap = 0;
+
+/// A host buffer whose 64-bit keys (the candidates' buffer and the pairs' window) and contacts
+/// cannot grow past their caps, as device memory near its limit: a failed allocation leaves it empty.
+template <class T>
+struct CappedBuffer : HostBuffer<T> {
+    static std::size_t cap() {
+        if constexpr (std::is_same_v<T, std::uint64_t>) return key_buffer_cap;
+        if constexpr (std::is_same_v<T, Contact>) return contact_buffer_cap;
+        return std::numeric_limits<std::size_t>::max();
+    }
+    bool try_resize_discard(std::size_t n) noexcept {
+        if (n > cap()) {
+            HostBuffer<T> released;
+            this->swap(released);
+            return false;
+        }
+        return HostBuffer<T>::try_resize_discard(n);
+    }
+    void resize_discard(std::size_t n) {
+        if (!try_resize_discard(n)) throw std::bad_alloc();
+    }
+};
+
+struct CappedExec : CpuExec {
+    using CpuExec::CpuExec;
+    template <class T>
+    using buffer = CappedBuffer<T>;
+};
+
+TEST(Pipeline, AFrameThatOutgrowsItsBuffersNearTheMemoryLimitGrowsThemToTheNeedOnly) {
+    // Two soups apart, then overlapping (without self-collision, so that the first frame sizes small
+    // buffers): the second frame outgrows the candidates' buffer and the pairs' window, and doubling
+    // them would pass a cap where the need does not.
+    const TetMesh a = random_soup(3000, 1.0, 0.05, 71), b = random_soup(3000, 1.0, 0.05, 72);
+    const std::vector<std::vector<TetMesh>> frames{{a, moved(b, 0.0, 5.0, 0.0, 0.0)}, {a, b}};
+    DetectorOptions options;
+    options.contacts = true;
+    Pipeline<CpuExec> unlimited(options);
+    const FrameResult expected = run_frames(unlimited, frames, false);
+    const std::size_t candidates = expected.counts.unique_candidates, pairs = expected.pairs.size();
+    ASSERT_GT(candidates, 4u * 4096u); // past the first frame's sizing
+    ASSERT_GT(pairs, 1000u);
+    constexpr std::size_t unlimited_room = std::numeric_limits<std::size_t>::max();
+    // Caps a tenth over the need, under the quarter over it that growing asks for: the candidates'
+    // buffer (the pairs' window, of fewer keys, fits), then the contacts beside the pairs' window.
+    for (const auto& [keys, contacts] : {std::pair{candidates + candidates / 10, unlimited_room},
+                                         std::pair{unlimited_room, pairs + pairs / 10}}) {
+        key_buffer_cap = keys;
+        contact_buffer_cap = contacts;
+        Pipeline<CappedExec> capped(options);
+        const FrameResult got = run_frames(capped, frames, false);
+        EXPECT_EQ(got.pairs, expected.pairs);
+        EXPECT_EQ(got.contacts.size(), pairs);
+        EXPECT_EQ(got.counts.unique_candidates, candidates);
+        EXPECT_GT(got.counts.buffer_regrows, 0u);
+    }
+    // Below the need itself the frame cannot run: an exception, not a partial answer.
+    for (const auto& [keys, contacts] : {std::pair{candidates / 2, unlimited_room}, std::pair{unlimited_room, pairs / 2}}) {
+        key_buffer_cap = keys;
+        contact_buffer_cap = contacts;
+        Pipeline<CappedExec> too_small(options);
+        EXPECT_THROW(run_frames(too_small, frames, false), std::bad_alloc);
     }
 }
 

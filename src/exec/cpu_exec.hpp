@@ -65,6 +65,16 @@ public:
         }
         size_ = n;
     }
+    /// @brief resize_discard that returns false instead of throwing when the memory cannot be had
+    /// (the buffer is then empty), so that the caller can ask for less.
+    bool try_resize_discard(std::size_t n) noexcept {
+        try {
+            resize_discard(n);
+        } catch (const std::bad_alloc&) {
+            return false;
+        }
+        return true;
+    }
     /// @brief Exchanges the memory of two buffers (growing one while keeping its contents).
     void swap(HostBuffer& other) noexcept {
         data_.swap(other.data_);

@@ -43,17 +43,30 @@ public:
     /// @brief Makes room for n elements; discards the old contents when it has to reallocate.
     /// A failed allocation throws and leaves the buffer empty, never a size without memory.
     void resize_discard(std::size_t n) {
+        if (!try_resize_discard(n))
+            throw Error("cannot allocate " + std::to_string(n) + " elements of " + std::to_string(sizeof(T)) +
+                        " bytes of device memory: the device has not that much free");
+    }
+    /// @brief resize_discard that returns false instead of throwing when the device has not the memory
+    /// (the buffer is then empty), so that the caller can ask for less.
+    bool try_resize_discard(std::size_t n) {
         if (n > capacity_) {
             T* old = data_;
             data_ = nullptr;
             size_ = capacity_ = 0;
             cuda_check(cudaFree(old), "cudaFree");
-            if (n > static_cast<std::size_t>(-1) / sizeof(T))
-                throw Error("cannot allocate " + std::to_string(n) + " elements of device memory: size overflows");
-            cuda_check(cudaMalloc(reinterpret_cast<void**>(&data_), n * sizeof(T)), "cudaMalloc");
+            if (n > static_cast<std::size_t>(-1) / sizeof(T)) return false;
+            const cudaError_t status = cudaMalloc(reinterpret_cast<void**>(&data_), n * sizeof(T));
+            if (status == cudaErrorMemoryAllocation) {
+                data_ = nullptr;
+                (void)cudaGetLastError(); // so that the next launch's check does not report it
+                return false;
+            }
+            cuda_check(status, "cudaMalloc");
             capacity_ = n;
         }
         size_ = n;
+        return true;
     }
     /// @brief Exchanges the memory of two buffers (growing one while keeping its contents).
     void swap(DeviceBuffer& other) noexcept {

@@ -29,6 +29,16 @@ constexpr std::uint64_t rerun_capacity(std::uint64_t current, std::uint64_t want
     return std::max(wanted + wanted / 4, 2 * current);
 }
 
+/// @brief Makes `buffer` (an execution layer's buffer) hold at least `wanted` elements for a frame that
+/// outgrew it: rerun_capacity's room where the memory allows, else `wanted` exactly, since near the
+/// memory's limit twice the old size can fail where the need itself still fits. Throws only when the
+/// need does not fit either (the buffer is then empty).
+template <class Buffer>
+void grow_for_rerun(Buffer& buffer, std::uint64_t wanted) {
+    if (wanted <= buffer.size()) return;
+    if (!buffer.try_resize_discard(rerun_capacity(buffer.size(), wanted))) buffer.resize_discard(wanted);
+}
+
 /// @brief The colliding pairs' window when the candidates outgrew their buffer of
 /// `candidate_capacity_before` keys and it grew to `candidate_capacity`: the window grows by the same
 /// factor (never shrinks here). The frame runs its search and narrow phase again for the candidates

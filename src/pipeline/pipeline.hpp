@@ -213,6 +213,7 @@ private:
     /// when everything fitted).
     enum class Rerun { none, results, candidates, grid };
     Rerun grow_for(const FrameCounters& c);
+    std::size_t pairs_window_within_memory(std::size_t wanted, std::size_t needed);
     void enqueue_from(Rerun stage);
     void enqueue_results();
     void enqueue_again(const FrameCounters& c, Rerun stage);
@@ -700,16 +701,18 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
     }
     const std::size_t candidates_fitted = candidates_.size();
     if (c.candidates > candidates_fitted) {
-        candidates_.resize_discard(rerun_capacity(candidates_fitted, c.candidates));
+        grow_for_rerun(candidates_, c.candidates);
         candidates_again = true;
     }
     bool pairs_again = false;
     if (options_.method != Method::kdet_no_pairs) {
         if (candidates_again) {
-            // The rerun decides every candidate again: the window grows with them, in it.
-            pairs_window_ = pairs_window_for_candidates(pairs_window_, candidates_fitted, candidates_.size());
+            // The rerun decides every candidate again: the window grows with them, in it (where the
+            // memory allows; else a rerun of its own grows it to what it needs).
+            pairs_window_ = pairs_window_within_memory(
+                pairs_window_for_candidates(pairs_window_, candidates_fitted, candidates_.size()), pairs_window_);
         } else if (c.colliding_pairs > pairs_window_) {
-            pairs_window_ = rerun_capacity(pairs_window_, c.colliding_pairs);
+            pairs_window_ = pairs_window_within_memory(rerun_capacity(pairs_window_, c.colliding_pairs), c.colliding_pairs);
             pairs_again = true;
         } else if (c.colliding_pairs * 4 < pairs_window_ && pairs_window_ > 4096) {
             // Far fewer pairs than room: the GPU sorts the whole window, so it shrinks (memory stays).
@@ -722,6 +725,17 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
     if (grid_again) return Rerun::grid;
     if (candidates_again) return Rerun::candidates;
     return pairs_again ? Rerun::results : Rerun::none;
+}
+
+/// @brief Allocates the buffers of a pairs' window of `wanted` pairs and returns `wanted`, or, where the
+/// memory does not allow it, of the `needed` pairs alone (grow_for_rerun's rule for the two buffers
+/// that hold the window); throws only when the need does not fit either.
+template <class Exec>
+std::size_t Pipeline<Exec>::pairs_window_within_memory(std::size_t wanted, std::size_t needed) {
+    if (out_keys_.try_resize_discard(wanted) && (!options_.contacts || out_contacts_.try_resize_discard(wanted))) return wanted;
+    out_keys_.resize_discard(needed);
+    if (options_.contacts) out_contacts_.resize_discard(needed);
+    return needed;
 }
 
 template <class Exec>
