@@ -659,6 +659,17 @@ struct TetRuns {
     KDET_HD static std::uint32_t end(std::uint32_t r, std::uint32_t tets) {
         return tets - first(r) < TetsPerItem ? tets : first(r) + TetsPerItem;
     }
+    /// @brief Calls f(t) for the tets t of run r in order while f returns true; a run of one tet (the
+    /// GPU's) without a loop, which cost the GPU's search kernel about 30 registers.
+    template <class F>
+    KDET_HD static void for_each_tet(std::uint32_t r, std::uint32_t tets, F&& f) {
+        if constexpr (TetsPerItem == 1) {
+            f(r);
+        } else {
+            for (std::uint32_t t = first(r), e = end(r, tets); t < e && f(t); ++t) {
+            }
+        }
+    }
 };
 
 /// @brief Stage 3 (kdet): writes the candidate pairs, each once, that the pre-test (the slabs where the
@@ -739,11 +750,9 @@ struct FindCandidatesKernel {
         const std::uint32_t run_part = item / block_parts;
         using Runs = TetRuns<TetsPerItem>;
         const std::uint32_t runs = Runs::count(scene.tet_count), run = run_part % runs;
-        const std::uint32_t first = Runs::first(run), end = Runs::end(run, scene.tet_count);
         const SearchPart part{run_part / runs, layer_parts, item % block_parts, block_parts};
-        // An item of one tet (the GPU's) that the search skips returns before it touches the buffer's
-        // count, and searches without a loop: a run's loop cost the GPU's kernel about 30 registers.
-        if (TetsPerItem == 1 && !searched(first, part)) return;
+        // An item of one tet (the GPU's) that the search skips returns before it touches the buffer's count.
+        if (TetsPerItem == 1 && !searched(Runs::first(run), part)) return;
         const std::uint32_t already_stored = resume_from ? resume_from[i].stored : 0u;
         // Once a first frame's buffer is full, an item that has not started would only search until
         // its first batch and then search again after the buffer grows: it waits for that at once.
@@ -753,12 +762,10 @@ struct FindCandidatesKernel {
         }
         KeyBatch batch(&out, already_stored);
         unsigned long long run_rejected = 0;
-        if (TetsPerItem == 1) {
-            run_rejected = search(first, part, batch);
-        } else {
-            for (std::uint32_t t = first; t < end && !(stop_when_full && batch.stopped); ++t)
-                if (searched(t, part)) run_rejected += search(t, part, batch);
-        }
+        Runs::for_each_tet(run, scene.tet_count, [&](std::uint32_t t) {
+            if (TetsPerItem == 1 || searched(t, part)) run_rejected += search(t, part, batch);
+            return !(stop_when_full && batch.stopped);
+        });
         batch.flush();
         if (batch.stopped) {
             record_stop(ResumePoint{item, batch.stored});
@@ -825,17 +832,11 @@ struct NoPairsKernel {
 
     KDET_HD void operator()(std::uint64_t i) const {
         TestAndFlag visit{this, 0, 0, 0};
-        if (TetsPerItem == 1) {
-            visit.t = static_cast<std::uint32_t>(i);
+        TetRuns<TetsPerItem>::for_each_tet(static_cast<std::uint32_t>(i), scene.tet_count, [&](std::uint32_t t) {
+            visit.t = t;
             search(visit);
-        } else {
-            using Runs = TetRuns<TetsPerItem>;
-            const auto run = static_cast<std::uint32_t>(i);
-            for (std::uint32_t t = Runs::first(run), end = Runs::end(run, scene.tet_count); t < end; ++t) {
-                visit.t = t;
-                search(visit);
-            }
-        }
+            return true;
+        });
         if (visit.tests) atomic_fetch_add(tests_run, visit.tests);
         if (visit.exact_stage) atomic_fetch_add(exact_stage_pairs, visit.exact_stage);
     }
