@@ -183,11 +183,6 @@ public:
     /// adds its counts with a few atomics and bounds the cells by what its previous tet covered.
     static constexpr std::uint32_t plan_chunk = 256;
 
-    /// @brief The backend's memory is the host's: a frame's end reads the pairs, flags and contacts
-    /// where the pipeline left them, where a copy of the whole pairs' window (tens of MB at 1M tets)
-    /// cost one thread's time every frame.
-    static constexpr bool host_reads_results_in_place = true;
-
     /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`),
     /// divided by `per_item` (rounded up) when each item takes that many: a stage whose size an earlier
     /// stage counted is launched without the host reading the count.
@@ -281,12 +276,27 @@ public:
     void download_later(T* host, const T* device, std::size_t n) const {
         if (n) pending_.push_back(PendingDownload{host, device, n * sizeof(T)});
     }
+    /// @brief Queues a download that the host reads where it lands, and returns its number: after the
+    /// next finish_downloads(), landed(number) points at its n elements until the one after. The
+    /// backend's memory is the host's, so it lands where it is: a copy of the whole pairs' window
+    /// (tens of MB at 1M tets) cost one thread's time every frame.
+    template <class T>
+    std::size_t download_view_later(const T* device, std::size_t /*n: read in place*/) const {
+        pending_views_.push_back(device);
+        return pending_views_.size() - 1;
+    }
+    template <class T>
+    const T* landed(std::size_t view) const {
+        return static_cast<const T*>(landed_views_[view]);
+    }
     /// @brief Does the queued copies: one host wait (none when nothing was queued).
     void finish_downloads() const {
-        if (pending_.empty()) return;
+        if (pending_.empty() && pending_views_.empty()) return;
         ++host_waits_;
         for (const PendingDownload& d : pending_) std::memcpy(d.host, d.device, d.bytes);
         pending_.clear();
+        landed_views_.swap(pending_views_);
+        pending_views_.clear();
     }
     /// @brief Copies within the backend's memory.
     template <class T>
@@ -320,6 +330,7 @@ private:
     int threads_;
     mutable std::uint64_t host_waits_ = 0;
     mutable std::vector<PendingDownload> pending_;
+    mutable std::vector<const void*> pending_views_, landed_views_;
     /// The radix sort's other buffer, kept between frames so that a frame allocates nothing.
     mutable HostBuffer<std::uint64_t> sort_scratch_;
 };

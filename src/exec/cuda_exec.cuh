@@ -273,9 +273,6 @@ public:
     /// the plan's bound on the cells loosens a little (each item counts its first tet's cells whole).
     static constexpr std::uint32_t plan_chunk = 16;
 
-    /// @brief Results are copied to the host before a frame's end reads them.
-    static constexpr bool host_reads_results_in_place = false;
-
     explicit CudaExec(const DetectorOptions& options)
         : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
         int devices = 0;
@@ -421,25 +418,48 @@ public:
     void download_later(T* host, const T* device, std::size_t n) const {
         if (n) pending_.push_back(PendingDownload{host, device, n * sizeof(T)});
     }
+    /// @brief Queues a download that the host reads where it lands, and returns its number: after the
+    /// next finish_downloads(), landed(number) points at its n elements in the pinned buffer until
+    /// the one after (no copy out of it, which took the host about as long as the copy from the device).
+    template <class T>
+    std::size_t download_view_later(const T* device, std::size_t n) const {
+        pending_views_.push_back(PendingDownload{nullptr, device, n * sizeof(T)});
+        return pending_views_.size() - 1;
+    }
+    template <class T>
+    const T* landed(std::size_t view) const {
+        return reinterpret_cast<const T*>(landed_views_[view]);
+    }
     /// @brief Enqueues the queued copies into one pinned buffer, waits once (none when nothing was
-    /// queued), and hands each its bytes.
+    /// queued), and hands each download_later its bytes (the views stay where they landed).
     void finish_downloads() const {
-        if (pending_.empty()) return;
+        if (pending_.empty() && pending_views_.empty()) return;
+        const auto room = [](std::size_t bytes) { return (bytes + 15) / 16 * 16; };
         std::size_t total = 0;
-        for (const PendingDownload& d : pending_) total += (d.bytes + 15) / 16 * 16;
+        for (const auto* queue : {&pending_, &pending_views_})
+            for (const PendingDownload& d : *queue) total += room(d.bytes);
         unsigned char* staging = staging_.reserve(total);
         std::size_t offset = 0;
-        for (const PendingDownload& d : pending_) {
-            cuda_check(cudaMemcpyAsync(staging + offset, d.device, d.bytes, cudaMemcpyDeviceToHost, stream_), "download");
-            offset += (d.bytes + 15) / 16 * 16;
-        }
+        for (const auto* queue : {&pending_, &pending_views_})
+            for (const PendingDownload& d : *queue) {
+                if (d.bytes)
+                    cuda_check(cudaMemcpyAsync(staging + offset, d.device, d.bytes, cudaMemcpyDeviceToHost, stream_),
+                               "download");
+                offset += room(d.bytes);
+            }
         wait_for_stream();
         offset = 0;
         for (const PendingDownload& d : pending_) {
             std::memcpy(d.host, staging + offset, d.bytes);
-            offset += (d.bytes + 15) / 16 * 16;
+            offset += room(d.bytes);
+        }
+        landed_views_.clear();
+        for (const PendingDownload& d : pending_views_) {
+            landed_views_.push_back(staging + offset);
+            offset += room(d.bytes);
         }
         pending_.clear();
+        pending_views_.clear();
     }
     /// @brief Copies within device memory.
     template <class T>
@@ -499,7 +519,8 @@ private:
     int block_size_;
     cudaStream_t stream_;
     mutable PinnedBuffer staging_;
-    mutable std::vector<PendingDownload> pending_;
+    mutable std::vector<PendingDownload> pending_, pending_views_;
+    mutable std::vector<const unsigned char*> landed_views_;
     mutable std::uint64_t host_waits_ = 0;
     mutable DeviceBuffer<unsigned char> temp_;
     mutable DeviceBuffer<std::uint64_t> spare_keys_;

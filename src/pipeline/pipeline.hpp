@@ -276,12 +276,10 @@ private:
     GridView grid_{}; ///< the frame's grid, once populated
 
     // The frame in flight: the staged ranges it adopts, and what it copies back at its end, read by
-    // finish() (the results only where the backend's memory is not the host's).
+    // finish(): the counters, and the results where they land (Exec::landed).
     std::vector<VertexRange> staged_;
     FrameCounters last_{};
-    std::vector<std::uint64_t> host_keys_;
-    std::vector<std::uint32_t> host_flags_;
-    std::vector<Contact> host_contacts_;
+    std::size_t keys_view_ = 0, flags_view_ = 0, contacts_view_ = 0;
     std::uint64_t waits_before_ = 0;
     std::uint32_t regrows_ = 0;
 };
@@ -634,13 +632,12 @@ void Pipeline<Exec>::enqueue_results() {
     exec_.sum(user_colliding_.data(), tets, &c->colliding_tets);
 
     exec_.download_later(&last_, counters_.data(), 1);
-    if (!options_.results_to_host || Exec::host_reads_results_in_place) return;
-    host_keys_.resize(method == Method::kdet_no_pairs ? 0 : pairs_window_);
-    exec_.download_later(host_keys_.data(), out_keys_.data(), host_keys_.size());
-    host_flags_.resize(tets);
-    exec_.download_later(host_flags_.data(), user_colliding_.data(), tets);
-    host_contacts_.resize(options_.contacts ? host_keys_.size() : 0);
-    exec_.download_later(host_contacts_.data(), out_contacts_.data(), host_contacts_.size());
+    if (!options_.results_to_host) return;
+    // The whole window: the count is not known when the copy is enqueued.
+    const std::size_t window = method == Method::kdet_no_pairs ? 0 : pairs_window_;
+    keys_view_ = exec_.download_view_later(out_keys_.data(), window);
+    flags_view_ = exec_.download_view_later(user_colliding_.data(), tets);
+    contacts_view_ = exec_.download_view_later(out_contacts_.data(), options_.contacts ? window : 0);
 }
 
 /// @brief Runs an attempt again from `stage` (grow_for has grown what it needs): the counters of the
@@ -799,10 +796,9 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
     const std::size_t objects = object_boxes_.size();
     result.colliding.resize(options_.results_to_host ? objects : 0);
     if (options_.results_to_host) {
-        constexpr bool in_place = Exec::host_reads_results_in_place;
-        const std::uint64_t* keys = in_place ? out_keys_.data() : host_keys_.data();
-        const std::uint32_t* flags = in_place ? user_colliding_.data() : host_flags_.data();
-        const Contact* contacts = in_place ? out_contacts_.data() : host_contacts_.data();
+        const std::uint64_t* keys = exec_.template landed<std::uint64_t>(keys_view_);
+        const std::uint32_t* flags = exec_.template landed<std::uint32_t>(flags_view_);
+        const Contact* contacts = exec_.template landed<Contact>(contacts_view_);
         const auto& begin = topology_.object_tet_begin;
         result.pairs.resize(colliding_count_);
         pairs_from_keys(begin, keys, colliding_count_, result.pairs.data(), options_.threads);
