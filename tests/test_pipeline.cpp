@@ -316,9 +316,9 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
             Pipeline<GpuShapedExec<3, 1, 1>> by_layers(options);
             Pipeline<GpuShapedExec<1, 8, 256>> by_blocks(options);
             // CudaExec's: cells one spacing wide, the face planes in the narrow phase
-            Pipeline<GpuShapedExec<4, 2, 16, 1, 1, false>> like_cuda(options);
+            Pipeline<GpuShapedExec<4, 2, 4, 1, 1, false>> like_cuda(options);
             // CudaExec's for small scenes without self-collision
-            Pipeline<GpuShapedExec<2, 4, 16, 1, 1, false>> like_cuda_without_self(options);
+            Pipeline<GpuShapedExec<2, 4, 4, 1, 1, false>> like_cuda_without_self(options);
             // Runs of 7 tets, split by layers: runs end inside objects and the last one is short.
             Pipeline<GpuShapedExec<3, 1, 256, 7>> odd_runs(options);
             // The face planes in the narrow phase, the CPU's search otherwise.

@@ -269,9 +269,11 @@ public:
     static constexpr float grid_cell_spacings = 1.0f;
 
     /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): few, since a thread
-    /// walks its tets in series (256 took 0.2-0.33 ms on an H200, a tenth of the frame's kernels);
-    /// the plan's bound on the cells loosens a little (each item counts its first tet's cells whole).
-    static constexpr std::uint32_t plan_chunk = 16;
+    /// walks its tets in series (256 took 0.2-0.33 ms on an H200, a tenth of the frame's kernels; 16
+    /// took 68-71 µs on armadillos r4 in 81 blocks, 6 % of the warp slots busy); the plan's bound on
+    /// the cells loosens a little (each item counts its first tet's cells whole: on the CPU, the GPU's
+    /// shape sized the same table with 4 as with 16 for the r4 scenes, 27 MiB more with 1).
+    static constexpr std::uint32_t plan_chunk = 4;
 
     explicit CudaExec(const DetectorOptions& options)
         : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
