@@ -403,6 +403,20 @@ TEST(Pipeline, AFrameThatOutgrowsItsBuffersNearTheMemoryLimitGrowsThemToTheNeedO
         EXPECT_EQ(got.counts.unique_candidates, candidates);
         EXPECT_GT(got.counts.buffer_regrows, 0u);
     }
+    // A first frame whose guess (16 keys a tet) the memory does not hold starts from less and grows
+    // as its search goes, within the cap.
+    key_buffer_cap = unlimited_room;
+    contact_buffer_cap = unlimited_room;
+    Pipeline<CpuExec> first_unlimited(options);
+    const FrameResult first_expected = run_frames(first_unlimited, {frames.back()}, true);
+    const std::size_t first_candidates = first_expected.counts.unique_candidates;
+    ASSERT_LT(first_candidates + first_candidates / 10, 16u * 6000u);
+    key_buffer_cap = first_candidates + first_candidates / 10;
+    Pipeline<CappedExec> first_capped(options);
+    const FrameResult first_got = run_frames(first_capped, {frames.back()}, true);
+    EXPECT_EQ(first_got.pairs, first_expected.pairs);
+    EXPECT_EQ(first_got.counts.unique_candidates, first_candidates);
+    EXPECT_GT(first_got.counts.buffer_regrows, 0u);
     // Below the need itself the frame cannot run: an exception, not a partial answer.
     for (const auto& [keys, contacts] : {std::pair{candidates / 2, unlimited_room}, std::pair{unlimited_room, pairs / 2}}) {
         key_buffer_cap = keys;

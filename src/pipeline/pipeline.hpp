@@ -446,14 +446,16 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         // The items that stopped quit searching when they did not fit, so their need is estimated from
         // the keys per item of the ones that finished in this run, with a quarter more (room for the
         // next frames, whose overflow would rerun the whole frame); the buffer grows by half at
-        // least, so a poor estimate costs few rounds.
+        // least, so a poor estimate costs few rounds; where the memory does not hold that much beside
+        // the kept keys, half as much, and so on down to a batch more (each round stores some).
         const std::size_t kept = candidates_.size();
         const double finished = static_cast<double>(items - after.stopped_items);
         const double stored_now = static_cast<double>(kept - std::min(kept, first_slot));
         const double estimate = finished > 0.0 ? 1.25 * stored_now / finished * after.stopped_items : 0.0;
-        const std::size_t more = std::max(static_cast<std::size_t>(estimate), kept / 2);
+        std::size_t more = std::max(static_cast<std::size_t>(estimate), kept / 2);
         const bool resume = after.stopped_items <= resume_room;
-        candidates_grown_.resize_discard(kept + more + KeyBatch::size);
+        while (more > 0 && !candidates_grown_.try_resize_discard(kept + more + KeyBatch::size)) more /= 2;
+        if (more == 0) candidates_grown_.resize_discard(kept + KeyBatch::size); // throws if not even that fits
         if (resume) exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
         candidates_.swap(candidates_grown_);
         ++regrows_;
@@ -575,7 +577,10 @@ void Pipeline<Exec>::enqueue_frame() {
         const std::size_t estimate = options_.initial_candidate_capacity
                                          ? options_.initial_candidate_capacity
                                          : std::max<std::size_t>(4096, 16 * plan.involved_tets);
-        if (candidates_.size() < estimate) candidates_.resize_discard(estimate);
+        // A guess: where the memory does not hold it, the search starts from less and grows as it
+        // goes (stop and resume, below).
+        if (candidates_.size() < estimate && !candidates_.try_resize_discard(estimate))
+            candidates_.resize_discard(std::min<std::size_t>(estimate, 4096));
         grid_planned_ = true;
     }
     enqueue_from(Rerun::grid);
