@@ -376,7 +376,7 @@ struct CappedExec : CpuExec {
     using buffer = CappedBuffer<T>;
 };
 
-TEST(Pipeline, AFrameThatOutgrowsItsBuffersNearTheMemoryLimitGrowsThemToTheNeedOnly) {
+TEST(Pipeline, NearTheMemoryLimitBuffersGrowToWhatFitsAndNoPairIsLost) {
     // Two soups apart, then overlapping (without self-collision, so that the first frame sizes small
     // buffers): the second frame outgrows the candidates' buffer and the pairs' window, and doubling
     // them would pass a cap where the need does not.
