@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 namespace kdet {
@@ -29,14 +30,22 @@ constexpr std::uint64_t rerun_capacity(std::uint64_t current, std::uint64_t want
     return std::max(wanted + wanted / 4, 2 * current);
 }
 
-/// @brief Makes `buffer` (an execution layer's buffer) hold at least `wanted` elements for a frame that
-/// outgrew it: rerun_capacity's room where the memory allows, else `wanted` exactly, since near the
-/// memory's limit twice the old size can fail where the need itself still fits. Throws only when the
-/// need does not fit either (the buffer is then empty).
+/// @brief Makes `buffer` (an execution layer's buffer) hold `wanted` elements where the memory allows,
+/// else `fallback` (fewer), and returns how many it holds: near the memory's limit room with headroom
+/// can fail where the need itself still fits. Throws only when `fallback` does not fit either (the
+/// buffer is then empty).
+template <class Buffer>
+std::size_t resize_within_memory(Buffer& buffer, std::size_t wanted, std::size_t fallback) {
+    if (buffer.try_resize_discard(wanted)) return wanted;
+    buffer.resize_discard(fallback);
+    return fallback;
+}
+
+/// @brief Makes `buffer` hold at least `wanted` elements for a frame that outgrew it: rerun_capacity's
+/// room where the memory allows, else `wanted` exactly (resize_within_memory).
 template <class Buffer>
 void grow_for_rerun(Buffer& buffer, std::uint64_t wanted) {
-    if (wanted <= buffer.size()) return;
-    if (!buffer.try_resize_discard(rerun_capacity(buffer.size(), wanted))) buffer.resize_discard(wanted);
+    if (wanted > buffer.size()) resize_within_memory(buffer, rerun_capacity(buffer.size(), wanted), wanted);
 }
 
 /// @brief The colliding pairs' window when the candidates outgrew their buffer of

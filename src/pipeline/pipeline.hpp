@@ -316,16 +316,16 @@ void Pipeline<Exec>::grid_geometry() {
                    GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask}, chunk);
 }
 
-/// @brief Sizes the table for a plan: per layer the occupied cells are at most the plan's bound
-/// (GridPlanKernel) and at most the region's cells; the table gets a quarter more slots than that
-/// bound (probing stays short), and the overflow pool one bucket
-/// per bucket_capacity entries, which holds every chain whatever the cells' fill, plus room for the
-/// buckets that racing threads waste; the compacted lists
-/// get room for the entries, which the plan counts exactly. All only grow, by a quarter at least
-/// (grown_capacity), so a scene that keeps its size sizes them once and a growing one a few times.
 /// @brief Overflow buckets the grid's pool holds at most.
 constexpr std::uint64_t max_overflow_buckets = std::uint64_t{1} << 30;
 
+/// @brief Sizes the table for a plan: per layer the occupied cells are at most the plan's bound
+/// (GridPlanKernel) and at most the region's cells; the table gets a quarter more slots than that
+/// bound (probing stays short), and the overflow pool one bucket per bucket_capacity entries, which
+/// holds every chain whatever the cells' fill, plus room for the buckets that racing threads waste;
+/// the compacted lists get room for the entries, which the plan counts exactly. All only grow, by a
+/// quarter at least (grown_capacity), so a scene that keeps its size sizes them once and a growing
+/// one a few times.
 template <class Exec>
 void Pipeline<Exec>::size_grid(const FrameCounters& plan) {
     const GridParams& params = plan.params;
@@ -579,8 +579,7 @@ void Pipeline<Exec>::enqueue_frame() {
                                          : std::max<std::size_t>(4096, 16 * plan.involved_tets);
         // A guess: where the memory does not hold it, the search starts from less and grows as it
         // goes (stop and resume, below).
-        if (candidates_.size() < estimate && !candidates_.try_resize_discard(estimate))
-            candidates_.resize_discard(std::min<std::size_t>(estimate, 4096));
+        if (candidates_.size() < estimate) resize_within_memory(candidates_, estimate, std::min<std::size_t>(estimate, 4096));
         grid_planned_ = true;
     }
     enqueue_from(Rerun::grid);
@@ -730,14 +729,12 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
 }
 
 /// @brief Allocates the buffers of a pairs' window of `wanted` pairs and returns `wanted`, or, where the
-/// memory does not allow it, of the `needed` pairs alone (grow_for_rerun's rule for the two buffers
-/// that hold the window); throws only when the need does not fit either.
+/// memory does not allow it, of the `needed` pairs alone (resize_within_memory for both buffers that
+/// hold the window); throws only when the need does not fit either.
 template <class Exec>
 std::size_t Pipeline<Exec>::pairs_window_within_memory(std::size_t wanted, std::size_t needed) {
-    if (out_keys_.try_resize_discard(wanted) && (!options_.contacts || out_contacts_.try_resize_discard(wanted))) return wanted;
-    out_keys_.resize_discard(needed);
-    if (options_.contacts) out_contacts_.resize_discard(needed);
-    return needed;
+    const std::size_t keys = resize_within_memory(out_keys_, wanted, needed);
+    return options_.contacts ? resize_within_memory(out_contacts_, keys, needed) : keys;
 }
 
 template <class Exec>
