@@ -5,17 +5,19 @@
 /// or an edge point of one tet lies inside the other), each only by a margin far above every rounding
 /// involved, and leaves all other pairs to the narrow-phase test. So it never changes what a test reports.
 ///
-/// Bounds, with u = 2^-24, L the pair's longest edge, l the plane owner's shortest edge, and for face k
-/// l_k the shorter and s_k the sine of the angle of the two edges its normal is built from (s_k >= 1/64
-/// for a used face, and l <= l_k <= L), and pairs whose boxes overlap (the pipeline runs the pre-test
-/// on no other), so every vertex lies within 2 sqrt(3) L of the owner's vertex 0, the origin of its planes:
+/// Bounds, with u = 2^-24, L the pair's longest edge, l_P the plane owner's longest and l its shortest
+/// edge, and for face k l_k the shorter and s_k the sine of the angle of the two edges its normal is
+/// built from (s_k >= 1/64 for a used face, and l <= l_k <= l_P <= L), and pairs whose boxes overlap
+/// (the pipeline runs the pre-test on no other), so every vertex lies within 2 sqrt(3) L of the
+/// owner's vertex 0, the origin of its planes:
 /// - Rounding of the pre-test. A signed distance dot(n, w - origin) - offset, with |n| = 1 within 2u,
 ///   is off by at most 4u |w - origin| + 4u L + u |d| < 23u L (1.4e-6 L) from the exact distance to
 ///   the stored plane (n, offset), and the stored offset is the owner's highest projection within 4u L.
-/// - Its normals against the true face normals. An owner edge is one rounded difference (error below
-///   3u L), so normal k is within (6u L / l_k + 3u) / s_k of the face's (below 2.3e-5 L / l + 1.2e-5
-///   at worst). Over the 4.5 L that the projections of the pair span, that moves a distance by
-///   (27u L^2 / l_k + 14u L) / s_k at most (1.1e-4 L^2 / l + 0.6e-4 L at worst).
+/// - Its normals against the true face normals. An owner edge is one rounded difference of two of its
+///   vertices taken from its vertex 0 (error below 3u l_P), so normal k is within (6u l_P / l_k + 3u) /
+///   s_k of the face's (below 2.3e-5 l_P / l + 1.2e-5 at worst). Over the 4.5 L that the projections
+///   of the pair span, that moves a distance by (27u l_P L / l_k + 14u L) / s_k at most (1.1e-4 l_P L / l
+///   + 0.6e-4 L at worst).
 /// - The float tests' own face axes. They build the same normal from the same two edges in the pair's
 ///   frame (origin at the first tet's vertex 0, unit longest edge), where an edge of the other tet
 ///   carries up to 14u L of rounding; their normal is within (34u L / l_k + 8u) / s_k of the pre-test's,
@@ -28,14 +30,19 @@
 /// report as separating, and with the first two bounds a true gap above 4e-5 L. Taken face by face,
 /// the margin is below 2^-12 L^2 / l_k for a face whose angle has a sine above 1/4, an eighth of what
 /// the smallest sine allowed (1/64) needs, so that most pairs a face axis separates are decided here.
-/// An intersection needs no agreement with the float tests' axes, only a point truly inside: a point
-/// of the other tet found inside all four planes of a tet whose opposite vertices lie below their faces
-/// by k_plane_margin L^2 / l = 2^-9 L^2 / l (`solid`), inside plane k by twice face k's separation
-/// margin, (2^-14 / s_k + 2^-15) L^2 / l_k, lies inside the true tet by more than (5.8e-5 / s_k +
-/// 2.6e-5) L^2 / l_k (at least 8.4e-5 L) behind every face: the first two bounds add up to
-/// (41u / s_k + 23u) L^2 / l_k at most, and the point is a vertex, or a point of an edge whose distances
-/// are interpolated from those of its ends (under 40u L more rounding). So the tets overlap by that
-/// much along every axis. Both
+/// An intersection needs no agreement with the float tests' axes, only a point truly inside the owner.
+/// Its error comes from the first two bounds alone, and the second shrinks with the owner: a point of
+/// the other tet found inside plane k of a `solid` tet by face k's inside margin, (2^-14 / s_k +
+/// 2^-15) l_P L / l_k (twice the separation margin with l_P L for L^2), lies behind the true face by
+/// more than (5.8e-5 / s_k + 2.6e-5) l_P L / l_k (at least 8.4e-5 L): the first two bounds add up to
+/// (41u / s_k + 23u) l_P L / l_k at most, and the point is a vertex, or a point of an edge whose
+/// distances are interpolated from those of its ends (under 40u L more rounding). A tet is solid when
+/// its four faces are used and each lies above its opposite vertex by more than the face's separation
+/// margin for the owner alone, (2^-15 / s_k + 2^-16) l_P^2 / l_k: that height is computed within
+/// (18u / s_k + 5u) l_P^2 / l_k (the second bound over the owner's own span of 2 l_P, and the rounding),
+/// a 28th of it, so every stored normal faces away from its opposite vertex as the true one does, and a
+/// point behind all four true faces lies inside the tet. So the tets overlap by that much along every
+/// axis. Both
 /// decisions are therefore true for the exact float input (the `exact` test agrees) and lie far
 /// inside the clear band (beyond 1e-5 L) where gjk and fast agree with CGAL
 /// (tests/cgal/test_narrow_phase_cgal.cpp), and no test misses an intersecting pair.
@@ -54,17 +61,13 @@
 
 namespace kdet {
 
-/// @brief How far below its faces each vertex of a `solid` tet lies, in units of L^2 / l_min (see the
-/// file comment).
-constexpr float k_plane_margin = 1.0f / 512.0f;
-
 /// @brief Face k's separation margin is (k_plane_sine_margin / s_k + k_plane_edge_margin) L^2 / l_k
 /// (see the file comment).
 constexpr float k_plane_sine_margin = 0x1p-15f;
 constexpr float k_plane_edge_margin = 0x1p-16f;
 
 /// @brief How far inside plane k of the other tet a point must lie to prove an intersection, in units
-/// of face k's separation margin (file comment).
+/// of face k's separation margin taken with l_P L for L^2 (file comment).
 constexpr float k_plane_inside_share = 2.0f;
 
 /// @brief Faces whose two normal-building edges meet at an angle with a smaller sine are not used.
@@ -88,8 +91,9 @@ struct TetPlanes {
     float longest;             ///< longest edge
     float separation_scale[4]; ///< face k's separation margin is separation_scale[k] * L^2; infinite for an
                                ///< unused face
-    std::uint32_t solid;       ///< 1 when all four faces are used and each opposite vertex lies clearly below
-                               ///< its face: only then can the pre-test prove a vertex inside
+    std::uint32_t solid;       ///< 1 when all four faces are used and each opposite vertex lies below its face
+                               ///< by more than the face's separation margin for the tet alone: only then can
+                               ///< the pre-test prove a point inside
 };
 
 /// @brief The face planes of tet v.
@@ -124,7 +128,6 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     // Undoes the scaling exactly for the lengths of a used tet (its exponent and lengths keep every
     // product normal).
     const float unscale = times_power_of_two(1.0f, exponent);
-    const float solidity_margin = k_plane_margin / (sqrtf(shortest2) * unscale) * p.longest * p.longest;
     // Face k (opposite vertex k) has the corners a, b, c = e[k+1], e[k+2], e[k+3] (mod 4); as rows, so
     // that the four faces are computed side by side, each lane without a branch.
     const float ax[4] = {ex[1], ex[2], ex[3], ex[0]}, ay[4] = {ey[1], ey[2], ey[3], ey[0]}, az[4] = {ez[1], ez[2], ez[3], ez[0]};
@@ -162,7 +165,10 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
         p.nz[k] = face_used ? n.z : 0.0f;
         p.offset[k] = face_used ? offset : 0.0f;
         p.separation_scale[k] = face_used ? separation_scale : INFINITY;
-        solid_faces[k] = face_used & (offset - dot(n, vec3{qx[k], qy[k], qz[k]}) > solidity_margin) ? 1u : 0u;
+        // The face's separation margin for the tet alone bounds the error of this height many times over
+        // (file comment), so the normal's side is certain.
+        const float owner_margin = separation_scale * p.longest * p.longest;
+        solid_faces[k] = face_used & (offset - dot(n, vec3{qx[k], qy[k], qz[k]}) > owner_margin) ? 1u : 0u;
     }
     p.solid = solid_faces[0] & solid_faces[1] & solid_faces[2] & solid_faces[3];
     return p;
@@ -177,24 +183,27 @@ KDET_HD inline void plane_distances(const TetPlanes& p, vec3 w, float distance[4
 
 /// @brief What the four face planes of p show about the four vertices w of a tet paired with p's:
 /// whether all of w lies beyond one face plane by more than its separation margin, for a pair whose
-/// longest edge squared is `longest2` (`separated`), and whether some vertex lies inside each of the
-/// four by more than its inside margin (`inside`). The four faces are evaluated side by side (vector
+/// longest edge is `longest` (`separated`), and whether some vertex lies inside each of the four by
+/// more than its inside margin (`inside`). The four faces are evaluated side by side (vector
 /// instructions on the CPU).
 struct PlaneSides {
     bool separated;
     bool inside;
 };
 
-/// @brief Face k's inside margin for a pair whose longest edge squared is longest2, in `margin[k]`.
-KDET_HD inline void inside_margins(const TetPlanes& p, float longest2, float margin[4]) {
+/// @brief Face k's inside margin for a pair whose longest edge is `longest`, in `margin[k]`: it grows with
+/// p's own longest edge times the pair's, not with the pair's squared (file comment).
+KDET_HD inline void inside_margins(const TetPlanes& p, float longest, float margin[4]) {
+    const float scale = p.longest * longest;
     KDET_VECTOR_LOOP
-    for (int k = 0; k < 4; ++k) margin[k] = k_plane_inside_share * p.separation_scale[k] * longest2;
+    for (int k = 0; k < 4; ++k) margin[k] = k_plane_inside_share * p.separation_scale[k] * scale;
 }
 
-KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float longest2) {
+KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float longest) {
+    const float longest2 = longest * longest;
     float nearest[4] = {3.4e38f, 3.4e38f, 3.4e38f, 3.4e38f};
     float inside_margin[4];
-    inside_margins(p, longest2, inside_margin);
+    inside_margins(p, longest, inside_margin);
     bool inside = false;
     for (int j = 0; j < 4; ++j) {
         float distance[4];
@@ -217,17 +226,17 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
 constexpr float k_plane_far = 3.0e38f;
 
 /// @brief Whether a point of some edge of tet w lies inside each of the four face planes of a solid tet
-/// p by more than its inside margin (for a pair whose longest edge squared is longest2): where no
+/// p by more than its inside margin (for a pair whose longest edge is `longest`): where no
 /// vertex lies inside the other tet, two intersecting tets still have an
 /// edge of one passing through the other. The distances vary linearly along an edge, so the part of
 /// it inside every plane is clipped from those at its ends (each face keeps the parameters between
 /// where its distance reaches minus its margin and where it would reach -k_plane_far, with min and max
 /// only: a branch per edge and face would be a coin flip). The middle of that part, clamped onto
 /// the edge whatever the rounding, is then checked as a vertex is, from the interpolated distances.
-KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float longest2) {
+KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float longest) {
     if (!p.solid) return false;
     float margin[4];
-    inside_margins(p, longest2, margin);
+    inside_margins(p, longest, margin);
     // plane_sides computed these distances too; they are computed again so that plane_sides, which
     // every candidate runs, keeps nothing for the few pairs that get this far.
     float distance[4][4];
@@ -280,15 +289,15 @@ enum class PlaneVerdict { unsure, separated, intersecting };
 /// intersection is not looked for (the caller only rejects).
 KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
                                                const vec3 b[4], bool separation_only) {
-    const float longest = max_f(pa.longest, pb.longest), longest2 = longest * longest;
-    const PlaneSides a_by_b = plane_sides(pb, a, longest2);
+    const float longest = max_f(pa.longest, pb.longest);
+    const PlaneSides a_by_b = plane_sides(pb, a, longest);
     if (a_by_b.separated) return PlaneVerdict::separated;
-    const PlaneSides b_by_a = plane_sides(pa, b, longest2);
+    const PlaneSides b_by_a = plane_sides(pa, b, longest);
     if (b_by_a.separated) return PlaneVerdict::separated;
     if (separation_only) return PlaneVerdict::unsure;
     if (b_by_a.inside || a_by_b.inside) return PlaneVerdict::intersecting;
     // The same verdict in either order; a's edges go first (see above).
-    if (edges_pass_inside(pb, a, longest2) || edges_pass_inside(pa, b, longest2))
+    if (edges_pass_inside(pb, a, longest) || edges_pass_inside(pa, b, longest))
         return PlaneVerdict::intersecting;
     return PlaneVerdict::unsure;
 }

@@ -98,14 +98,15 @@ TEST(FacePlanesCgal, NearItsMarginItDecidesOnlyWhatEveryTestDecides) {
 }
 
 /// Face k of a tet, in double: its outward unit normal, a point on it, its centroid, and its
-/// separation margin (2^-15 / s + 2^-16) L^2 / l_f for a pair whose longest edge is `longest` (s, l_f:
-/// the sine and the shorter of the two edges at its largest angle, which build the pre-test's normal).
+/// separation margin (2^-15 / s + 2^-16) A / l_f (s, l_f: the sine and the shorter of the two edges at
+/// its largest angle, which build the pre-test's normal) for the area A = `scale`: L^2 for a pair whose
+/// longest edge is L; l_P L for its inside margin, l_P the tet's own longest edge.
 struct FaceOf {
     d3 normal, point, centroid;
     double margin;
 };
 
-FaceOf face_of(const d3 v[4], int k, double longest) {
+FaceOf face_of(const d3 v[4], int k, double scale) {
     const d3 f0 = v[(k + 1) % 4], f1 = v[(k + 2) % 4], f2 = v[(k + 3) % 4];
     auto length = [](d3 e) { return std::sqrt(dot(e, e)); };
     FaceOf face;
@@ -117,7 +118,7 @@ FaceOf face_of(const d3 v[4], int k, double longest) {
     const double top = std::max({l01, l02, l12});
     const double first = top == l01 ? l02 : l01, second = top == l12 ? l02 : l12;
     const double sine = length(cross(f1 - f0, f2 - f0)) / (first * second);
-    face.margin = (std::ldexp(1.0, -15) / sine + std::ldexp(1.0, -16)) * longest * longest / std::min(first, second);
+    face.margin = (std::ldexp(1.0, -15) / sine + std::ldexp(1.0, -16)) * scale / std::min(first, second);
     return face;
 }
 
@@ -145,7 +146,7 @@ TEST(FacePlanesCgal, EachFaceSeparatesByItsOwnMargin) {
     const ShapedTet a;
     VerdictCheck check;
     for (int k = 0; k < 4; ++k) {
-        const FaceOf face = face_of(a.wide, k, a.longest);
+        const FaceOf face = face_of(a.wide, k, a.longest * a.longest);
         ASSERT_LT(8.0 * face.margin, std::ldexp(1.0, -9) * a.longest * a.longest / a.shortest) << "face " << k;
         for (const double gap : {0.5 * face.margin, 2.0 * face.margin}) {
             // The mirror image across the face, moved out by the gap: its copy of the face lies parallel
@@ -168,34 +169,91 @@ TEST(FacePlanesCgal, EachFaceSeparatesByItsOwnMargin) {
 }
 
 /// A tet with one vertex pushed through a face of another, the rest beyond that face: the pre-test
-/// proves them intersecting once the vertex lies deeper than twice that face's separation margin (its
-/// inside margin; the vertex is far inside the other three faces), and not before.
-TEST(FacePlanesCgal, EachFaceProvesAnIntersectionByTwiceItsMargin) {
+/// proves them intersecting once the vertex lies deeper than that face's inside margin (twice its
+/// separation margin taken with l_P L for L^2: l_P the owner's longest edge, L the pair's; the vertex
+/// is far inside the other three faces), and not before. With the pushing tet of about the owner's size
+/// and with one 8 times larger, whose depth the pair's L^2 would have left unproven.
+TEST(FacePlanesCgal, EachFaceProvesAnIntersectionByItsInsideMargin) {
     const ShapedTet a;
     VerdictCheck check;
-    for (int k = 0; k < 4; ++k) {
-        const FaceOf face = face_of(a.wide, k, a.longest);
-        // Far below 2^-11 L^2 / l, a margin for the whole tet from its shortest edge: only the face's own
-        // margin proves these pairs.
-        ASSERT_LT(8.0 * face.margin, std::ldexp(1.0, -11) * a.longest * a.longest / a.shortest) << "face " << k;
-        for (const double depth : {1.5 * face.margin, 3.0 * face.margin}) {
-            const d3 out = face.normal * (0.5 * a.longest);
-            const d3 tip = face.centroid - face.normal * depth;
-            const d3 along = normalized(face.point - face.centroid) * (0.4 * a.longest);
-            const d3 across = normalized(cross(face.normal, along)) * (0.4 * a.longest);
-            const d3 bd_exact[4] = {tip, face.centroid + out + along, face.centroid + out - along + across,
-                                    face.centroid + out - along - across};
-            kdet::vec3 b[4];
-            for (int v = 0; v < 4; ++v) b[v] = to_vec3(bd_exact[v]);
-            d3 bd[4];
-            widen(b, bd);
-            ASSERT_TRUE(cgal_intersect(a.wide, bd)) << "face " << k << ", depth " << depth;
-            const kdet::TetPlanes pa = kdet::tet_planes(a.v), pb = kdet::tet_planes(b);
-            const bool proven = kdet::face_plane_pretest(pa, a.v, pb, b, false) == PlaneVerdict::intersecting;
-            EXPECT_EQ(proven, depth > 2.0 * face.margin) << "face " << k << ", depth " << depth;
-            check.check(a.v, b, true, "vertex through a face");
+    for (const double size : {1.0, 8.0})
+        for (int k = 0; k < 4; ++k) {
+            const FaceOf unit_face = face_of(a.wide, k, 1.0);
+            const d3 out = unit_face.normal * (0.5 * size * a.longest);
+            const d3 along = normalized(unit_face.point - unit_face.centroid) * (0.4 * size * a.longest);
+            const d3 across = normalized(cross(unit_face.normal, along)) * (0.4 * size * a.longest);
+            // The pushing tet's longest edge, from its three far vertices (the tip's edges are shorter).
+            const double b_longest = std::sqrt(dot(along * 2.0 - across, along * 2.0 - across));
+            const double pair_longest = std::max(a.longest, b_longest);
+            const FaceOf face = face_of(a.wide, k, a.longest * pair_longest);
+            // Far below 2^-11 L^2 / l, a margin for the whole tet from its shortest edge: only the face's
+            // own margin proves these pairs.
+            ASSERT_LT(8.0 * face.margin, std::ldexp(1.0, -11) * a.longest * pair_longest / a.shortest) << "face " << k;
+            // The deeper vertex lies within the inside margin the pair's L^2 would give.
+            if (size > 1.0) {
+                ASSERT_LT(3.0 * face.margin, 2.0 * face_of(a.wide, k, pair_longest * pair_longest).margin);
+            }
+            for (const double depth : {1.5 * face.margin, 3.0 * face.margin}) {
+                const d3 tip = face.centroid - face.normal * depth;
+                const d3 bd_exact[4] = {tip, face.centroid + out + along, face.centroid + out - along + across,
+                                        face.centroid + out - along - across};
+                kdet::vec3 b[4];
+                for (int v = 0; v < 4; ++v) b[v] = to_vec3(bd_exact[v]);
+                d3 bd[4];
+                widen(b, bd);
+                ASSERT_TRUE(cgal_intersect(a.wide, bd)) << "face " << k << ", depth " << depth;
+                const kdet::TetPlanes pa = kdet::tet_planes(a.v), pb = kdet::tet_planes(b);
+                ASSERT_NEAR(pb.longest, b_longest, 1e-5 * b_longest);
+                const bool proven = kdet::face_plane_pretest(pa, a.v, pb, b, false) == PlaneVerdict::intersecting;
+                EXPECT_EQ(proven, depth > 2.0 * face.margin) << "size " << size << ", face " << k << ", depth " << depth;
+                check.check(a.v, b, true, "vertex through a face");
+            }
         }
+    EXPECT_EQ(check.wrong, 0);
+}
+
+/// A flat tet counts as solid, so that a point inside it can prove an intersection, once each face lies
+/// above its opposite vertex by more than the face's separation margin for the tet alone, (2^-15 / s +
+/// 2^-16) l_P^2 / l_f: here the lowest such height is below 2^-9 l_P^2 / l, the whole tet's former
+/// clearance, and the vertex of a tet that touches nothing else of it, put at its centroid, proves the pair.
+TEST(FacePlanesCgal, AFlatTetWhoseFacesClearTheirOwnMarginsIsSolid) {
+    const kdet::vec3 a[4] = {kdet::make_vec3(1.0f, 1.0f, 1.0f), kdet::make_vec3(2.0f, 1.0f, 1.0f),
+                             kdet::make_vec3(1.0f, 2.0f, 1.0f), kdet::make_vec3(1.3f, 1.3f, 1.004f)};
+    d3 ad[4];
+    widen(a, ad);
+    double longest = 0.0, shortest = 1e300;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+            const double l = std::sqrt(dot(ad[j] - ad[i], ad[j] - ad[i]));
+            longest = std::max(longest, l);
+            shortest = std::min(shortest, l);
+        }
+    const d3 centroid = (ad[0] + ad[1] + ad[2] + ad[3]) * 0.25;
+    // The tip at the centroid, the rest of the other tet above it: nothing but the tip lies in the flat tet.
+    const kdet::vec3 b[4] = {to_vec3(centroid), kdet::make_vec3(1.2f, 1.2f, 2.0f), kdet::make_vec3(1.6f, 1.2f, 2.0f),
+                             kdet::make_vec3(1.3f, 1.6f, 2.0f)};
+    d3 bd[4];
+    widen(b, bd);
+    double b_longest = 0.0;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) b_longest = std::max(b_longest, std::sqrt(dot(bd[j] - bd[i], bd[j] - bd[i])));
+    double lowest = 1e300;
+    for (int k = 0; k < 4; ++k) {
+        const FaceOf own = face_of(ad, k, longest * longest);
+        const double height = -dot(own.normal, ad[k] - own.point);
+        EXPECT_GT(height, 4.0 * own.margin) << "face " << k;
+        lowest = std::min(lowest, height);
+        const FaceOf inside = face_of(ad, k, longest * std::max(longest, b_longest));
+        EXPECT_GT(-dot(inside.normal, centroid - inside.point), 4.0 * inside.margin) << "face " << k;
     }
+    EXPECT_LT(lowest, std::ldexp(1.0, -9) * longest * longest / shortest);
+    ASSERT_TRUE(cgal_intersect(ad, bd));
+    const kdet::TetPlanes pa = kdet::tet_planes(a), pb = kdet::tet_planes(b);
+    EXPECT_EQ(pa.solid, 1u);
+    EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, false), PlaneVerdict::intersecting);
+    EXPECT_EQ(kdet::face_plane_pretest(pb, b, pa, a, false), PlaneVerdict::intersecting);
+    VerdictCheck check;
+    check.check(a, b, true, "vertex inside a flat tet");
     EXPECT_EQ(check.wrong, 0);
 }
 
