@@ -88,7 +88,7 @@ def main() -> None:
         "",
         f"- Machine: {detector.device_name}, {os.cpu_count()} cores, {platform.platform()}; "
         f"Python {platform.python_version()}, NumPy {np.__version__}; load average (1 min) {load_before:.1f} before, "
-        f"{load_after:.1f} after: the cores were shared with other work.",
+        f"{load_after:.1f} after (the second counts this benchmark's own threads).",
         f"- kdet {kdet.version()}; detector threads: {detector.options['threads'] or 'all'}.",
         f"- Command: `python3 {' '.join(sys.argv)}` (bench/python_overhead.py, package built by `pip install .`).",
         f"- Workload: two tet grids of {grid.num_tets:,} tets each ({tets:,} in all), one sliding through the "
