@@ -33,8 +33,9 @@ struct NearTouchingPairs {
 /// vertex inside A (by d while d is below its depth under the other faces). A third of the pairs take d
 /// within three times the pre-test's separation margin of that face, (2^-15 / s + 2^-16) L^2 / l_f
 /// (L: the pair's longest edge; s, l_f: the sine and the shorter of the face's two edges at its largest
-/// angle; its inside margin is twice that), a third within three times 2^-9 L^2 / l (l: A's shortest
-/// edge), the margin of a face at the smallest sine the pre-test allows, and a third within 1e-7 L to
+/// angle; its inside margin is twice that with l_A L for L^2, l_A A's longest edge, so at most twice
+/// that), a third within three times 2^-9 L^2 / l (l: A's shortest edge), the margin of a face at the
+/// smallest sine the pre-test allows, and a third within 1e-7 L to
 /// 3e-4 L of touching, where the float tests' tolerance lies. `per_size` pairs
 /// (rounded up to a cube) for each of four sizes a decade apart, each size on its own lattice at most
 /// 60 sizes from the origin, so that the float coordinates keep the depths (relative rounding below 4e-6).
