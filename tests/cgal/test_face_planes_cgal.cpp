@@ -212,6 +212,75 @@ TEST(FacePlanesCgal, EachFaceProvesAnIntersectionByItsInsideMargin) {
     EXPECT_EQ(check.wrong, 0);
 }
 
+/// Random pairs of a small tet and one 4 to 64 times larger, pushed with a vertex through a face of the
+/// small one to within three inside margins of that face (l_P L for L^2: the margins this pairing
+/// shrinks most), at sizes six decades apart and away from the origin: wherever the pre-test decides,
+/// CGAL and every test agree, and every pair pushed in beyond one and a half margins is proven (the
+/// pair's L^2 would have proven none of them: L is at least 3.6 times the small tet's longest edge).
+TEST(FacePlanesCgal, GradedPairsNearTheInsideMarginAreDecidedOnlyWhereEveryTestAgrees) {
+    Random rng(0x67726164u);
+    VerdictCheck check;
+    int pushed_in = 0;
+    for (const double size : {1e-3, 1.0, 1e3})
+        for (int n = 0; n < 600; ++n) {
+            d3 ad[4];
+            double longest = 0.0, shortest = 0.0;
+            kdet::vec3 a[4];
+            do {
+                const d3 centre = rng.direction() * (rng.uniform(0.0, 100.0) * size);
+                for (int v = 0; v < 4; ++v) a[v] = to_vec3(centre + rng.in_cube(size));
+                widen(a, ad);
+                longest = 0.0, shortest = 1e300;
+                for (int i = 0; i < 4; ++i)
+                    for (int j = i + 1; j < 4; ++j) {
+                        const double l = std::sqrt(dot(ad[j] - ad[i], ad[j] - ad[i]));
+                        longest = std::max(longest, l);
+                        shortest = std::min(shortest, l);
+                    }
+                // Well shaped: each vertex at least a fifth of the longest edge above its opposite face.
+                for (int f = 0; f < 4 && shortest >= 0.1 * longest; ++f) {
+                    const FaceOf face = face_of(ad, f, 1.0);
+                    if (-dot(face.normal, ad[f] - face.point) < 0.2 * longest) shortest = 0.0;
+                }
+            } while (shortest < 0.1 * longest);
+            const int k = rng.index(4);
+            const double scale = std::ldexp(1.0, 2 + rng.index(5)) * longest; // 4 to 64 times a's longest edge
+            const FaceOf unit_face = face_of(ad, k, 1.0);
+            const d3 along = normalized(unit_face.point - unit_face.centroid), across = cross(unit_face.normal, along);
+            const double turn = rng.uniform(0.0, 6.283185307179586);
+            const d3 u = along * std::cos(turn) + across * std::sin(turn), w = cross(unit_face.normal, u);
+            const d3 base = unit_face.centroid + unit_face.normal * (0.5 * scale);
+            d3 far[3] = {base + u * (0.4 * scale), base - u * (0.4 * scale) + w * (0.4 * scale),
+                         base - u * (0.4 * scale) - w * (0.4 * scale)};
+            double b_longest = 0.0;
+            for (int i = 0; i < 3; ++i)
+                for (int j = i + 1; j < 3; ++j) b_longest = std::max(b_longest, std::sqrt(dot(far[j] - far[i], far[j] - far[i])));
+            const double inside = 2.0 * face_of(ad, k, longest * std::max(longest, b_longest)).margin;
+            const double depth = inside * rng.uniform(-3.0, 3.0);
+            kdet::vec3 b[4] = {to_vec3(unit_face.centroid - unit_face.normal * depth), to_vec3(far[0]), to_vec3(far[1]),
+                               to_vec3(far[2])};
+            std::rotate(b, b + rng.index(4), b + 4);
+            d3 bd[4];
+            widen(b, bd);
+            char what[64];
+            std::snprintf(what, sizeof what, "graded pair, size %g, depth %.2f inside margins", size, depth / inside);
+            const bool truth = cgal_intersect(ad, bd);
+            check.check(a, b, truth, what);
+            check.check(b, a, truth, what);
+            if (depth > 1.5 * inside) {
+                // Far enough in for the vertex alone to prove it, whichever tet goes first.
+                ++pushed_in;
+                const kdet::TetPlanes pa = kdet::tet_planes(a), pb = kdet::tet_planes(b);
+                EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, false), PlaneVerdict::intersecting) << what;
+                EXPECT_EQ(kdet::face_plane_pretest(pb, b, pa, a, false), PlaneVerdict::intersecting) << what;
+            }
+        }
+    std::printf("graded pairs %lld: pre-test separated %lld, intersecting %lld; %d pushed in beyond 1.5 margins\n",
+                check.pairs, check.separated, check.intersecting, pushed_in);
+    EXPECT_EQ(check.wrong, 0);
+    EXPECT_GT(pushed_in, 300);
+}
+
 /// A flat tet counts as solid, so that a point inside it can prove an intersection, once each face lies
 /// above its opposite vertex by more than the face's separation margin for the tet alone, (2^-15 / s +
 /// 2^-16) l_P^2 / l_f: here the lowest such height is below 2^-9 l_P^2 / l, the whole tet's former
