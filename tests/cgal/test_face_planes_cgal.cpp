@@ -186,7 +186,7 @@ TEST(FacePlanesCgal, EachFaceProvesAnIntersectionByItsInsideMargin) {
             const double b_longest = std::sqrt(dot(along * 2.0 - across, along * 2.0 - across));
             const double pair_longest = std::max(a.longest, b_longest);
             const FaceOf face = face_of(a.wide, k, a.longest * pair_longest);
-            // Far below 2^-11 L^2 / l, a margin for the whole tet from its shortest edge: only the face's
+            // Far below 2^-11 l_P L / l, a margin for the whole tet from its shortest edge: only the face's
             // own margin proves these pairs.
             ASSERT_LT(8.0 * face.margin, std::ldexp(1.0, -11) * a.longest * pair_longest / a.shortest) << "face " << k;
             // The deeper vertex lies within the inside margin the pair's L^2 would give.
@@ -250,8 +250,8 @@ TEST(FacePlanesCgal, GradedPairsNearTheInsideMarginAreDecidedOnlyWhereEveryTestA
             const double turn = rng.uniform(0.0, 6.283185307179586);
             const d3 u = along * std::cos(turn) + across * std::sin(turn), w = cross(unit_face.normal, u);
             const d3 base = unit_face.centroid + unit_face.normal * (0.5 * scale);
-            d3 far[3] = {base + u * (0.4 * scale), base - u * (0.4 * scale) + w * (0.4 * scale),
-                         base - u * (0.4 * scale) - w * (0.4 * scale)};
+            const d3 far[3] = {base + u * (0.4 * scale), base - u * (0.4 * scale) + w * (0.4 * scale),
+                               base - u * (0.4 * scale) - w * (0.4 * scale)};
             double b_longest = 0.0;
             for (int i = 0; i < 3; ++i)
                 for (int j = i + 1; j < 3; ++j) b_longest = std::max(b_longest, std::sqrt(dot(far[j] - far[i], far[j] - far[i])));
