@@ -122,6 +122,22 @@ FaceOf face_of(const d3 v[4], int k, double scale) {
     return face;
 }
 
+/// The longest and shortest edges of a tet.
+struct EdgeLengths {
+    double longest = 0.0, shortest = 1e300;
+};
+
+EdgeLengths edge_lengths(const d3 v[4]) {
+    EdgeLengths e;
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+            const double l = std::sqrt(dot(v[j] - v[i], v[j] - v[i]));
+            e.longest = std::max(e.longest, l);
+            e.shortest = std::min(e.shortest, l);
+        }
+    return e;
+}
+
 /// A well-shaped tet, away from the origin, and its longest and shortest edges.
 struct ShapedTet {
     kdet::vec3 v[4] = {kdet::make_vec3(1.0f, 1.0f, 1.0f), kdet::make_vec3(2.0f, 1.1f, 1.0f),
@@ -130,12 +146,9 @@ struct ShapedTet {
     double longest = 0.0, shortest = 1e300;
     ShapedTet() {
         widen(v, wide);
-        for (int i = 0; i < 4; ++i)
-            for (int j = i + 1; j < 4; ++j) {
-                const double l = std::sqrt(dot(wide[j] - wide[i], wide[j] - wide[i]));
-                longest = std::max(longest, l);
-                shortest = std::min(shortest, l);
-            }
+        const EdgeLengths e = edge_lengths(wide);
+        longest = e.longest;
+        shortest = e.shortest;
     }
 };
 
@@ -230,13 +243,8 @@ TEST(FacePlanesCgal, GradedPairsNearTheInsideMarginAreDecidedOnlyWhereEveryTestA
                 const d3 centre = rng.direction() * (rng.uniform(0.0, 100.0) * size);
                 for (int v = 0; v < 4; ++v) a[v] = to_vec3(centre + rng.in_cube(size));
                 widen(a, ad);
-                longest = 0.0, shortest = 1e300;
-                for (int i = 0; i < 4; ++i)
-                    for (int j = i + 1; j < 4; ++j) {
-                        const double l = std::sqrt(dot(ad[j] - ad[i], ad[j] - ad[i]));
-                        longest = std::max(longest, l);
-                        shortest = std::min(shortest, l);
-                    }
+                const EdgeLengths e = edge_lengths(ad);
+                longest = e.longest, shortest = e.shortest;
                 // Well shaped: each vertex at least a fifth of the longest edge above its opposite face.
                 for (int f = 0; f < 4 && shortest >= 0.1 * longest; ++f) {
                     const FaceOf face = face_of(ad, f, 1.0);
@@ -290,22 +298,14 @@ TEST(FacePlanesCgal, AFlatTetWhoseFacesClearTheirOwnMarginsIsSolid) {
                              kdet::make_vec3(1.0f, 2.0f, 1.0f), kdet::make_vec3(1.3f, 1.3f, 1.004f)};
     d3 ad[4];
     widen(a, ad);
-    double longest = 0.0, shortest = 1e300;
-    for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) {
-            const double l = std::sqrt(dot(ad[j] - ad[i], ad[j] - ad[i]));
-            longest = std::max(longest, l);
-            shortest = std::min(shortest, l);
-        }
+    const auto [longest, shortest] = edge_lengths(ad);
     const d3 centroid = (ad[0] + ad[1] + ad[2] + ad[3]) * 0.25;
     // The tip at the centroid, the rest of the other tet above it: nothing but the tip lies in the flat tet.
     const kdet::vec3 b[4] = {to_vec3(centroid), kdet::make_vec3(1.2f, 1.2f, 2.0f), kdet::make_vec3(1.6f, 1.2f, 2.0f),
                              kdet::make_vec3(1.3f, 1.6f, 2.0f)};
     d3 bd[4];
     widen(b, bd);
-    double b_longest = 0.0;
-    for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) b_longest = std::max(b_longest, std::sqrt(dot(bd[j] - bd[i], bd[j] - bd[i])));
+    const double b_longest = edge_lengths(bd).longest;
     double lowest = 1e300;
     for (int k = 0; k < 4; ++k) {
         const FaceOf own = face_of(ad, k, longest * longest);
