@@ -142,8 +142,8 @@ std::string stage_table(const std::vector<PeerCase>& cases, int threads) {
         const FrameCounts& n = runs[runs.size() / 2].counts;
         std::snprintf(line, sizeof line, "| %s | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %llu | %llu | %llu | %u |\n",
                       c.name.c_str(), mode, t.total, t.bounding_boxes, t.populate_grid, t.find_candidates, t.narrow_phase,
-                      t.sort_unique, static_cast<unsigned long long>(n.candidates),
-                      static_cast<unsigned long long>(n.unique_candidates),
+                      t.sort_pairs, static_cast<unsigned long long>(n.candidates),
+                      static_cast<unsigned long long>(n.narrow_phase_candidates),
                       static_cast<unsigned long long>(n.colliding_pairs), n.buffer_regrows);
         out += line;
     };

@@ -73,7 +73,7 @@ void report(const std::string& name, const TetMesh& a, const TetMesh* b) {
         const cli::ExactReport exact = cli::check_exact(a, b, reported, options);
         checked = std::max(checked, exact.pairs_checked);
         truth = exact.true_pairs;
-        candidates = r.counts.unique_candidates;
+        candidates = r.counts.narrow_phase_candidates;
         if (test == NarrowPhase::exact) exact_stage = r.counts.exact_stage_pairs;
         row += " | " + std::to_string(exact.false_positives.size()) + " / " + std::to_string(exact.false_negatives.size());
     }

@@ -44,7 +44,7 @@ void expect_backends_agree(const std::vector<TetMesh>& meshes, bool self, const 
     EXPECT_EQ(cuda.colliding, cpu.colliding);
     expect_same_contacts(cuda.contacts, cpu.contacts, to_string(options.method));
     if (options.method == Method::kdet) {
-        EXPECT_EQ(cuda.counts.unique_candidates, cpu.counts.unique_candidates);
+        EXPECT_EQ(cuda.counts.narrow_phase_candidates, cpu.counts.narrow_phase_candidates);
     }
     if (options.method != Method::kdet_no_pairs) { // kdet_no_pairs skips pairs in a racy order
         EXPECT_EQ(cuda.counts.exact_stage_pairs, cpu.counts.exact_stage_pairs);

@@ -163,7 +163,7 @@ FrameResult sample_result() {
     FrameResult r;
     r.colliding = {{1, 0, 1, 1}, {0, 1}};
     r.counts.candidates = 40;
-    r.counts.unique_candidates = 30;
+    r.counts.narrow_phase_candidates = 30;
     r.counts.colliding_pairs = 5;
     r.counts.colliding_tets = 4;
     r.counts.buffer_regrows = 1;

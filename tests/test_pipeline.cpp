@@ -124,7 +124,7 @@ TEST_P(RealMesh, UndeformedMeshHasNoSelfCollision) {
     const FrameCounts counts = run({mesh}, true, with_method(Method::kdet)).counts;
     EXPECT_GT(counts.candidates, 0u); // the grid did find neighbours
     // ... and the face-plane pre-test proved most of them separated before they were written.
-    EXPECT_LT(counts.unique_candidates, counts.candidates / 2);
+    EXPECT_LT(counts.narrow_phase_candidates, counts.candidates / 2);
 }
 
 // Named after the model (Models/RealMesh.Test/bunny), so test filters can pick models by name.
@@ -159,7 +159,7 @@ TEST(Pipeline, NearTouchingPairsGetEachTestsOwnAnswer) {
         EXPECT_EQ(found.pairs, oracle.pairs) << to_string(narrow);
         EXPECT_GT(oracle.pairs.size(), count / 4) << to_string(narrow);
         // Not vacuous: the pre-test proved a good part of the pairs separated.
-        EXPECT_GT(found.counts.candidates - found.counts.unique_candidates, count / 10) << to_string(narrow);
+        EXPECT_GT(found.counts.candidates - found.counts.narrow_phase_candidates, count / 10) << to_string(narrow);
         grid.method = Method::kdet_no_pairs;
         EXPECT_EQ(run({pairs.first, pairs.second}, false, grid).colliding, flags_of(oracle.pairs, oracle.colliding))
             << to_string(narrow);
@@ -209,7 +209,7 @@ TEST(Pipeline, PairsThatOnlyAnEdgeAxisSeparatesGetEachTestsOwnAnswer) {
         const bool reports_them = narrow == NarrowPhase::sat_no_edges;
         EXPECT_EQ(oracle.pairs.size(), reports_them ? count : 0u) << to_string(narrow);
         EXPECT_EQ(found.counts.candidates, count) << to_string(narrow);
-        EXPECT_EQ(found.counts.unique_candidates, reports_them ? count : 0u) << to_string(narrow);
+        EXPECT_EQ(found.counts.narrow_phase_candidates, reports_them ? count : 0u) << to_string(narrow);
         grid.method = Method::kdet_no_pairs;
         EXPECT_EQ(run({first, second}, false, grid).colliding, flags_of(oracle.pairs, oracle.colliding))
             << to_string(narrow);
@@ -229,18 +229,18 @@ TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
     // The tets that did not fit resume where they stopped: no candidate is written twice or lost,
     // and no rejection is counted twice. Dense soups give tets several batches of candidates, so
     // some stop after storing a batch.
-    EXPECT_EQ(small.counts.unique_candidates, reference.counts.unique_candidates);
+    EXPECT_EQ(small.counts.narrow_phase_candidates, reference.counts.narrow_phase_candidates);
     EXPECT_EQ(small.counts.candidates, reference.counts.candidates);
     const TetMesh c = random_soup(3000, 1.0, 0.05, 41), d = random_soup(3000, 1.0, 0.05, 42);
     const Outcome dense = run({c, d}, true, with_method(Method::kdet));
-    ASSERT_GT(dense.counts.unique_candidates, 8u * 6000u); // 16 keys to a batch
+    ASSERT_GT(dense.counts.narrow_phase_candidates, 8u * 6000u); // 16 keys to a batch
     for (const auto& [meshes, whole] : {std::pair{std::vector<TetMesh>{a, b}, reference}, std::pair{std::vector<TetMesh>{c, d}, dense}})
-        for (std::size_t capacity : {std::size_t{17}, whole.counts.unique_candidates / 3, whole.counts.unique_candidates - 1}) {
+        for (std::size_t capacity : {std::size_t{17}, whole.counts.narrow_phase_candidates / 3, whole.counts.narrow_phase_candidates - 1}) {
             DetectorOptions part = with_method(Method::kdet);
             part.initial_candidate_capacity = capacity;
             const Outcome grown = run(meshes, true, part);
             EXPECT_EQ(grown.pairs, whole.pairs) << capacity;
-            EXPECT_EQ(grown.counts.unique_candidates, whole.counts.unique_candidates) << capacity;
+            EXPECT_EQ(grown.counts.narrow_phase_candidates, whole.counts.narrow_phase_candidates) << capacity;
             EXPECT_EQ(grown.counts.candidates, whole.counts.candidates) << capacity;
             EXPECT_GT(grown.counts.buffer_regrows, 0u) << capacity;
         }
@@ -335,7 +335,7 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
                 EXPECT_EQ(got.pairs, expected.pairs) << "capacity " << capacity;
                 EXPECT_EQ(got.colliding, expected.colliding);
                 EXPECT_EQ(got.counts.candidates, expected.counts.candidates);
-                EXPECT_EQ(got.counts.unique_candidates, expected.counts.unique_candidates);
+                EXPECT_EQ(got.counts.narrow_phase_candidates, expected.counts.narrow_phase_candidates);
                 // A plan in smaller chunks bounds the cells more loosely, never too tightly.
                 if (capacity == 0 && same_candidates_written) {
                     EXPECT_EQ(got.counts.buffer_regrows, expected.counts.buffer_regrows);
@@ -386,7 +386,7 @@ TEST(Pipeline, NearTheMemoryLimitBuffersGrowToWhatFitsAndNoPairIsLost) {
     options.contacts = true;
     Pipeline<CpuExec> unlimited(options);
     const FrameResult expected = run_frames(unlimited, frames, false);
-    const std::size_t candidates = expected.counts.unique_candidates, pairs = expected.pairs.size();
+    const std::size_t candidates = expected.counts.narrow_phase_candidates, pairs = expected.pairs.size();
     ASSERT_GT(candidates, 4u * 4096u); // past the first frame's sizing
     ASSERT_GT(pairs, 1000u);
     constexpr std::size_t unlimited_room = std::numeric_limits<std::size_t>::max();
@@ -400,7 +400,7 @@ TEST(Pipeline, NearTheMemoryLimitBuffersGrowToWhatFitsAndNoPairIsLost) {
         const FrameResult got = run_frames(capped, frames, false);
         EXPECT_EQ(got.pairs, expected.pairs);
         EXPECT_EQ(got.contacts.size(), pairs);
-        EXPECT_EQ(got.counts.unique_candidates, candidates);
+        EXPECT_EQ(got.counts.narrow_phase_candidates, candidates);
         EXPECT_GT(got.counts.buffer_regrows, 0u);
     }
     // A first frame whose guess (16 keys a tet) the memory does not hold starts from less and grows
@@ -409,13 +409,13 @@ TEST(Pipeline, NearTheMemoryLimitBuffersGrowToWhatFitsAndNoPairIsLost) {
     contact_buffer_cap = unlimited_room;
     Pipeline<CpuExec> first_unlimited(options);
     const FrameResult first_expected = run_frames(first_unlimited, {frames.back()}, true);
-    const std::size_t first_candidates = first_expected.counts.unique_candidates;
+    const std::size_t first_candidates = first_expected.counts.narrow_phase_candidates;
     ASSERT_LT(first_candidates + first_candidates / 10, 16u * 6000u);
     key_buffer_cap = first_candidates + first_candidates / 10;
     Pipeline<CappedExec> first_capped(options);
     const FrameResult first_got = run_frames(first_capped, {frames.back()}, true);
     EXPECT_EQ(first_got.pairs, first_expected.pairs);
-    EXPECT_EQ(first_got.counts.unique_candidates, first_candidates);
+    EXPECT_EQ(first_got.counts.narrow_phase_candidates, first_candidates);
     EXPECT_GT(first_got.counts.buffer_regrows, 0u);
     // Below the need itself the frame cannot run: an exception, not a partial answer.
     for (const auto& [keys, contacts] : {std::pair{candidates / 2, unlimited_room}, std::pair{unlimited_room, pairs / 2}}) {
@@ -436,7 +436,7 @@ TEST(Pipeline, OrdinaryInputGrowsNoBuffer) {
                                        std::pair{std::vector<TetMesh>{hand}, true},
                                        std::pair{std::vector<TetMesh>{hand, moved(hand, 0.3, 0.1 * e, 0.0, 0.0)}, false}}) {
         const Outcome outcome = run(meshes, self, with_method(Method::kdet));
-        EXPECT_GT(outcome.counts.unique_candidates, 0u);
+        EXPECT_GT(outcome.counts.narrow_phase_candidates, 0u);
         EXPECT_EQ(outcome.counts.buffer_regrows, 0u) << meshes.size() << " objects, self " << self;
     }
 }
@@ -479,7 +479,7 @@ TEST(Pipeline, ThreadCountDoesNotChangeTheAnswer) {
         more.threads = threads;
         const Outcome r = run({a, b}, true, more);
         EXPECT_EQ(r1.pairs, r.pairs) << threads;
-        EXPECT_EQ(r1.counts.unique_candidates, r.counts.unique_candidates) << threads;
+        EXPECT_EQ(r1.counts.narrow_phase_candidates, r.counts.narrow_phase_candidates) << threads;
     }
 }
 
@@ -755,7 +755,7 @@ TEST(Detector, AFrameWhoseObjectsMeetRunsAgainFromEachStageThatLackedRoomAndLose
         EXPECT_EQ(grown.pairs, expected.pairs) << to_string(method);
         EXPECT_EQ(grown.colliding, expected.colliding) << to_string(method);
         EXPECT_EQ(grown.counts.candidates, expected.counts.candidates) << to_string(method);
-        EXPECT_EQ(grown.counts.unique_candidates, expected.counts.unique_candidates) << to_string(method);
+        EXPECT_EQ(grown.counts.narrow_phase_candidates, expected.counts.narrow_phase_candidates) << to_string(method);
         EXPECT_EQ(grown.counts.colliding_tets, expected.counts.colliding_tets) << to_string(method);
         EXPECT_EQ(grown.counts.exact_stage_pairs, expected.counts.exact_stage_pairs) << to_string(method);
         EXPECT_EQ(grown.counts.grid_cells, expected.counts.grid_cells) << to_string(method);
@@ -880,8 +880,8 @@ TEST(Detector, ReportsMemoryAndStageTimes) {
     EXPECT_GT(r.times.total, 0.0);
     EXPECT_GE(r.times.total, r.times.populate_grid + r.times.find_candidates);
     EXPECT_GT(r.counts.candidates, 0u);
-    EXPECT_GE(r.counts.candidates, r.counts.unique_candidates);
-    EXPECT_GE(r.counts.unique_candidates, r.counts.colliding_pairs);
+    EXPECT_GE(r.counts.candidates, r.counts.narrow_phase_candidates);
+    EXPECT_GE(r.counts.narrow_phase_candidates, r.counts.colliding_pairs);
     EXPECT_GT(r.counts.grid_cells, 0u);
     EXPECT_LE(r.counts.grid_cells, r.counts.grid_slots);
     EXPECT_GT(r.grid_bytes, 0u);

@@ -55,7 +55,7 @@ void print_report(const BenchConfig& config, const Scene& scene, const BenchOutc
                 to_string(config.options.backend), value("device").c_str());
     const std::size_t device = column("device time"), pairs = column("collision pairs");
     if (!config.quiet) {
-        std::printf("%6s %12s %12s %14s %14s %12s %12s\n", "frame", "device_ms", "host_ms", "candidates", "unique",
+        std::printf("%6s %12s %12s %14s %14s %12s %12s\n", "frame", "device_ms", "host_ms", "candidates", "narrow",
                     "pairs", "tets");
         for (const FrameRow& row : mean)
             std::printf("%6.0f %12.3f %12.3f %14.0f %14.0f %12.0f %12.0f\n", row[column("frame")], row[device],

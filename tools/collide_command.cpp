@@ -141,14 +141,14 @@ int run_collide(int argc, char** argv) {
         std::cout << ", \"self\": " << (self ? "true" : "false") << ", \"method\": \"" << to_string(options.method)
                   << "\", \"test\": \"" << to_string(options.narrow_phase) << "\", \"hash\": \""
                   << to_string(options.hash) << "\", \"backend\": \"" << to_string(options.backend)
-                  << "\", \"candidates\": " << c.candidates << ", \"unique_candidates\": " << c.unique_candidates
+                  << "\", \"candidates\": " << c.candidates << ", \"narrow_phase_candidates\": " << c.narrow_phase_candidates
                   << ", \"colliding_pairs\": " << c.colliding_pairs << ", \"colliding_tets\": " << c.colliding_tets
                   << ", \"buffer_regrows\": " << c.buffer_regrows << ", \"host_waits\": " << c.host_waits
                   << ", \"exact_stage_pairs\": " << c.exact_stage_pairs
                   << ", \"times_ms\": {\"bounding_boxes\": "
                   << json_number(t.bounding_boxes) << ", \"populate_grid\": " << json_number(t.populate_grid)
                   << ", \"find_candidates\": " << json_number(t.find_candidates)
-                  << ", \"sort_unique\": " << json_number(t.sort_unique)
+                  << ", \"sort_pairs\": " << json_number(t.sort_pairs)
                   << ", \"narrow_phase\": " << json_number(t.narrow_phase) << "}, \"total_ms\": "
                   << json_number(t.total) << ", \"memory_bytes\": " << result.memory_bytes;
         if (check)
@@ -165,15 +165,15 @@ int run_collide(int argc, char** argv) {
     std::printf("%s\n", self ? ", self-collision" : "");
     std::printf("method            %s, test %s, hash %s, backend %s\n", to_string(options.method),
                 to_string(options.narrow_phase), to_string(options.hash), to_string(options.backend));
-    std::printf("candidates        %llu (unique %llu)\n", static_cast<unsigned long long>(c.candidates),
-                static_cast<unsigned long long>(c.unique_candidates));
+    std::printf("candidates        %llu (%llu to the narrow phase)\n", static_cast<unsigned long long>(c.candidates),
+                static_cast<unsigned long long>(c.narrow_phase_candidates));
     if (options.method != Method::kdet_no_pairs)
         std::printf("colliding pairs   %llu\n", static_cast<unsigned long long>(c.colliding_pairs));
     std::printf("colliding tets    %llu\n", static_cast<unsigned long long>(c.colliding_tets));
     if (options.narrow_phase == NarrowPhase::exact)
         std::printf("exact stage       %llu pairs\n", static_cast<unsigned long long>(c.exact_stage_pairs));
-    std::printf("times (ms)        boxes %.3f, populate %.3f, candidates %.3f, sort+unique %.3f, narrow %.3f\n",
-                t.bounding_boxes, t.populate_grid, t.find_candidates, t.sort_unique, t.narrow_phase);
+    std::printf("times (ms)        boxes %.3f, populate %.3f, candidates %.3f, sort pairs %.3f, narrow %.3f\n",
+                t.bounding_boxes, t.populate_grid, t.find_candidates, t.sort_pairs, t.narrow_phase);
     std::printf("total             %.3f ms\n", t.total);
     std::printf("memory            %zu bytes\n", result.memory_bytes);
     if (check) {

@@ -14,7 +14,7 @@ enum class Backend { cpu, cuda };
 
 /// @brief How candidate pairs are found. All methods report the same pairs.
 enum class Method {
-    kdet,              ///< hierarchical grid, candidates, sort+unique, narrow phase: all unique pairs
+    kdet,              ///< hierarchical grid, candidates, narrow phase, sorted pairs: all unique pairs
     kdet_no_pairs,     ///< the thesis's old method: per-tet colliding flags only, no pair list
     brute_force_loop,  ///< every tet against every later tet, one work item per tet
     brute_force_pairs, ///< one work item per tet pair

@@ -45,7 +45,7 @@ struct StageTimes {
     double bounding_boxes = 0;  ///< per-tet boxes and sizes, object boxes and their overlap
     double populate_grid = 0;
     double find_candidates = 0; ///< for kdet_no_pairs this includes its inline narrow phase
-    double sort_unique = 0;     ///< sorting the colliding pairs into the output order (candidates are unique as found)
+    double sort_pairs = 0;      ///< sorting the colliding pairs into the output order (the thesis's CSV: "sort unique time")
     double narrow_phase = 0;    ///< includes compacting the colliding pairs, contacts and copying them out
     double total = 0;           ///< the whole detect() call, positions copied in and results copied out included
 };
@@ -53,7 +53,9 @@ struct StageTimes {
 /// @brief Sizes of one detection.
 struct FrameCounts {
     std::uint64_t candidates = 0;        ///< candidate pairs found (boxes overlap, not adjacent), each once
-    std::uint64_t unique_candidates = 0; ///< of which the pre-test (slabs, face planes) could not reject: the narrow phase runs on these
+    /// Of the candidates, those the pre-test (slabs, face planes) could not reject: the narrow phase runs on
+    /// these (the thesis's CSV: "unique candidates").
+    std::uint64_t narrow_phase_candidates = 0;
     std::uint64_t colliding_pairs = 0;
     std::uint64_t colliding_tets = 0;    ///< tets flagged as colliding, all objects together
     std::uint64_t exact_stage_pairs = 0; ///< NarrowPhase::exact: pairs its float filter left to the exact stage

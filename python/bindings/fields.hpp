@@ -32,7 +32,7 @@ constexpr auto fields_of();
 template <>
 constexpr auto fields_of<FrameCounts>() {
     using C = FrameCounts;
-    return std::make_tuple(Field{"candidates", &C::candidates}, Field{"unique_candidates", &C::unique_candidates},
+    return std::make_tuple(Field{"candidates", &C::candidates}, Field{"narrow_phase_candidates", &C::narrow_phase_candidates},
                            Field{"colliding_pairs", &C::colliding_pairs}, Field{"colliding_tets", &C::colliding_tets},
                            Field{"exact_stage_pairs", &C::exact_stage_pairs},
                            Field{"buffer_regrows", &C::buffer_regrows}, Field{"grid_cells", &C::grid_cells},
@@ -46,7 +46,7 @@ template <>
 constexpr auto fields_of<StageTimes>() {
     using T = StageTimes;
     return std::make_tuple(Field{"bounding_boxes", &T::bounding_boxes}, Field{"populate_grid", &T::populate_grid},
-                           Field{"find_candidates", &T::find_candidates}, Field{"sort_unique", &T::sort_unique},
+                           Field{"find_candidates", &T::find_candidates}, Field{"sort_pairs", &T::sort_pairs},
                            Field{"narrow_phase", &T::narrow_phase}, Field{"total", &T::total});
 }
 

@@ -113,7 +113,7 @@ def test_counts_match_the_command_json(cli, octopus_files):
     detector.add_object(kdet.read_tet_mesh(b_file))
     counts = detector.detect().counts.as_dict()
     shared = [key for key in printed if key in counts]
-    assert {"candidates", "unique_candidates", "colliding_pairs", "colliding_tets"} <= set(shared)
+    assert {"candidates", "narrow_phase_candidates", "colliding_pairs", "colliding_tets"} <= set(shared)
     for key in shared:
         assert counts[key] == printed[key], key
     assert set(detector.detect().times.as_dict()) >= set(printed["times_ms"]) | {"total"}

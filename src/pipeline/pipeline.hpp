@@ -779,10 +779,10 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
     result.counts = FrameCounts{};
     FrameCounts& counts = result.counts;
     if (method == Method::kdet_no_pairs) {
-        counts.candidates = counts.unique_candidates = c.tests_run;
+        counts.candidates = counts.narrow_phase_candidates = c.tests_run;
     } else {
-        counts.unique_candidates = c.candidates - c.candidate_padding - c.rejected_after_search;
-        counts.candidates = counts.unique_candidates + c.rejected + c.rejected_after_search;
+        counts.narrow_phase_candidates = c.candidates - c.candidate_padding - c.rejected_after_search;
+        counts.candidates = counts.narrow_phase_candidates + c.rejected + c.rejected_after_search;
     }
     counts.exact_stage_pairs = c.exact_stage_pairs;
     counts.colliding_pairs = colliding_count_;
@@ -815,7 +815,7 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
     t.bounding_boxes = clock_.between_ms(frame_start, boxes_done);
     t.populate_grid = clock_.between_ms(boxes_done, grid_done);
     t.find_candidates = clock_.between_ms(grid_method() ? grid_done : boxes_done, candidates_done);
-    t.sort_unique = clock_.between_ms(narrow_phase_done, sorted);
+    t.sort_pairs = clock_.between_ms(narrow_phase_done, sorted);
     t.narrow_phase = clock_.between_ms(candidates_done, narrow_phase_done) + clock_.between_ms(sorted, results_done);
     t.total = clock_.between_ms(frame_start, frame_end);
     counts.host_waits = static_cast<std::uint32_t>(exec_.host_waits() - waits_before_);

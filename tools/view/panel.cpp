@@ -261,7 +261,7 @@ void Viewer::panel_results() {
     const StageTimes& t = r.times;
     if (ImGui::BeginTable("counts", 2, ImGuiTableFlags_SizingStretchProp)) {
         row("candidates", c.candidates);
-        row("unique candidates", c.unique_candidates);
+        row("to narrow phase", c.narrow_phase_candidates);
         row("colliding pairs", session_.options().method == Method::kdet_no_pairs ? std::string("(tets only)")
                                                                                    : std::to_string(c.colliding_pairs));
         row("colliding tets", c.colliding_tets);
@@ -270,7 +270,7 @@ void Viewer::panel_results() {
         row_ms("boxes", t.bounding_boxes);
         row_ms("populate grid", t.populate_grid);
         row_ms("candidates", t.find_candidates);
-        row_ms("sort + unique", t.sort_unique);
+        row_ms("sort pairs", t.sort_pairs);
         row_ms("narrow phase", t.narrow_phase);
         row_ms("detect() total", t.total);
         if (draw_measured_) {
