@@ -28,9 +28,8 @@ struct Free {
 
 /// Uninitialised memory for `count` objects of `size` bytes aligned to `alignment` (a power of two);
 /// throws std::bad_alloc when it cannot. Plain pages, no huge-page advice: since layer 0's cells hold
-/// dozens of tets the frames take at most 3 % longer without it, where a one-off query's first touch
-/// of fresh memory took up to 1.5 times as long with it in a VM that returns free memory to its host
-/// (docs/performance.md).
+/// dozens of tets the frames gain little from it, where a one-off query's first touch of fresh memory
+/// took far longer with it in a VM that returns free memory to its host (docs/performance.md).
 inline void* allocate(std::size_t count, std::size_t size, std::size_t alignment) {
     if (count > std::numeric_limits<std::size_t>::max() / size) throw std::bad_alloc();
     const std::size_t bytes = count * size;
@@ -279,7 +278,7 @@ public:
     /// @brief Queues a download that the host reads where it lands, and returns its number: after the
     /// next finish_downloads(), landed(number) points at its n elements until the one after. The
     /// backend's memory is the host's, so it lands where it is: a copy of the whole pairs' window
-    /// (tens of MB at 1M tets) cost one thread's time every frame.
+    /// cost one thread's time every frame.
     template <class T>
     std::size_t download_view_later(const T* device, std::size_t /*n: read in place*/) const {
         pending_views_.push_back(device);

@@ -345,8 +345,7 @@ public:
     /// list is shared among many threads, where one thread sorting it took milliseconds, and nothing
     /// waits for the host (CUB's segmented sort reads its segment groups' sizes back to the host once
     /// there are more than a few hundred segments). Each key finds its list through a scan of the
-    /// lists' marks, a thread a key: a thread prefixing a whole list waited on the longest lists
-    /// (0.2 ms on procedural 100k on an H100).
+    /// lists' marks, a thread a key: a thread prefixing a whole list waited on the longest lists.
     void sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t capacity, const std::uint32_t* begin,
                     const std::uint32_t* end, std::size_t lists) const {
         if (capacity == 0) return;
@@ -422,8 +421,7 @@ public:
     }
     /// @brief Queues a download that the host reads where it lands, and returns its number: after the
     /// next finish_downloads(), landed(number) points at its n elements in the pinned buffer until
-    /// the one after or a download(): the host copies nothing out of it (about 1 MB a frame on
-    /// armadillos r4 before).
+    /// the one after or a download(): the host copies nothing out of it.
     template <class T>
     std::size_t download_view_later(const T* device, std::size_t n) const {
         pending_views_.push_back(PendingDownload{nullptr, device, n * sizeof(T)});
