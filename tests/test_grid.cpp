@@ -1,6 +1,7 @@
 // Grid building blocks: hash functions, layer choice, cell ranges and the bucket table.
 
 #include "exec/cpu_exec.hpp"
+#include "exec/tuning.hpp"
 #include "geometry/enclosing_sphere.hpp"
 #include "grid/bucket_table.hpp"
 #include "pipeline/kernels.hpp"
@@ -367,7 +368,7 @@ TEST(GridPlan, PutsEveryTetOnItsSpheresLayerThoughSizingLeavesMostSpheresUncompu
     GridParams params{};
     // No spacing counted: c0 is the smallest size (these tets lie far apart; see the spacing test).
     const std::vector<std::uint32_t> no_spacing(float_octaves, 0u);
-    GridParamsKernel{&min_size, &max_size, no_spacing.data(), &region, &params, CpuExec::grid_cell_spacings}(0);
+    GridParamsKernel{&min_size, &max_size, no_spacing.data(), &region, &params, CpuTuning::grid_cell_spacings}(0);
     EXPECT_EQ(params.cell_size0, dmin);
     unsigned long long entries[max_grid_layers] = {}, cells[max_grid_layers] = {};
     std::uint32_t mask = 0;
@@ -401,8 +402,8 @@ float cell_size0_of_row(float edge, float pitch, std::uint32_t count, float cell
 }
 
 TEST(GridParams, CellsSpanAFewOfTheTetsSpacings) {
-    static_assert(CpuExec::grid_cell_spacings == 4.0f, "the sizes below are four spacings");
-    const float four = CpuExec::grid_cell_spacings;
+    static_assert(CpuTuning::grid_cell_spacings == 4.0f, "the sizes below are four spacings");
+    const float four = CpuTuning::grid_cell_spacings;
     // Tets far apart: c0 is four times their spacing rounded up to a power of two, and every tet
     // shares layer 0.
     EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000, four), 16.0f);
@@ -419,12 +420,14 @@ TEST(GridParams, CellsSpanAFewOfTheTetsSpacings) {
 }
 
 TEST(GridParams, CellsOfOneSpacingAreTheSpacingOrTheSmallestSphere) {
-    // The GPU's cells (CudaExec::grid_cell_spacings) span one spacing: the spacing rounded up to a
+    // The GPU's cells (CudaTuning::grid_cell_spacings) span one spacing: the spacing rounded up to a
     // power of two where the tets lie apart, the smallest sphere where the spacing is below it.
-    EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000, 1.0f), 4.0f);
-    EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000, 1.0f), 0.5f);
+    static_assert(CudaTuning::grid_cell_spacings == 1.0f, "the sizes below are one spacing");
+    const float one = CudaTuning::grid_cell_spacings;
+    EXPECT_EQ(cell_size0_of_row(0.01f, 3.0f, 1000, one), 4.0f);
+    EXPECT_EQ(cell_size0_of_row(0.01f, 0.3f, 1000, one), 0.5f);
     const float regular_sphere = 0.01f * std::sqrt(1.5f);
-    EXPECT_NEAR(cell_size0_of_row(0.01f, 0.004f, 1000, 1.0f), regular_sphere, 1e-4f);
+    EXPECT_NEAR(cell_size0_of_row(0.01f, 0.004f, 1000, one), regular_sphere, 1e-4f);
 }
 
 TEST(GridParams, MedianSpacingIsTheMiddleSamplesBinsUpperEnd) {

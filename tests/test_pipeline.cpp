@@ -2,6 +2,7 @@
 // the tets that appear in brute force's pairs.
 
 #include "exec/cpu_exec.hpp"
+#include "exec/tuning.hpp"
 #include "near_touching.hpp"
 #include "pipeline/pipeline.hpp"
 #include "test_support.hpp"
@@ -249,21 +250,40 @@ TEST(Pipeline, TinyBuffersGrowAndGiveTheSamePairs) {
     EXPECT_EQ(run({a, b}, true, tiny_brute).pairs, reference.pairs);
 }
 
-/// The CPU backend with its work divided as the GPU's is: the candidate search split into parts by
-/// layers and by blocks of each list (SearchPart), a tet per search item (or TetsPerItem), the
-/// grid's plan in small chunks (Exec::plan_chunk), layer 0's cells CellSpacings spacings wide
-/// (Exec::grid_cell_spacings), and the face planes in the search or in the narrow phase
-/// (Exec::face_planes_in_search).
-template <std::uint32_t LayerParts, std::uint32_t BlockParts, std::uint32_t PlanChunk, std::uint32_t TetsPerItem = 1,
-          std::uint32_t CellSpacings = 4, bool FacePlanesInSearch = true>
-struct GpuShapedExec : CpuExec {
+/// The CPU backend with the pipeline's work divided as `Tuning` says (exec/tuning.hpp): with
+/// CudaTuning, as on the GPU.
+template <class Tuning>
+struct TunedCpuExec : CpuExec {
     using CpuExec::CpuExec;
+    using tuning = Tuning;
+};
+
+/// CpuTuning with the candidate search split as the GPU splits it, into LayerParts x BlockParts parts
+/// by layers and by blocks of each list (SearchPart), a tet per search item (or TetsPerItem), and the
+/// grid's plan in chunks of PlanChunk tets.
+template <std::uint32_t LayerParts, std::uint32_t BlockParts, std::uint32_t PlanChunk, std::uint32_t TetsPerItem = 1>
+struct SplitTuning : CpuTuning {
     static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return LayerParts; }
     static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return BlockParts; }
     static constexpr std::uint32_t search_tets_per_item = TetsPerItem;
     static constexpr std::uint32_t plan_chunk = PlanChunk;
-    static constexpr float grid_cell_spacings = static_cast<float>(CellSpacings);
-    static constexpr bool face_planes_in_search = FacePlanesInSearch;
+};
+
+/// CudaTuning with the split of its search that it picks for the other kind of scene (with
+/// self-collision where the scene has none, and the other way round), so that both of its splits
+/// search every scene.
+struct CudaTuningOtherSplit : CudaTuning {
+    static constexpr std::uint32_t search_layer_parts(bool self_collision, std::size_t tets) {
+        return CudaTuning::search_layer_parts(!self_collision, tets);
+    }
+    static constexpr std::uint32_t search_block_parts(bool self_collision, std::size_t tets) {
+        return CudaTuning::search_block_parts(!self_collision, tets);
+    }
+};
+
+/// CpuTuning with the face planes in the narrow phase (as CudaTuning has them).
+struct PlanesAfterSearchTuning : CpuTuning {
+    static constexpr bool face_planes_in_search = false;
 };
 
 /// Frames of `pipeline`, each over the meshes of one element of `frames` (the same tets, other
@@ -313,22 +333,22 @@ TEST(Pipeline, WorkDividedAsOnTheGpuFindsEveryCandidateOnce) {
         for (const auto& [meshes, self] : {std::pair{std::vector<TetMesh>{a, b}, true}, std::pair{folded_and_moved, true},
                                            std::pair{folded_and_moved, false}}) {
             Pipeline<CpuExec> whole(options);
-            Pipeline<GpuShapedExec<3, 1, 1>> by_layers(options);
-            Pipeline<GpuShapedExec<1, 8, 256>> by_blocks(options);
-            // CudaExec's: cells one spacing wide, the face planes in the narrow phase
-            Pipeline<GpuShapedExec<4, 2, 4, 1, 1, false>> like_cuda(options);
-            // CudaExec's for small scenes without self-collision
-            Pipeline<GpuShapedExec<2, 4, 4, 1, 1, false>> like_cuda_without_self(options);
+            Pipeline<TunedCpuExec<SplitTuning<3, 1, 1>>> by_layers(options);
+            Pipeline<TunedCpuExec<SplitTuning<1, 8, 256>>> by_blocks(options);
+            // The GPU's: cells one spacing wide, the face planes in the narrow phase
+            Pipeline<TunedCpuExec<CudaTuning>> like_cuda(options);
+            // The GPU's with the split it picks for the other kind of scene
+            Pipeline<TunedCpuExec<CudaTuningOtherSplit>> like_cuda_other_split(options);
             // Runs of 7 tets, split by layers: runs end inside objects and the last one is short.
-            Pipeline<GpuShapedExec<3, 1, 256, 7>> odd_runs(options);
+            Pipeline<TunedCpuExec<SplitTuning<3, 1, 256, 7>>> odd_runs(options);
             // The face planes in the narrow phase, the CPU's search otherwise.
-            Pipeline<GpuShapedExec<1, 1, 256, 32, 4, false>> planes_after_search(options);
-            const FrameResult expected = run_pipeline(whole, meshes, self); // runs of CpuExec::search_tets_per_item
+            Pipeline<TunedCpuExec<PlanesAfterSearchTuning>> planes_after_search(options);
+            const FrameResult expected = run_pipeline(whole, meshes, self); // runs of CpuTuning::search_tets_per_item
             ASSERT_GT(expected.pairs.size(), 20u);
             // Whether the shape writes the same candidates as the CPU's search, so that its buffer grows
             // as often.
             const std::pair<PipelineBase*, bool> shapes[] = {{&by_layers, true},  {&by_blocks, true},
-                                                             {&like_cuda, false}, {&like_cuda_without_self, false},
+                                                             {&like_cuda, false}, {&like_cuda_other_split, false},
                                                              {&odd_runs, true},   {&planes_after_search, false}};
             for (const auto& [split, same_candidates_written] : shapes) {
                 const FrameResult got = run_pipeline(*split, meshes, self);

@@ -2,6 +2,8 @@
 /// @file cpu_exec.hpp
 /// @brief The CPU execution layer: OpenMP loops over the same per-element functors the CUDA layer launches.
 
+#include "exec/tuning.hpp"
+
 #include <kdet/options.hpp>
 
 #include <algorithm>
@@ -28,9 +30,8 @@ struct Free {
 
 /// Uninitialised memory for `count` objects of `size` bytes aligned to `alignment` (a power of two);
 /// throws std::bad_alloc when it cannot. Plain pages, no huge-page advice: since layer 0's cells hold
-/// dozens of tets the frames take at most 3 % longer without it, where a one-off query's first touch
-/// of fresh memory took up to 1.5 times as long with it in a VM that returns free memory to its host
-/// (docs/performance.md).
+/// dozens of tets the frames gain little from it, where a one-off query's first touch of fresh memory
+/// took far longer with it in a VM that returns free memory to its host (docs/performance.md).
 inline void* allocate(std::size_t count, std::size_t size, std::size_t alignment) {
     if (count > std::numeric_limits<std::size_t>::max() / size) throw std::bad_alloc();
     const std::size_t bytes = count * size;
@@ -120,6 +121,8 @@ public:
     template <class T>
     using buffer = HostBuffer<T>;
     using stage_clock = CpuStageClock;
+    /// How the pipeline divides its work on this backend.
+    using tuning = CpuTuning;
 
     /// @brief options.threads = 0 keeps OpenMP's default; the block size and stream only matter on the GPU.
     explicit CpuExec(const DetectorOptions& options);
@@ -146,42 +149,6 @@ public:
         const auto count = static_cast<std::int64_t>(n);
         for_each_in_chunks(count, std::max<std::int64_t>(256, count / (8 * std::int64_t{threads_})), count > 512, f);
     }
-
-    /// @brief Consecutive keys per work item of a stage that appends what it finds: a batch's worth, so
-    /// that a thread appends them with one atomic (threads contend for the one counter). More would
-    /// leave small stages too few items to share (64 ran a resolution-4 scene's narrow phase on one
-    /// thread: for_each below runs 512 items or fewer serially).
-    static constexpr std::uint32_t keys_per_appending_item = 16;
-
-    /// @brief Work items a tet's candidate search is split into, by layers and by blocks of each list
-    /// (SearchPart), whether a scene has self-collision and however many tets: none, so that a thread
-    /// loads the tet once and its dynamic chunks stay balanced.
-    static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
-    static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
-
-    /// @brief Consecutive tets per work item of the grid's searches (the candidates', kdet_no_pairs'): a
-    /// thread appends their keys and adds their counts with one atomic per run, where an item per tet
-    /// added to counters that both threads passed back and forth (soup 100k: 6-9 % of a frame in the
-    /// VM's slow phase).
-    static constexpr std::uint32_t search_tets_per_item = 32;
-
-    /// @brief The face-plane pre-test runs inside the candidate search, where the searching tet's
-    /// planes and its neighbours' data are in the thread's caches, so that only the pairs it cannot
-    /// decide are written. In the narrow phase instead (the GPU's way), frames took 1-4 % longer on
-    /// the meshes (bunny folded 3.6 %) and 0.8 % less on soup 100k (docs/performance.md).
-    static constexpr bool face_planes_in_search = true;
-
-    /// @brief How many of the tets' spacings layer 0's cells span at least (GridParamsKernel), so that
-    /// a cell holds dozens of tets: a query's visit of a cell costs far more than reading an entry of
-    /// its list (soup 100k: about 120 cycles a visit, 2.3 an entry read), and the block bounds skip most
-    /// of a large cell's entries. With 1 instead of 4, the frames of soup 100k took 37 ms against 28,
-    /// those of the thesis scenes at resolution 4 with self-collision 10-15 % longer
-    /// (docs/performance.md).
-    static constexpr float grid_cell_spacings = 4.0f;
-
-    /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): many, since an item
-    /// adds its counts with a few atomics and bounds the cells by what its previous tet covered.
-    static constexpr std::uint32_t plan_chunk = 256;
 
     /// @brief Runs f(i) for every i below the count in the backend's memory (at most `capacity`),
     /// divided by `per_item` (rounded up) when each item takes that many: a stage whose size an earlier
@@ -279,7 +246,7 @@ public:
     /// @brief Queues a download that the host reads where it lands, and returns its number: after the
     /// next finish_downloads(), landed(number) points at its n elements until the one after. The
     /// backend's memory is the host's, so it lands where it is: a copy of the whole pairs' window
-    /// (tens of MB at 1M tets) cost one thread's time every frame.
+    /// cost one thread's time every frame.
     template <class T>
     std::size_t download_view_later(const T* device, std::size_t /*n: read in place*/) const {
         pending_views_.push_back(device);

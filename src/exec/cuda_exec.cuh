@@ -6,6 +6,7 @@
 /// stream when none is given), so a frame runs in order after the caller's own work on that stream.
 
 #include "exec/radix_sort.hpp"
+#include "exec/tuning.hpp"
 
 #include <kdet/error.hpp>
 #include <kdet/options.hpp>
@@ -218,62 +219,8 @@ public:
     template <class T>
     using buffer = DeviceBuffer<T>;
     using stage_clock = CudaStageClock;
-
-    /// @brief Consecutive keys per work item of a stage that appends what it finds: one, a thread each.
-    static constexpr std::uint32_t keys_per_appending_item = 1;
-
-    /// @brief Work items a tet's candidate search is split into (SearchPart): every fourth of its layers
-    /// and in each list every second block (4 x 2), or, for a scene of at most split_by_blocks_max_tets
-    /// tets without self-collision, every second layer and every fourth block (2 x 4). A thread's search
-    /// is a chain of dependent loads (cells, then blocks of entries) that occupancy cannot hide when a
-    /// scene has few tets: on an H200 the kernel took about as long for 20k tets as for 164k (1-4 ms,
-    /// the longest threads' chains), and on an H100 a warp of the split by layers alone ran 3 of its 32
-    /// lanes on average. The block parts of a tet are neighbouring lanes that walk the same cells in
-    /// step. Of 1 x 8, 2 x 4, 4 x 1, 4 x 2 and 4 x 4 on an H100 (docs/performance.md), 4 x 2 searched
-    /// the resolution-4 scenes with self-collision fastest and the procedural scene from 400k tets on;
-    /// without self-collision 2 x 4 searched the resolution-4 scenes 8-15 % faster, the pass-through
-    /// 17 %, and the procedural scene up to 200k tets a little faster. Both keep 8 items a tet. With the
-    /// face planes out of the search (H200, f656abe), 4 x 4, 2 x 4, 4 x 8, 8 x 2 and 4 x 1 with
-    /// self-collision and 2 x 2 without were each slower somewhere and faster nowhere beyond 3 %.
-    static constexpr std::size_t split_by_blocks_max_tets = 300000;
-    static constexpr bool split_by_blocks(bool self_collision, std::size_t tets) {
-        return !self_collision && tets <= split_by_blocks_max_tets;
-    }
-    static constexpr std::uint32_t search_layer_parts(bool self_collision, std::size_t tets) {
-        return split_by_blocks(self_collision, tets) ? 2 : 4;
-    }
-    static constexpr std::uint32_t search_block_parts(bool self_collision, std::size_t tets) {
-        return split_by_blocks(self_collision, tets) ? 4 : 2;
-    }
-
-    /// @brief Consecutive tets per work item of the grid's searches: one, a thread's search is long
-    /// enough (its appends are gathered per warp).
-    static constexpr std::uint32_t search_tets_per_item = 1;
-
-    /// @brief The face-plane pre-test runs in the narrow phase, a thread a pair, not inside the
-    /// candidate search: there a lane with a match ran it (a few hundred instructions) while the others
-    /// of its warp waited, 4.2 of 32 lanes busy on an H100 (armadillos r4 with self-collision, at
-    /// 73fd55f). The search writes the pairs the slabs leave, more keys for fuller warps: on an H200
-    /// the frames became 17-22 % shorter with self-collision and 10-20 % without (its registers
-    /// 167 -> 96; f656abe against 8ff462c).
-    static constexpr bool face_planes_in_search = false;
-
-    /// @brief How many of the tets' spacings layer 0's cells span at least (GridParamsKernel): one, the
-    /// spacing. A thread scans a tet's lists and a thread gathers each cell's list, so the longer lists
-    /// of larger cells keep a warp's other threads waiting: on an H100, four spacings (the CPU's
-    /// choice) made procedural 100k's frames 2.0 -> 3.0 ms, the resolution-4 scenes without
-    /// self-collision 11-27 % longer and procedural 8M with self-collision take 38 GB instead of 9,
-    /// while two spacings ran as one (bench/results/gpu-h100, 73fd55f). With self-collision, four
-    /// shortened two of the three resolution-4 scenes by 7-9 % (on an H200 at f656abe all three by
-    /// 4-6 %, and procedural 100k's frames a half longer).
-    static constexpr float grid_cell_spacings = 1.0f;
-
-    /// @brief Consecutive tets per work item of the grid's plan (GridPlanKernel): few, since a thread
-    /// walks its tets in series (256 took 0.2-0.33 ms on an H200, a tenth of the frame's kernels; 16
-    /// took 68-71 µs on armadillos r4 in 81 blocks, 6 % of the warp slots busy); the plan's bound on
-    /// the cells loosens a little (each item counts its first tet's cells whole: on the CPU, the GPU's
-    /// shape sized the same table with 4 as with 16 for the r4 scenes, 27 MiB more with 1).
-    static constexpr std::uint32_t plan_chunk = 4;
+    /// How the pipeline divides its work on this backend.
+    using tuning = CudaTuning;
 
     explicit CudaExec(const DetectorOptions& options)
         : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {
@@ -345,8 +292,7 @@ public:
     /// list is shared among many threads, where one thread sorting it took milliseconds, and nothing
     /// waits for the host (CUB's segmented sort reads its segment groups' sizes back to the host once
     /// there are more than a few hundred segments). Each key finds its list through a scan of the
-    /// lists' marks, a thread a key: a thread prefixing a whole list waited on the longest lists
-    /// (0.2 ms on procedural 100k on an H100).
+    /// lists' marks, a thread a key: a thread prefixing a whole list waited on the longest lists.
     void sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t capacity, const std::uint32_t* begin,
                     const std::uint32_t* end, std::size_t lists) const {
         if (capacity == 0) return;
@@ -422,8 +368,7 @@ public:
     }
     /// @brief Queues a download that the host reads where it lands, and returns its number: after the
     /// next finish_downloads(), landed(number) points at its n elements in the pinned buffer until
-    /// the one after or a download(): the host copies nothing out of it (about 1 MB a frame on
-    /// armadillos r4 before).
+    /// the one after or a download(): the host copies nothing out of it.
     template <class T>
     std::size_t download_view_later(const T* device, std::size_t n) const {
         pending_views_.push_back(PendingDownload{nullptr, device, n * sizeof(T)});

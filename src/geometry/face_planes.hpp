@@ -283,10 +283,9 @@ enum class PlaneVerdict { unsure, separated, intersecting };
 /// @brief The face-plane pre-test of tets a and b (with their planes pa and pb): b's planes go first,
 /// and b's vertices are read only when they do not separate the pair (the grid's pairs read them from
 /// beside b's planes, TetPlanes::vertex). In the candidate search's pairs b is the larger tet, whose
-/// faces separate more pairs (the bunny cases: 70-76 % of the pairs, against 45-48 % by a's), and the
-/// smaller a's edges are the likelier to pass through it, so they are tried first (the narrow phase,
-/// where the GPU runs the pre-test, takes a pair's tets in id order). With `separation_only`, an
-/// intersection is not looked for (the caller only rejects).
+/// faces separate more pairs than a's, and the smaller a's edges are the likelier to pass through it,
+/// so they are tried first (the narrow phase, where the GPU runs the pre-test, takes a pair's tets in
+/// id order). With `separation_only`, an intersection is not looked for (the caller only rejects).
 KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
                                                const vec3 b[4], bool separation_only) {
     const float longest = max_f(pa.longest, pb.longest);

@@ -7,9 +7,10 @@
 /// The directions are the four space diagonals (1,1,1), (1,1,-1), (1,-1,1), (-1,1,1) and four of
 /// the six face diagonals, (1,1,0), (1,-1,0), (1,0,1), (1,0,-1): eight lanes, one vector row per bound.
 /// Of the box-overlapping pairs of the peer comparison's cases (bench/cpu_vs_cgal.cpp) they separate
-/// 50-74 % (bunny vs a moved copy: 63 %; the space diagonals alone 51 %, all six face diagonals added
-/// 66 %): most of them pairs that a face plane would also have separated, at a fraction of its cost,
-/// and some that only an edge axis separates, which no longer reach the narrow phase.
+/// most, the space diagonals alone fewer, and the other two face diagonals would add little
+/// (docs/performance.md): most of them pairs that a face plane would also have separated, at a
+/// fraction of its cost, and some that only an edge axis separates, which no longer reach the narrow
+/// phase.
 ///
 /// A rejection is certain, with a margin far beyond every test's tolerance: a projection, a sum of
 /// two or three coordinates with signs, is off by at most 2.0000003 u M (u = 2^-24, M the tet's

@@ -318,7 +318,7 @@ struct TetSizeKernel {
 /// @brief Stage 1, grid methods only, one work item: the grid's geometry from the relevant tets' sizes
 /// and spacings (TetSizeKernel) and the region (ObjectCullingKernel), written where the later kernels
 /// read it. c0 is the smallest size, so the smallest tets sit on layer 0, unless the tets lie closer
-/// together than that: then c0 is `cell_spacings` (Exec::grid_cell_spacings) times their median
+/// together than that: then c0 is `cell_spacings` (Tuning::grid_cell_spacings) times their median
 /// spacing, rounded up to a power of two, and every smaller tet shares layer 0. Cells about the
 /// spacing's size each hold about one tet (a sparse soup of small tets), and every such tet costs
 /// inserts into cells of its own and lookups on each of the many layers above it; in a mesh, whose
@@ -517,8 +517,8 @@ struct ObjectFilter {
 
 /// @brief The share of a tet's candidate search that one work item takes: the layers t's own + layer,
 /// + layer + layers, ..., and in each cell's list the blocks of each group that
-/// group_blocks_of_part(block, blocks) names. The GPU splits a search (Exec::search_layer_parts(),
-/// Exec::search_block_parts()) because a thread's search is a chain of dependent loads that occupancy
+/// group_blocks_of_part(block, blocks) names. The GPU splits a search (Tuning::search_layer_parts(),
+/// Tuning::search_block_parts()) because a thread's search is a chain of dependent loads that occupancy
 /// cannot hide; the CPU searches a tet whole.
 struct SearchPart {
     std::uint32_t layer = 0, layers = 1;
@@ -650,7 +650,7 @@ struct KeyBatch {
 };
 
 /// @brief The runs of consecutive tets that the grid's searches take per work item
-/// (Exec::search_tets_per_item): how many there are for `tets` tets, and the tets [first, end) of run r
+/// (Tuning::search_tets_per_item): how many there are for `tets` tets, and the tets [first, end) of run r
 /// (the last run may be shorter).
 template <std::uint32_t TetsPerItem>
 struct TetRuns {
@@ -677,9 +677,9 @@ struct TetRuns {
 /// can are only counted): a rejected pair is never written, sorted or loaded again. A pair the face
 /// planes prove intersecting is written as a proven_pair_key, so that the narrow phase neither
 /// repeats the pre-test nor runs the test on it. Without FacePlanesInSearch the narrow phase runs the
-/// face planes, a thread a pair (Exec::face_planes_in_search). An item searches a run of TetsPerItem
+/// face planes, a thread a pair (Tuning::face_planes_in_search). An item searches a run of TetsPerItem
 /// consecutive tets (SearchPart's share of each) and appends their keys and adds their rejections
-/// together (Exec::search_tets_per_item: a constant, so that the GPU's item of one tet keeps no loop).
+/// together (Tuning::search_tets_per_item: a constant, so that the GPU's item of one tet keeps no loop).
 /// An item whose keys did not all fit leaves a ResumePoint instead of counting its rejections; a rerun
 /// after growing (`resume_from` set) runs only those items.
 template <std::uint32_t TetsPerItem, bool FacePlanesInSearch>

@@ -31,7 +31,7 @@ struct FrameCounters {
     alignas(64) unsigned long long tests_run;
     alignas(64) unsigned long long rejected; ///< candidate pairs the pre-test (slabs, face planes) proved separated
     /// Of the candidates written, those the face planes proved separated in the narrow phase (where the
-    /// search does not run them: Exec::face_planes_in_search)
+    /// search does not run them: Tuning::face_planes_in_search)
     alignas(64) unsigned long long rejected_after_search;
     alignas(64) unsigned long long colliding_pairs; ///< appended (counts past the window's end)
     alignas(64) std::uint32_t cells_claimed;
@@ -78,6 +78,8 @@ template <class Exec>
 class Pipeline final : public PipelineBase {
     template <class T>
     using buffer = typename Exec::template buffer<T>;
+    /// How the stages divide their work on this backend (exec/tuning.hpp).
+    using Tuning = typename Exec::tuning;
 
 public:
     explicit Pipeline(const DetectorOptions& options)
@@ -310,8 +312,8 @@ void Pipeline<Exec>::grid_geometry() {
     exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size, &c->min_upper_size, &c->max_lower_size,
                                                  c->spacing_octaves});
     exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, c->spacing_octaves, &c->region, &c->params,
-                                       Exec::grid_cell_spacings});
-    constexpr std::uint32_t chunk = Exec::plan_chunk;
+                                       Tuning::grid_cell_spacings});
+    constexpr std::uint32_t chunk = Tuning::plan_chunk;
     exec_.for_each((tets_.size() + chunk - 1) / chunk,
                    GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask}, chunk);
 }
@@ -418,14 +420,14 @@ GridView Pipeline<Exec>::populate() {
 template <class Exec>
 std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
     // Items are numbered in 32 bits (ResumePoint): a scene too large for that searches its tets whole.
-    const std::uint32_t layer_parts_wanted = Exec::search_layer_parts(self_collision_, tets_.size());
-    const std::uint32_t block_parts_wanted = Exec::search_block_parts(self_collision_, tets_.size());
+    const std::uint32_t layer_parts_wanted = Tuning::search_layer_parts(self_collision_, tets_.size());
+    const std::uint32_t block_parts_wanted = Tuning::search_block_parts(self_collision_, tets_.size());
     const bool split = tets_.size() * layer_parts_wanted * block_parts_wanted <= 0xffffffffu;
     const std::uint32_t layer_parts = split ? layer_parts_wanted : 1u;
     const std::uint32_t block_parts = split ? block_parts_wanted : 1u;
     const std::size_t parts = std::size_t{layer_parts} * block_parts;
-    constexpr std::uint32_t tets_per_item = Exec::search_tets_per_item;
-    using Search = FindCandidatesKernel<tets_per_item, Exec::face_planes_in_search>;
+    constexpr std::uint32_t tets_per_item = Tuning::search_tets_per_item;
+    using Search = FindCandidatesKernel<tets_per_item, Tuning::face_planes_in_search>;
     const std::size_t runs = TetRuns<tets_per_item>::count(static_cast<std::uint32_t>(tets_.size()));
     const std::size_t all_items = runs * parts, resume_room = tets_.size();
     for (auto& points : resume_points_) points.resize_discard(resume_room);
@@ -529,7 +531,7 @@ void Pipeline<Exec>::narrow_phase_and_results() {
     resize_filled(out_keys_, pairs_window_, no_pair_key);
     const KeyAppender out{out_keys_.data(), out_keys_.size(), &c->colliding_pairs, nullptr};
     with_narrow_phase(options_.narrow_phase, [&](auto test) {
-        constexpr std::uint32_t per_item = Exec::keys_per_appending_item;
+        constexpr std::uint32_t per_item = Tuning::keys_per_appending_item;
         const auto decide = [&](auto planes_here) {
             exec_.for_each_counted(&c->candidates, candidates_.size(),
                                    NarrowPhaseKernel<decltype(test)::value, per_item, decltype(planes_here)::value>{
@@ -539,7 +541,7 @@ void Pipeline<Exec>::narrow_phase_and_results() {
         };
         // The search's candidates still need their face planes where it did not run them; brute force's
         // pairs need none (and have no planes).
-        if constexpr (!Exec::face_planes_in_search) {
+        if constexpr (!Tuning::face_planes_in_search) {
             if (options_.method == Method::kdet) return decide(std::true_type{});
         }
         decide(std::false_type{});
@@ -601,11 +603,11 @@ void Pipeline<Exec>::enqueue_from(Rerun stage) {
             found = find_candidates(grid_);
         } else if (method == Method::kdet_no_pairs) {
             with_narrow_phase(options_.narrow_phase, [&](auto test) {
-                using Search = NoPairsKernel<decltype(test)::value, Exec::search_tets_per_item>;
-                exec_.for_each(TetRuns<Exec::search_tets_per_item>::count(static_cast<std::uint32_t>(tets_.size())),
+                using Search = NoPairsKernel<decltype(test)::value, Tuning::search_tets_per_item>;
+                exec_.for_each(TetRuns<Tuning::search_tets_per_item>::count(static_cast<std::uint32_t>(tets_.size())),
                                Search{scene_view(), grid_, &c->params, &c->layer_mask, colliding_.data(), &c->tests_run,
                                       &c->exact_stage_pairs},
-                               Exec::search_tets_per_item);
+                               Tuning::search_tets_per_item);
             });
         } else {
             if (candidates_.size() == 0)
