@@ -24,7 +24,7 @@ enum class Method {
 enum class NarrowPhase {
     sat,          ///< separating axis test over the 44 axes, float with a relative tolerance
     sat_no_edges, ///< face normals only: conservative, may report extra pairs
-    sat_mtv,      ///< 44-axis SAT that also returns depth and direction
+    sat_mtv,      ///< decides overlap with the 44-axis SAT as sat does; contacts come from `contacts`
     gjk,          ///< GJK with a signed-volumes distance sub-algorithm
     fast,         ///< Ganovelli-Ponchio-Rocchini face-plane test
     exact,        ///< exact for the float coordinates (filtered: float, then double, then exact sums); default
@@ -87,7 +87,8 @@ struct DetectorOptions {
     /// Initial capacity of the candidate buffer in pairs; 0 sizes it from the tet count.
     /// It grows (and the stage reruns) whenever a frame needs more, so any value is safe.
     std::size_t initial_candidate_capacity = 0;
-    /// Return depth and direction per colliding pair (computed with the 44-axis SAT).
+    /// Return depth and direction per colliding pair, whatever the narrow-phase test: a stage after
+    /// the test computes them with the 44-axis SAT's minimum translation vector.
     bool contacts = false;
     /// CUDA backend: the stream (a cudaStream_t) every kernel, copy and sort of the detector runs on,
     /// so positions that the caller's kernels write on that stream are read after them. Null: the

@@ -85,6 +85,8 @@ KDET_HD inline bool tets_intersect_as(const vec3 a[4], const vec3 b[4], bool& ex
     } else if constexpr (Test == NarrowPhase::sat_no_edges) {
         return tets_intersect_sat_no_edges(a, b);
     } else if constexpr (Test == NarrowPhase::sat_mtv) {
+        // Only the verdict counts here; the contact stage computes depth and direction when
+        // DetectorOptions::contacts is on, for every test alike.
         float depth;
         vec3 direction;
         return tets_intersect_sat_mtv(a, b, depth, direction);

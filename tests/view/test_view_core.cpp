@@ -9,6 +9,7 @@
 #include "surface.hpp"
 #include "view_args.hpp"
 #include "view_test_support.hpp"
+#include "viewer.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/scenes.hpp>
@@ -544,6 +545,28 @@ CsvShape shape_of(const std::filesystem::path& path) {
         }
     }
     return shape;
+}
+
+TEST(ViewSession, ContactsOfAnyTestWhenTheViewerShowsThem) {
+    DisplaySettings normals;
+    normals.contact_normals = true;
+    EXPECT_TRUE(wants_contacts(normals, false));
+    EXPECT_TRUE(wants_contacts(DisplaySettings{}, true)) << "a selected tet lists its partners' depths";
+    EXPECT_FALSE(wants_contacts(DisplaySettings{}, false));
+    for (const NarrowPhase t : {NarrowPhase::sat, NarrowPhase::sat_no_edges, NarrowPhase::sat_mtv, NarrowPhase::gjk,
+                                NarrowPhase::fast, NarrowPhase::exact}) {
+        DetectorOptions options;
+        options.narrow_phase = t;
+        options.contacts = true;
+        ViewSession session(test::nested_boxes(), options, false);
+        session.update();
+        const FrameResult& r = session.result();
+        ASSERT_FALSE(r.pairs.empty()) << to_string(t);
+        EXPECT_EQ(r.contacts.size(), r.pairs.size()) << to_string(t);
+        const std::vector<Partner> partners = partners_of(r, TetRef{r.pairs[0].object_a, r.pairs[0].tet_a});
+        ASSERT_FALSE(partners.empty());
+        for (const Partner& p : partners) EXPECT_TRUE(p.has_contact) << to_string(t);
+    }
 }
 
 TEST(ViewBenchmark, WritesTheFilesOfKdetBench) {

@@ -234,14 +234,11 @@ void Viewer::panel_display() {
         ImGui::Checkbox("flip", &d.clip_flip);
         ImGui::SliderFloat("plane", &d.clip_position, 0.0f, 1.0f, "%.2f");
     }
-    const bool contacts = session_.options().narrow_phase == NarrowPhase::sat_mtv;
-    ImGui::BeginDisabled(!contacts);
-    ImGui::Checkbox(contacts ? "contact normals (N)" : "contact normals (test sat_mtv)", &d.contact_normals);
-    if (d.contact_normals && contacts) {
+    ImGui::Checkbox("contact normals (N)", &d.contact_normals);
+    if (d.contact_normals) {
         ImGui::SliderFloat("normal length", &d.normal_length, 0.1f, 5.0f, "%.1f");
         ImGui::TextDisabled("%zu of %zu pairs", renderer_->contact_lines(), session_.result().pairs.size());
     }
-    ImGui::EndDisabled();
     if (ImGui::Button("reset camera (R)")) {
         config_.camera = CameraRequest{};
         reset_camera(scene_aspect());
@@ -314,8 +311,7 @@ void Viewer::panel_selection() {
     if (session_.options().method == Method::kdet_no_pairs) {
         ImGui::TextDisabled("kdet_no_pairs flags tets and builds no pairs");
     } else if (colliding) {
-        ImGui::TextWrapped("collides with %zu tet(s) (yellow)%s", partners_.size(),
-                    !partners_.empty() && !partners_[0].has_contact ? "; depths with test sat_mtv" : "");
+        ImGui::TextWrapped("collides with %zu tet(s) (yellow)", partners_.size());
         constexpr std::size_t listed = 8;
         for (std::size_t k = 0; k < partners_.size() && k < listed; ++k) {
             const Partner& p = partners_[k];

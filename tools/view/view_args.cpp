@@ -66,7 +66,7 @@ display options (the panel changes them too):
   --wireframe          draw the surface's edges
   --clip AXIS          clipping plane across x, y or z (-x, -y, -z keep the other side)
   --clip-at T          position of the plane across the scene's box, 0-1 (default 0.5)
-  --normals            contact normals as short lines (with --test sat_mtv)
+  --normals            contact normals as short lines (turns the detector's contacts on)
   --camera YAW,PITCH   view direction in degrees (default 35,25)
   --zoom F             camera distance as a multiple of the framing distance (default 1)
   --focus colliding    start framed on the colliding tetrahedra (as the F key)

@@ -16,7 +16,7 @@ struct DisplaySettings {
     float surface_opacity = 0.35f; ///< 1 draws opaque surfaces; below 1 colliding tets show through
     bool only_colliding = false;   ///< hide the surfaces, draw the colliding tets only
     bool wireframe = false;
-    bool contact_normals = false;  ///< drawn when the test gives contacts (sat_mtv)
+    bool contact_normals = false;  ///< turns the detector's contacts on (wants_contacts), any test
     float normal_length = 1.0f;    ///< scale of the contact normals (1: 5% of the scene's radius)
     bool clip = false;
     int clip_axis = 0;             ///< 0 x, 1 y, 2 z

@@ -23,7 +23,7 @@ int run_view(int argc, char** argv) {
     std::string reason;
     if (config.options.backend == Backend::cuda && !cuda_available(&reason))
         throw Error("view: --backend cuda is not available here: " + reason);
-    config.options.contacts = config.options.narrow_phase == NarrowPhase::sat_mtv;
+    config.options.contacts = view::wants_contacts(config.display, false);
     view::ViewSession session(config.source, config.options, config.self);
     if (config.frame >= session.num_frames())
         throw UsageError("invalid value '" + std::to_string(config.frame) + "' for --frame: scene '" +

@@ -44,6 +44,10 @@ double median(std::vector<double> values) {
 
 } // namespace
 
+bool wants_contacts(const DisplaySettings& display, bool tet_selected) {
+    return display.contact_normals || tet_selected;
+}
+
 void Viewer::History::add(float detect, float draw) {
     detect_ms[static_cast<std::size_t>(next)] = detect;
     draw_ms[static_cast<std::size_t>(next)] = draw;
@@ -135,9 +139,18 @@ void Viewer::set_status(const std::string& text) {
 
 void Viewer::apply(const DetectorOptions& options) {
     DetectorOptions o = options;
-    o.contacts = o.narrow_phase == NarrowPhase::sat_mtv;
+    o.contacts = wants_contacts(config_.display, selected_.has_value());
     session_.set_options(o);
     config_.options = o;
+}
+
+void Viewer::sync_contacts() {
+    const bool wanted = wants_contacts(config_.display, selected_.has_value());
+    if (session_.options().contacts != wanted) {
+        DetectorOptions o = session_.options();
+        o.contacts = wanted;
+        apply(o);
+    }
 }
 
 void Viewer::open_source(const ViewSource& source) {
@@ -280,6 +293,7 @@ void Viewer::run() {
             if (playing_) session_.set_frame(next);
         }
         // The benchmark has the processor to itself: the view keeps its last frame meanwhile.
+        if (!bench_job_) sync_contacts();
         const bool computed = !bench_job_ && session_.update();
         renderer_->update(session_);
         if (selection_version_ != session_.result_version()) {
@@ -331,6 +345,7 @@ void Viewer::save_window_screenshot(int width, int height) {
 }
 
 void Viewer::screenshot(const std::string& path, int width, int height, bool with_panel) {
+    sync_contacts();
     session_.update();
     renderer_->update(session_);
     const int scene_x = with_panel ? static_cast<int>(panel_width) : 0;
@@ -358,6 +373,7 @@ void Viewer::screenshot(const std::string& path, int width, int height, bool wit
 void Viewer::profile(int width, int height) {
     OffscreenTarget target(width, height, config_.samples);
     session_.set_frame(0);
+    sync_contacts();
     session_.update();
     renderer_->update(session_);
     reset_camera(static_cast<float>(width) / static_cast<float>(height));

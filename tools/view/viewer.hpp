@@ -19,6 +19,11 @@ struct GLFWwindow;
 
 namespace kdet::view {
 
+/// @brief Whether the detector computes contacts (DetectorOptions::contacts): while the viewer shows
+/// them, as normals or as the selected tet's depths, under any narrow-phase test; off otherwise, since
+/// they cost a 44-axis SAT per colliding pair.
+bool wants_contacts(const DisplaySettings& display, bool tet_selected);
+
 /// @brief One window (visible, or hidden for headless runs) with its OpenGL context and ImGui.
 class Viewer {
 public:
@@ -57,6 +62,9 @@ private:
     void handle_key(int key);
     void handle_input(int scene_height);
     void apply(const DetectorOptions& options);
+    /// @brief Turns the detector's contacts on or off as wants_contacts() says (a new detector when
+    /// that changes).
+    void sync_contacts();
     void open_source(const ViewSource& source);
     void draw_panel(float width, float height);
     void panel_scene();
