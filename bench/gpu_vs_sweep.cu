@@ -246,18 +246,14 @@ CaseResult run_case(const Config& config, const Scene& scene, const std::string&
     options.cuda_stream = stream;
     Detector detector(options);
 
-    // The objects and the pairs checked as `kdet bench` sets them up (self-collision for every object).
+    // The objects and the pairs checked as `kdet bench` sets them up, and the same pairs for the peer.
+    add_scene_objects(detector, scene, self);
     std::vector<std::uint8_t> checked(objects * objects, 0);
     std::vector<std::uint32_t> vertex_begin(objects + 1, 0);
     for (std::size_t o = 0; o < objects; ++o) {
-        detector.set_self_collision(detector.add_object(scene.rest_mesh(o)), self);
         vertex_begin[o + 1] = vertex_begin[o] + static_cast<std::uint32_t>(scene.rest_mesh(o).num_vertices());
         checked[o * objects + o] = self;
-        for (std::size_t p = o + 1; p < objects; ++p) {
-            const bool on = scene.checks_pair(o, p);
-            checked[o * objects + p] = checked[p * objects + o] = on;
-            if (!on) detector.set_pair_collision(static_cast<ObjectId>(o), static_cast<ObjectId>(p), false);
-        }
+        for (std::size_t p = o + 1; p < objects; ++p) checked[o * objects + p] = checked[p * objects + o] = scene.checks_pair(o, p);
     }
     // The peer's tets in kdet's global numbering (first_tet(o) + t), so the pair keys compare directly.
     std::vector<TetIndices> tets;

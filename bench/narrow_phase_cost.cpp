@@ -94,11 +94,7 @@ std::vector<PairPoints> candidate_pairs(const Scene& scene, int frame, bool self
 
 Detector make_detector(const Scene& scene, bool self, DetectorOptions options) {
     Detector detector(options);
-    for (std::size_t o = 0; o < scene.num_objects(); ++o)
-        detector.set_self_collision(detector.add_object(scene.rest_mesh(o)), self);
-    for (std::size_t a = 0; a < scene.num_objects(); ++a)
-        for (std::size_t b = a + 1; b < scene.num_objects(); ++b)
-            if (!scene.checks_pair(a, b)) detector.set_pair_collision(static_cast<ObjectId>(a), static_cast<ObjectId>(b), false);
+    add_scene_objects(detector, scene, self);
     return detector;
 }
 

@@ -87,16 +87,6 @@ int last_frame_of(const BenchConfig& config, const Scene& scene) {
     return config.last_frame < 0 ? scene.num_frames() - 1 : config.last_frame;
 }
 
-void add_scene_objects(Detector& detector, const Scene& scene, bool self) {
-    for (std::size_t o = 0; o < scene.num_objects(); ++o)
-        detector.set_self_collision(detector.add_object(scene.rest_mesh(o)), self);
-    // Self-collisions follow -s, as in the thesis; which object pairs collide is the scene's choice.
-    for (std::size_t a = 0; a < scene.num_objects(); ++a)
-        for (std::size_t b = a + 1; b < scene.num_objects(); ++b)
-            if (!scene.checks_pair(a, b))
-                detector.set_pair_collision(static_cast<ObjectId>(a), static_cast<ObjectId>(b), false);
-}
-
 BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, const BenchProgress& progress) {
     Detector detector(config.options);
     add_scene_objects(detector, scene, config.self);

@@ -28,10 +28,6 @@ struct BenchOutcome {
 /// next; returning false stops the benchmark there.
 using BenchProgress = std::function<bool(int run, int frame_index)>;
 
-/// @brief Adds every object of @p scene to @p detector (ids in scene order), with self-collision of
-/// each object as @p self says and the object pairs the scene checks.
-void add_scene_objects(Detector& detector, const Scene& scene, bool self);
-
 /// @brief The last frame `config` selects in `scene` (its --frames B, else the scene's last frame).
 int last_frame_of(const BenchConfig& config, const Scene& scene);
 

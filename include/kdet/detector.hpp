@@ -17,6 +17,19 @@ namespace kdet {
 
 using ObjectId = std::uint32_t;
 
+/// @brief Vertex positions as they lie in the caller's memory: coordinate k (0: x, 1: y, 2: z) of
+/// vertex v is element `v * row_stride + k * column_stride` of `data`, float32 or float64 (strides
+/// in elements, not bytes; any sign, zero included, as NumPy's strides divided by the item size).
+/// The defaults describe x y z per vertex, contiguous: a C-ordered (n, 3) array. A Fortran-ordered
+/// one has row_stride 1 and column_stride n; every other row of a C-ordered one, row_stride 6.
+struct PositionsView {
+    const void* data = nullptr;
+    bool is_double = false; ///< float64 elements, else float32
+    std::size_t vertex_count = 0;
+    std::ptrdiff_t row_stride = 3;
+    std::ptrdiff_t column_stride = 1;
+};
+
 /// @brief Keeps objects and buffers between frames. Typical use:
 /// add objects once, then each frame set_positions() for the objects that moved and detect().
 ///
@@ -42,20 +55,32 @@ public:
     ObjectId add_object(const double* positions, std::size_t vertex_count, const std::uint32_t* tets,
                         std::size_t tet_count);
     ObjectId add_object(const TetMesh& mesh);
+    /// @brief add_object() from host positions in any layout (PositionsView).
+    ObjectId add_object(const PositionsView& positions, const std::uint32_t* tets, std::size_t tet_count);
 
     /// @brief Replaces an object's vertex positions (x y z per vertex, same count as when added).
+    /// Throws kdet::Error on a wrong vertex count or a non-finite coordinate (or one beyond float
+    /// range), and then keeps the object's previous positions.
     void set_positions(ObjectId object, const float* positions, std::size_t vertex_count);
     void set_positions(ObjectId object, const double* positions, std::size_t vertex_count);
+    /// @brief set_positions() from host memory in any layout (PositionsView), read where it lies:
+    /// a strided or float64 array needs no contiguous copy first. Also throws kdet::Error on null
+    /// data or strides whose extent overflows.
+    void set_positions(ObjectId object, const PositionsView& positions);
 
     /// @brief Replaces an object's positions from memory of the detector's backend (a CUDA device
     /// pointer for Backend::cuda, a host pointer for Backend::cpu), e.g. a simulation's own buffer;
-    /// nothing passes through the host and nothing waits. x y z float per vertex. The positions are
-    /// copied now (on Backend::cuda in the order of DetectorOptions::cuda_stream, after the kernels
-    /// enqueued on it so far) and checked by the next detection, on the backend: if one is not
-    /// finite, that detection uses none of the positions given this way, keeps the objects' previous
-    /// ones, and its detect() or finish() throws kdet::Error naming the object and vertex. Throws at
-    /// once on a wrong vertex count.
+    /// nothing passes through the host and nothing waits. The positions are copied now (on
+    /// Backend::cuda in the order of DetectorOptions::cuda_stream, after the kernels enqueued on it
+    /// so far) and checked by the next detection, on the backend: if one is not finite, that
+    /// detection uses none of the positions given this way, keeps the objects' previous ones, and its
+    /// detect() or finish() throws kdet::Error naming the object and vertex. Throws at once on a wrong
+    /// vertex count, null data, strides whose extent overflows, or (Backend::cuda) memory of another
+    /// CUDA device than the detector's.
+    /// The first form takes x y z float per vertex; the second any layout, float32 or float64 (a
+    /// strided or float64 array is gathered into float32 by the backend, on the same stream).
     void set_positions_on_device(ObjectId object, const float* positions, std::size_t vertex_count);
+    void set_positions_on_device(ObjectId object, const PositionsView& positions);
 
     /// @brief Switches self-collision of one object (off by default).
     void set_self_collision(ObjectId object, bool enabled);

@@ -95,7 +95,6 @@ Coordinates coordinates(nb::handle object, const char* name) {
                               " are not supported (host or CUDA memory only)")
                                  .c_str());
     }
-    if (c.on_device) c.device_id = c.array.device_id();
     c.data = c.array.data();
     c.rows = shape[0];
     c.row_stride = c.array.stride(0);
@@ -104,19 +103,24 @@ Coordinates coordinates(nb::handle object, const char* name) {
     return c;
 }
 
+namespace {
+
 template <class Scalar>
-const Scalar* contiguous_host(const Coordinates& c, std::vector<Scalar>& storage) {
+void copy_rows(const Coordinates& c, double* out) {
     const auto* source = static_cast<const Scalar*>(c.data);
-    if (c.contiguous()) return source;
-    storage.resize(3 * c.rows);
     for (std::size_t v = 0; v < c.rows; ++v)
         for (std::size_t k = 0; k < 3; ++k)
-            storage[3 * v + k] = source[static_cast<std::int64_t>(v) * c.row_stride +
-                                        static_cast<std::int64_t>(k) * c.column_stride];
-    return storage.data();
+            out[3 * v + k] = source[static_cast<std::int64_t>(v) * c.row_stride + static_cast<std::int64_t>(k) * c.column_stride];
 }
-template const float* contiguous_host(const Coordinates&, std::vector<float>&);
-template const double* contiguous_host(const Coordinates&, std::vector<double>&);
+
+} // namespace
+
+void copy_xyz(const Coordinates& c, double* out) {
+    if (c.is_double)
+        copy_rows<double>(c, out);
+    else
+        copy_rows<float>(c, out);
+}
 
 namespace {
 

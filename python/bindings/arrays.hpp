@@ -5,6 +5,8 @@
 /// They are read where they lie, in their own dtype and strides; every wrong type names the argument
 /// in a TypeError and every wrong shape or value in a kdet.Error.
 
+#include <kdet/detector.hpp>
+
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/string.h>
@@ -29,21 +31,19 @@ struct Coordinates {
     std::int64_t column_stride = 1; ///< in elements
     bool is_double = false;
     bool on_device = false; ///< CUDA device (or managed) memory
-    int device_id = -1;     ///< the CUDA device when DLPack names it; -1 when not known
     /// A CUDA stream that the producer's writes are ordered on (__cuda_array_interface__'s "stream";
     /// 0 when none is given): kdet waits for it before reading.
     std::uintptr_t stream = 0;
 
-    bool contiguous() const { return rows <= 1 || (row_stride == 3 && column_stride == 1); }
+    /// @brief The layout as the Detector reads it, where it lies.
+    PositionsView view() const { return PositionsView{data, is_double, rows, row_stride, column_stride}; }
 };
 
 /// @brief Reads @p object (the argument @p name) as coordinates, without copying.
 Coordinates coordinates(nb::handle object, const char* name);
 
-/// @brief Host coordinates as x y z per vertex, contiguous, in their own type: the caller's memory
-/// when it is already laid out so, else a copy in @p storage.
-template <class Scalar>
-const Scalar* contiguous_host(const Coordinates& c, std::vector<Scalar>& storage);
+/// @brief Copies host coordinates into x y z per vertex, float64 (a TetMesh's vertices).
+void copy_xyz(const Coordinates& c, double* out);
 
 /// @brief (m, 4) vertex indices of any integer dtype, as uint32 (host memory only).
 struct TetIndices {

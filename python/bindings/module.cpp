@@ -3,7 +3,7 @@
 #include "arrays.hpp"
 #include "fields.hpp"
 #ifdef KDET_HAS_CUDA
-#include "device_arrays.hpp"
+#include <cuda_runtime.h>
 #endif
 
 #include <kdet/kdet.hpp>
@@ -128,15 +128,7 @@ TetMesh mesh_from_arrays(nb::handle vertices, nb::handle tets, bool allow_degene
     const TetIndices t = tet_indices(tets, tets_name);
     TetMesh mesh;
     mesh.positions.resize(3 * c.rows);
-    if (c.is_double) {
-        std::vector<double> storage;
-        const double* xyz = contiguous_host(c, storage);
-        std::copy(xyz, xyz + 3 * c.rows, mesh.positions.begin());
-    } else {
-        std::vector<float> storage;
-        const float* xyz = contiguous_host(c, storage);
-        std::copy(xyz, xyz + 3 * c.rows, mesh.positions.begin());
-    }
+    copy_xyz(c, mesh.positions.data());
     mesh.tets.assign(t.data, t.data + 4 * t.rows);
     validate_tet_mesh(mesh, source, ReadOptions{allow_degenerate});
     return mesh;
@@ -222,9 +214,6 @@ struct PyDetector {
     explicit PyDetector(const DetectorOptions& options) : detector(options) {}
     Detector detector;
     std::mutex mutex;
-#ifdef KDET_HAS_CUDA
-    DeviceScratch scratch;
-#endif
 };
 
 ObjectId object_id(PyDetector& self, std::int64_t object) {
@@ -239,32 +228,30 @@ ObjectId add_object(PyDetector& self, nb::handle vertices, nb::handle tets) {
     if (c.on_device)
         throw nb::type_error("vertices: add_object reads the rest shape on the host; give set_positions the device array");
     const TetIndices t = tet_indices(tets, "tets");
-    std::vector<double> doubles;
-    std::vector<float> floats;
     nb::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(self.mutex);
-    if (c.is_double) return self.detector.add_object(contiguous_host(c, doubles), c.rows, t.data, t.rows);
-    return self.detector.add_object(contiguous_host(c, floats), c.rows, t.data, t.rows);
+    return self.detector.add_object(c.view(), t.data, t.rows);
 }
 
+#ifdef KDET_HAS_CUDA
+void check_cuda(cudaError_t status, const char* what) {
+    if (status != cudaSuccess) throw Error(std::string("CUDA error in ") + what + ": " + cudaGetErrorString(status));
+}
+#endif
+
+/// GPU positions, read where they lie: the library gathers any layout on the detector's stream and
+/// checks the array's device.
 void set_device_positions(PyDetector& self, ObjectId id, const Coordinates& c) {
 #ifdef KDET_HAS_CUDA
     if (self.detector.options().backend != Backend::cuda)
         throw Error("positions: a CUDA array needs a detector with backend='cuda'; this one runs on the " +
                     std::string(to_string(self.detector.options().backend)));
-    const int device = current_cuda_device();
-    const int holder = c.device_id >= 0 ? c.device_id : cuda_device_of(c.data);
-    if (holder >= 0 && holder != device)
-        throw Error("positions: the array lives on CUDA device " + std::to_string(holder) +
-                    ", the detector runs on device " + std::to_string(device));
     nb::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(self.mutex);
-    if (c.stream) synchronize_cuda_stream(c.stream);
-    const float* xyz = c.contiguous() && !c.is_double
-                           ? static_cast<const float*>(c.data)
-                           : self.scratch.gather(c.data, c.is_double, c.rows, c.row_stride, c.column_stride,
-                                                 self.detector.options().cuda_stream);
-    self.detector.set_positions_on_device(id, xyz, c.rows);
+    // __cuda_array_interface__'s producer stream (1 and 2 are CUDA's legacy and per-thread default
+    // streams): its writes must be done before the detector's stream reads the array.
+    if (c.stream) check_cuda(cudaStreamSynchronize(reinterpret_cast<cudaStream_t>(c.stream)), "cudaStreamSynchronize");
+    self.detector.set_positions_on_device(id, c.view());
 #else
     (void)self;
     (void)id;
@@ -277,14 +264,9 @@ void set_positions(PyDetector& self, std::int64_t object, nb::handle positions) 
     const ObjectId id = object_id(self, object);
     const Coordinates c = coordinates(positions, "positions");
     if (c.on_device) return set_device_positions(self, id, c);
-    std::vector<double> doubles;
-    std::vector<float> floats;
     nb::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(self.mutex);
-    if (c.is_double)
-        self.detector.set_positions(id, contiguous_host(c, doubles), c.rows);
-    else
-        self.detector.set_positions(id, contiguous_host(c, floats), c.rows);
+    self.detector.set_positions(id, c.view());
 }
 
 /// What detect() and finish() return: the frame that `complete` (Detector::detect or Detector::finish)
@@ -318,7 +300,7 @@ nb::object completed_frame(nb::handle handle, bool device_results, const FrameRe
 #ifdef KDET_HAS_CUDA
     if (options.backend == Backend::cuda) {
         device_type = nb::device::cuda::value;
-        device_id = current_cuda_device();
+        check_cuda(cudaGetDevice(&device_id), "cudaGetDevice"); // the detector's device
     }
 #endif
     device_frame->pair_keys = device_view(buffers.pair_keys, {buffers.pair_count}, handle, device_type, device_id);

@@ -91,7 +91,8 @@ def gpu_detector(bunny: kdet.TetMesh, **options) -> tuple[kdet.Detector, int]:
     return detector, detector.add_object(bunny)
 
 
-@pytest.mark.parametrize("layout", ["float32", "float64", "float32 column slice", "float64 every other row"])
+@pytest.mark.parametrize("layout", ["float32", "float64", "float32 column slice", "float64 every other row",
+                                    "float64 fortran", "float32 rows reversed"])
 def test_gpu_positions_give_the_cpu_pairs(scene, layout):
     bunny, other, expected = scene
     v = other.vertices
@@ -102,6 +103,9 @@ def test_gpu_positions_give_the_cpu_pairs(scene, layout):
         "float64": v,
         "float32 column slice": wide.astype(np.float32)[:, 1:4],
         "float64 every other row": np.repeat(v, 2, axis=0)[::2],
+        # Views of a C-contiguous array, which CudaArray copies whole.
+        "float64 fortran": np.ascontiguousarray(v.T).T,
+        "float32 rows reversed": np.ascontiguousarray(v[::-1], dtype=np.float32)[::-1],
     }[layout]
     detector, moving = gpu_detector(bunny)
     device_positions = CudaArray(host)
@@ -117,7 +121,7 @@ def test_the_detector_runs_on_the_callers_stream(scene):
     try:
         detector, moving = gpu_detector(bunny, cuda_stream=stream.value)
         assert detector.options["cuda_stream"] == stream.value
-        # float64 with strides: the binding's gather kernel runs too, and must run on that stream.
+        # float64 with strides: the library's gather kernel runs too, and must run on that stream.
         for frame in range(3):
             detector.set_positions(moving, CudaArray(np.repeat(other.vertices, 2, axis=0)[::2]))
             np.testing.assert_array_equal(detector.detect().pairs[:, [1, 3]], expected, err_msg=f"frame {frame}")

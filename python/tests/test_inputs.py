@@ -88,6 +88,20 @@ def test_detector_arguments_are_checked(octopus):
         positions = octopus.vertices.copy()
         positions[3, 0] = np.nan
         detector.add_object(positions, octopus.tets)
+    # Strided and Fortran-ordered arrays are read where they lie: the bad vertex is still the one named.
+    with pytest.raises(kdet.Error, match="object 0: vertex 9 has a non-finite coordinate"):
+        positions = np.asfortranarray(octopus.vertices)
+        positions[9, 1] = 1e300  # beyond float32 range
+        detector.set_positions(ia, positions)
+    with pytest.raises(kdet.Error, match="object 0: vertex 11 has a non-finite coordinate"):
+        positions = np.repeat(octopus.vertices.astype(np.float32), 2, axis=0)
+        positions[23, 0] = np.inf  # row 23 is not read; row 22 is vertex 11
+        positions[22, 2] = np.inf
+        detector.set_positions(ia, positions[::2])
+    with pytest.raises(kdet.Error, match="object 1: vertex 450 has a non-finite coordinate"):
+        positions = octopus.vertices.copy()
+        positions[1, 2] = np.nan
+        detector.add_object(positions[::-1], octopus.tets)
     with pytest.raises(kdet.Error, match=r"object 1: tet 0 has vertex index 452 out of range \[0, 452\)"):
         tets = octopus.tets.copy()
         tets[0, 0] = 452

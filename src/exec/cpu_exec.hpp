@@ -270,6 +270,8 @@ public:
     void copy(T* destination, const T* source, std::size_t n) const {
         if (n) std::memmove(destination, source, n * sizeof(T));
     }
+    /// @brief Memory handed in as the backend's: any host address is (see CudaExec's).
+    void check_readable(const void* /*data*/, const char* /*what*/) const {}
     /// @brief Times the host has waited for the backend so far: once per download and per
     /// finish_downloads().
     std::uint64_t host_waits() const { return host_waits_; }

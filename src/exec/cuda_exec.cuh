@@ -416,6 +416,21 @@ public:
             cuda_check(cudaMemcpyAsync(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice, stream_),
                        "device copy");
     }
+    /// @brief Throws kdet::Error when `data`, handed in as device memory, belongs to another CUDA
+    /// device than the current one, whose kernels would fault on it; `what` names it in the message.
+    void check_readable(const void* data, const char* what) const {
+        cudaPointerAttributes attributes{};
+        if (cudaPointerGetAttributes(&attributes, data) != cudaSuccess) {
+            cudaGetLastError(); // not memory CUDA knows: clear the error, the copy reports its own
+            return;
+        }
+        if (attributes.type != cudaMemoryTypeDevice && attributes.type != cudaMemoryTypeManaged) return;
+        int device = 0;
+        cuda_check(cudaGetDevice(&device), "cudaGetDevice");
+        if (attributes.device != device)
+            throw Error(std::string(what) + " lie in the memory of CUDA device " + std::to_string(attributes.device) +
+                        ", the detector runs on device " + std::to_string(device));
+    }
     /// @brief Times the host has waited for the device so far: once per download and per
     /// finish_downloads().
     std::uint64_t host_waits() const { return host_waits_; }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -42,7 +43,7 @@ struct Detector::Impl {
                 // Staged in the caller's order; the host copy keeps the pipeline's.
                 std::vector<vec3> staged(count);
                 pipeline->get_positions(first, staged.data(), count, true);
-                const std::uint32_t bad = first_non_finite(staged.data(), count);
+                const std::uint32_t bad = first_non_finite(xyz_view(staged.data(), count));
                 if (bad != no_vertex) {
                     rejected = non_finite_message(o, bad);
                     pipeline->get_positions(first, held, count, false);
@@ -72,19 +73,18 @@ struct Detector::Impl {
         return static_cast<std::size_t>(first);
     }
 
-    /// The first of `count` vertices (x y z each, float or double) with a coordinate that is not
-    /// finite as the float32 the pipeline stores, or no_vertex. Out-of-range doubles become infinite
-    /// floats, so this also catches values beyond float range.
-    template <class Scalar>
-    std::uint32_t first_non_finite(const Scalar* xyz, std::size_t count) const {
-        const std::size_t first = first_where(count, [xyz](std::ptrdiff_t v) {
-            const vec3 p = to_float(xyz + 3 * v);
-            return !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z);
+    /// The first vertex of `xyz` with a coordinate that is not finite as the float32 the pipeline
+    /// stores, or no_vertex. Out-of-range doubles become infinite floats, so this also catches values
+    /// beyond float range.
+    std::uint32_t first_non_finite(const PositionsView& xyz) const {
+        const std::size_t count = xyz.vertex_count;
+        const std::size_t first = with_positions(xyz, [&](const auto& source) {
+            return first_where(count, [&source](std::ptrdiff_t v) {
+                const vec3 p = source(static_cast<std::uint64_t>(v));
+                return !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z);
+            });
         });
         return first < count ? static_cast<std::uint32_t>(first) : no_vertex;
-    }
-    std::uint32_t first_non_finite(const vec3* p, std::size_t count) const {
-        return first_non_finite(reinterpret_cast<const float*>(p), count);
     }
 
     /// The threads of the host's work on positions: the detector's, as its CPU backend uses.
@@ -103,32 +103,50 @@ struct Detector::Impl {
     }
 
     /// Rejects coordinates that are not finite as the float32 the pipeline stores.
-    template <class Scalar>
-    void check_finite(std::size_t object, const Scalar* xyz, std::size_t vertex_count) const {
-        const std::uint32_t bad = first_non_finite(xyz, vertex_count);
+    void check_finite(std::size_t object, const PositionsView& xyz) const {
+        const std::uint32_t bad = first_non_finite(xyz);
         if (bad != no_vertex)
             throw Error("object " + std::to_string(object) + ": vertex " + std::to_string(bad) +
                         " has a non-finite coordinate (or one beyond float range)");
     }
 
-    template <class Scalar>
-    void store_positions(ObjectId object, const Scalar* xyz, std::size_t vertex_count) {
+    /// Rejects a view that cannot hold `expected` vertices of `object`: another count, no data, or
+    /// strides reaching further than an address can (the reads' offsets would overflow).
+    static void check_view(std::size_t object, const PositionsView& xyz, std::size_t expected) {
+        const std::string name = "object " + std::to_string(object) + ": ";
+        if (xyz.vertex_count != expected)
+            throw Error(name + "got " + std::to_string(xyz.vertex_count) + " vertices, expected " + std::to_string(expected));
+        if (xyz.vertex_count == 0) return;
+        if (!xyz.data) throw Error(name + "the positions' data pointer is null");
+        const auto magnitude = [](std::ptrdiff_t stride) {
+            return stride < 0 ? 0 - static_cast<std::uint64_t>(stride) : static_cast<std::uint64_t>(stride);
+        };
+        const std::uint64_t item = xyz.is_double ? sizeof(double) : sizeof(float);
+        std::uint64_t rows = 0, columns = 0, extent = 0;
+        const bool overflows = __builtin_mul_overflow(std::uint64_t{xyz.vertex_count - 1}, magnitude(xyz.row_stride), &rows) ||
+                               __builtin_mul_overflow(std::uint64_t{2}, magnitude(xyz.column_stride), &columns) ||
+                               __builtin_add_overflow(rows, columns, &extent) || __builtin_mul_overflow(extent, item, &extent) ||
+                               extent > static_cast<std::uint64_t>(PTRDIFF_MAX);
+        if (overflows)
+            throw Error(name + "the positions' strides (" + std::to_string(xyz.row_stride) + ", " +
+                        std::to_string(xyz.column_stride) + " elements) reach beyond any address for " +
+                        std::to_string(xyz.vertex_count) + " vertices");
+    }
+
+    void store_positions(ObjectId object, const PositionsView& xyz) {
         const std::uint32_t first = object_vertex_begin[object];
-        const std::size_t expected = object_vertex_begin[object + 1] - first;
-        if (vertex_count != expected)
-            throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
-                        " vertices, expected " + std::to_string(expected));
+        check_view(object, xyz, object_vertex_begin[object + 1] - first);
         // Checked first, converted into place second: a simulation sets positions every frame, and a
         // converted copy allocated each time cost a fresh (page-faulted) buffer per frame.
-        check_finite(object, xyz, vertex_count);
-        topology.to_stored_order(first, static_cast<std::uint32_t>(vertex_count), xyz, positions.data() + first, host_threads());
+        check_finite(object, xyz);
+        topology.to_stored_order(first, xyz, positions.data() + first, host_threads());
         positions_dirty[object] = 1;
         positions_on_device[object] = positions_staged[object] = 0;
     }
 
     /// Adds an object; on a bad index or coordinate it throws and leaves the detector as it was.
-    template <class Scalar>
-    ObjectId add(const Scalar* xyz, std::size_t vertex_count, const std::uint32_t* tets, std::size_t tet_count) {
+    ObjectId add(const PositionsView& xyz, const std::uint32_t* tets, std::size_t tet_count) {
+        const std::size_t vertex_count = xyz.vertex_count;
         const std::uint64_t total_tets = topology.tets.size() + tet_count;
         const std::uint64_t total_vertices = std::uint64_t{object_vertex_begin.back()} + vertex_count;
         if (total_tets > grid_id_mask)
@@ -136,6 +154,7 @@ struct Detector::Impl {
                         std::to_string(grid_id_mask));
         if (total_vertices >= 0xffffffffull) throw Error("too many vertices for 32-bit ids");
         const ObjectId id = static_cast<ObjectId>(objects());
+        check_view(id, xyz, vertex_count);
         const std::size_t bad_index = first_where(4 * tet_count, [&](std::ptrdiff_t i) { return tets[i] >= vertex_count; });
         if (bad_index < 4 * tet_count)
             throw Error("object " + std::to_string(id) + ": tet " + std::to_string(bad_index / 4) + " has vertex index " +
@@ -144,9 +163,11 @@ struct Detector::Impl {
         // once), then checked as the float32 the pipeline stores, as check_finite checks.
         const std::unique_ptr<vec3[]> converted(new vec3[vertex_count]);
         const auto vertices = static_cast<std::ptrdiff_t>(vertex_count);
+        with_positions(xyz, [&](const auto& source) {
 #pragma omp parallel for num_threads(host_threads()) schedule(static) if (vertices > host_parallel_elements)
-        for (std::ptrdiff_t v = 0; v < vertices; ++v) converted[v] = to_float(xyz + 3 * v);
-        check_finite(id, reinterpret_cast<const float*>(converted.get()), vertex_count);
+            for (std::ptrdiff_t v = 0; v < vertices; ++v) converted[v] = source(static_cast<std::uint64_t>(v));
+        });
+        check_finite(id, xyz_view(converted.get(), vertex_count));
 
         // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
@@ -189,35 +210,40 @@ Detector& Detector::operator=(Detector&&) noexcept = default;
 
 ObjectId Detector::add_object(const float* positions, std::size_t vertex_count, const std::uint32_t* tets,
                               std::size_t tet_count) {
-    return impl_->add(positions, vertex_count, tets, tet_count);
+    return impl_->add(xyz_view(positions, vertex_count), tets, tet_count);
 }
 ObjectId Detector::add_object(const double* positions, std::size_t vertex_count, const std::uint32_t* tets,
                               std::size_t tet_count) {
-    return impl_->add(positions, vertex_count, tets, tet_count);
+    return impl_->add(xyz_view(positions, vertex_count), tets, tet_count);
 }
 ObjectId Detector::add_object(const TetMesh& mesh) {
-    return impl_->add(mesh.positions.data(), mesh.num_vertices(), mesh.tets.data(), mesh.num_tets());
+    return impl_->add(xyz_view(mesh.positions.data(), mesh.num_vertices()), mesh.tets.data(), mesh.num_tets());
+}
+ObjectId Detector::add_object(const PositionsView& positions, const std::uint32_t* tets, std::size_t tet_count) {
+    return impl_->add(positions, tets, tet_count);
 }
 
 void Detector::set_positions(ObjectId object, const float* positions, std::size_t vertex_count) {
-    impl_->check_object(object);
-    impl_->store_positions(object, positions, vertex_count);
+    set_positions(object, xyz_view(positions, vertex_count));
 }
 void Detector::set_positions(ObjectId object, const double* positions, std::size_t vertex_count) {
+    set_positions(object, xyz_view(positions, vertex_count));
+}
+void Detector::set_positions(ObjectId object, const PositionsView& positions) {
     impl_->check_object(object);
-    impl_->store_positions(object, positions, vertex_count);
+    impl_->store_positions(object, positions);
 }
 
 void Detector::set_positions_on_device(ObjectId object, const float* positions, std::size_t vertex_count) {
+    set_positions_on_device(object, xyz_view(positions, vertex_count));
+}
+void Detector::set_positions_on_device(ObjectId object, const PositionsView& positions) {
     Impl& d = *impl_;
     d.check_object(object);
     const std::uint32_t first = d.object_vertex_begin[object];
-    const std::size_t expected = d.object_vertex_begin[object + 1] - first;
-    if (vertex_count != expected)
-        throw Error("object " + std::to_string(object) + ": got " + std::to_string(vertex_count) +
-                    " vertices, expected " + std::to_string(expected));
+    Impl::check_view(object, positions, d.object_vertex_begin[object + 1] - first);
     if (d.topology_changed) d.rebuild_pipeline();
-    d.pipeline->stage_positions(first, reinterpret_cast<const vec3*>(positions), static_cast<std::uint32_t>(vertex_count));
+    d.pipeline->stage_positions(first, positions);
     d.positions_dirty[object] = 0;
     d.positions_on_device[object] = d.positions_staged[object] = 1;
 }

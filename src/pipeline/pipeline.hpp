@@ -126,10 +126,18 @@ public:
         colliding_count_ = 0;
     }
 
-    void stage_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) override {
+    void stage_positions(std::uint32_t first, const PositionsView& positions) override {
+        exec_.check_readable(positions.data, "set_positions_on_device: the positions");
         // Allocated on first use: only simulations that hand positions over on the device need it.
         if (staged_positions_.size() != positions_.size()) staged_positions_.resize_discard(positions_.size());
-        exec_.copy(staged_positions_.data() + first, positions, count);
+        vec3* staged = staged_positions_.data() + first;
+        if (is_xyz_float(positions)) {
+            exec_.copy(staged, static_cast<const vec3*>(positions.data), positions.vertex_count);
+            return;
+        }
+        with_positions(positions, [&](const auto& source) {
+            exec_.for_each(positions.vertex_count, GatherPositionsKernel<std::decay_t<decltype(source)>>{source, staged});
+        });
     }
 
     void get_positions(std::uint32_t first, vec3* positions, std::uint32_t count, bool staged) override {

@@ -2,8 +2,10 @@
 /// @file pipeline_base.hpp
 /// @brief The interface a Detector drives; one implementation per backend, both from pipeline.hpp.
 
+#include "pipeline/gather_positions.hpp"
 #include "pipeline/kernels.hpp"
 
+#include <kdet/detector.hpp>
 #include <kdet/options.hpp>
 #include <kdet/results.hpp>
 
@@ -11,12 +13,6 @@
 #include <vector>
 
 namespace kdet {
-
-/// @brief The float32 point of the coordinates x y z at `xyz` (float or double).
-template <class Scalar>
-inline vec3 to_float(const Scalar* xyz) {
-    return vec3{static_cast<float>(xyz[0]), static_cast<float>(xyz[1]), static_cast<float>(xyz[2])};
-}
 
 /// @brief Elements (tets, vertices, pairs) up to which the host's own loops over them run on one
 /// thread: sharing fewer costs more than it saves.
@@ -48,15 +44,13 @@ struct SceneTopology {
     void add_object(const vec3* positions, std::uint32_t vertex_count, const std::uint32_t* tets, std::size_t tet_count,
                     int threads = 1);
 
-    /// @brief `count` positions of the vertices from global id `first` on (one object's or a range of
-    /// them), given in the caller's order as x y z each (`xyz`, float or double), written in the order
-    /// the pipeline stores them as float32 (`stored`, also indexed from `first`), on `threads` threads
-    /// when there are many: a simulation hands over every object's positions each frame.
-    void to_stored_order(std::uint32_t first, std::uint32_t count, const double* xyz, vec3* stored, int threads = 1) const;
-    void to_stored_order(std::uint32_t first, std::uint32_t count, const float* xyz, vec3* stored, int threads = 1) const;
+    /// @brief The positions of the vertices from global id `first` on (one object's or a range of
+    /// them; `caller.vertex_count` of them), given in the caller's order and layout, written in the
+    /// order the pipeline stores them as float32 (`stored`, also indexed from `first`), on `threads`
+    /// threads when there are many: a simulation hands over every object's positions each frame.
+    void to_stored_order(std::uint32_t first, const PositionsView& caller, vec3* stored, int threads = 1) const;
     void to_stored_order(std::uint32_t first, std::uint32_t count, const vec3* caller_order, vec3* stored, int threads = 1) const {
-        static_assert(sizeof(vec3) == 3 * sizeof(float), "a vec3 is its three coordinates");
-        to_stored_order(first, count, reinterpret_cast<const float*>(caller_order), stored, threads);
+        to_stored_order(first, xyz_view(caller_order, count), stored, threads);
     }
 };
 
@@ -90,10 +84,11 @@ public:
     virtual ~PipelineBase() = default;
     /// @brief Replaces all geometry; positions must be set again afterwards.
     virtual void set_topology(const SceneTopology& topology) = 0;
-    /// @brief Copies `count` positions already in the backend's memory (in stream order) into a
-    /// staging buffer, waiting for nothing; a frame adopts them (start()'s `staged`) once it has
-    /// checked that they are finite, so rejected positions never become current.
-    virtual void stage_positions(std::uint32_t first, const vec3* positions, std::uint32_t count) = 0;
+    /// @brief Copies positions already in the backend's memory (in stream order), in any layout, as
+    /// float32 into a staging buffer from global vertex `first` on, waiting for nothing; a frame
+    /// adopts them (start()'s `staged`) once it has checked that they are finite, so rejected
+    /// positions never become current. Throws kdet::Error for memory the backend cannot read.
+    virtual void stage_positions(std::uint32_t first, const PositionsView& positions) = 0;
     /// @brief Copies `count` positions starting at global vertex `first` back to the host: the current
     /// ones, in stored order, or with `staged` those stage_positions() copied (in the caller's order)
     /// and no frame has adopted yet.

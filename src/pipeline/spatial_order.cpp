@@ -86,28 +86,27 @@ void SceneTopology::add_object(const vec3* positions, std::uint32_t object_verte
 
 namespace {
 
-template <class Scalar>
+template <class Source>
 void gather_in_stored_order(const std::vector<std::uint32_t>& vertex_user_id, std::uint32_t first, std::uint32_t count,
-                            const Scalar* xyz, vec3* stored, int threads) {
+                            const Source& source, vec3* stored, int threads) {
     // Read at random where the caller's order is not spatial: fetched a few vertices ahead.
     constexpr std::ptrdiff_t ahead = 16;
     const std::uint32_t* user_id = vertex_user_id.data() + first;
     const auto n = static_cast<std::ptrdiff_t>(count);
 #pragma omp parallel for num_threads(threads) schedule(static) if (n > host_parallel_elements)
     for (std::ptrdiff_t v = 0; v < n; ++v) {
-        if (v + ahead < n) __builtin_prefetch(xyz + 3 * std::size_t{user_id[v + ahead] - first});
-        stored[v] = to_float(xyz + 3 * std::size_t{user_id[v] - first});
+        if (v + ahead < n) __builtin_prefetch(source.row(user_id[v + ahead] - first));
+        stored[v] = source(user_id[v] - first);
     }
 }
 
 } // namespace
 
-void SceneTopology::to_stored_order(std::uint32_t first, std::uint32_t count, const double* xyz, vec3* stored, int threads) const {
-    gather_in_stored_order(vertex_user_id, first, count, xyz, stored, threads);
-}
-
-void SceneTopology::to_stored_order(std::uint32_t first, std::uint32_t count, const float* xyz, vec3* stored, int threads) const {
-    gather_in_stored_order(vertex_user_id, first, count, xyz, stored, threads);
+void SceneTopology::to_stored_order(std::uint32_t first, const PositionsView& caller, vec3* stored, int threads) const {
+    const auto count = static_cast<std::uint32_t>(caller.vertex_count);
+    with_positions(caller, [&](const auto& source) {
+        gather_in_stored_order(vertex_user_id, first, count, source, stored, threads);
+    });
 }
 
 } // namespace kdet

@@ -1,12 +1,11 @@
 #include "session.hpp"
 
-#include "bench_runner.hpp"
-
 #include <kdet/error.hpp>
 
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -106,7 +105,7 @@ void ViewSession::set_frame(int frame) { frame_ = std::clamp(frame, 0, scene_->n
 
 void ViewSession::build_detector() {
     auto detector = std::make_unique<Detector>(options_);
-    cli::add_scene_objects(*detector, *scene_, self_);
+    add_scene_objects(*detector, *scene_, self_);
     detector_ = std::move(detector);
 }
 

@@ -4,6 +4,7 @@
 /// moving scenes that the code builds itself (so that kdet runs without data files), the thesis
 /// scenes, scene files and recordings.
 
+#include <kdet/detector.hpp>
 #include <kdet/mesh.hpp>
 
 #include <cstddef>
@@ -50,6 +51,11 @@ public:
     /// @brief Whether the scene asks for self-collisions of @p object (default: none).
     virtual bool checks_self(std::size_t /*object*/) const { return false; }
 };
+
+/// @brief Adds every object of @p scene to @p detector (ids in scene order, from the detector's next
+/// id on), with self-collision of each object as @p self says (the thesis's `-s`, whatever the
+/// scene's checks_self) and collisions between the object pairs the scene checks only.
+void add_scene_objects(Detector& detector, const Scene& scene, bool self);
 
 /// @brief Size of a ProceduralScene.
 struct ProceduralSceneOptions {

@@ -1,0 +1,18 @@
+/// @file scene_objects.cpp
+/// @brief add_scene_objects: a scene's objects and the collisions it checks, set up in a Detector.
+
+#include <kdet/scenes.hpp>
+
+namespace kdet {
+
+void add_scene_objects(Detector& detector, const Scene& scene, bool self) {
+    const auto first = static_cast<ObjectId>(detector.object_count());
+    for (std::size_t o = 0; o < scene.num_objects(); ++o)
+        detector.set_self_collision(detector.add_object(scene.rest_mesh(o)), self);
+    for (std::size_t a = 0; a < scene.num_objects(); ++a)
+        for (std::size_t b = a + 1; b < scene.num_objects(); ++b)
+            if (!scene.checks_pair(a, b))
+                detector.set_pair_collision(first + static_cast<ObjectId>(a), first + static_cast<ObjectId>(b), false);
+}
+
+} // namespace kdet
