@@ -7,8 +7,16 @@
 /// buffer only when a counter says that the buffer was too small, running the frame again from the
 /// stage that lacked room.
 
+#include "pipeline/baseline_kernels.hpp"
+#include "pipeline/bounding_boxes.hpp"
+#include "pipeline/candidate_search.hpp"
 #include "pipeline/capacity.hpp"
+#include "pipeline/grid_populate.hpp"
+#include "pipeline/grid_sizing.hpp"
+#include "pipeline/narrow_phase.hpp"
 #include "pipeline/pipeline_base.hpp"
+#include "pipeline/positions_check.hpp"
+#include "pipeline/scene_view.hpp"
 
 #include <kdet/error.hpp>
 

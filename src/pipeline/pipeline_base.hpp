@@ -2,7 +2,8 @@
 /// @file pipeline_base.hpp
 /// @brief The interface a Detector drives; one implementation per backend, both from pipeline.hpp.
 
-#include "pipeline/kernels.hpp"
+#include "pipeline/positions_check.hpp"
+#include "pipeline/scene_view.hpp"
 
 #include <kdet/options.hpp>
 #include <kdet/results.hpp>

@@ -1,3 +1,4 @@
+#include "pipeline/pair_keys.hpp"
 #include "pipeline/pipeline_base.hpp"
 
 #include <algorithm>
