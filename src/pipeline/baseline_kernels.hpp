@@ -1,7 +1,7 @@
 #pragma once
 /// @file baseline_kernels.hpp
 /// @brief The kernels of the thesis's baselines (Method::kdet_no_pairs, brute_force_loop,
-/// brute_force_pairs), which the pipeline runs in place of kdet's candidate search.
+/// brute_force_pairs), which BaselinePipeline runs in place of kdet's candidate search.
 
 #include "exec/atomic.hpp"
 #include "pipeline/candidate_search.hpp"

@@ -1,6 +1,7 @@
 #pragma once
 /// @file pipeline_base.hpp
-/// @brief The interface a Detector drives; one implementation per backend, both from pipeline.hpp.
+/// @brief The interface a Detector drives: per backend Pipeline (pipeline.hpp) for Method::kdet and
+/// BaselinePipeline (baselines.hpp) for the thesis's baselines, chosen by make_pipeline.
 
 #include "pipeline/positions_check.hpp"
 #include "pipeline/scene_view.hpp"
