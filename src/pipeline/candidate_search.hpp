@@ -108,7 +108,8 @@ struct TetRuns {
         return tets - first(r) < TetsPerItem ? tets : first(r) + TetsPerItem;
     }
     /// @brief Calls f(t) for the tets t of run r in order while f returns true; a run of one tet (the
-    /// GPU's) without a loop, which cost the GPU's search kernel about 30 registers.
+    /// GPU's) without a loop, whose counter and bounds would take registers from the GPU's search
+    /// kernel and lower its occupancy.
     template <class F>
     KDET_HD static void for_each_tet(std::uint32_t r, std::uint32_t tets, F&& f) {
         if constexpr (TetsPerItem == 1) {
@@ -169,7 +170,7 @@ struct FindCandidatesKernel {
             // Tets of one object that share a vertex are skipped first: they touch, so the slabs would
             // never separate them, and a self-colliding mesh's box-overlapping pairs hold many (its
             // neighbours); u's indices are loaded only for a pair within one object. Then the slabs,
-            // whose 64 bytes separate about half of the rest (slabs.hpp), before the face planes.
+            // whose 64 bytes separate many of the rest (slabs.hpp), before the costlier face planes.
             if (e.object == object && share_vertex(tet, scene->tets[u])) return;
             if (scene->slabs && slabs_separate(slabs, scene->slabs[u])) {
                 ++rejected;

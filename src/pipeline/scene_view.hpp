@@ -63,9 +63,9 @@ KDET_HD inline SpreadIndices spread_indices(const TetIndices& a) {
     return s;
 }
 
-/// @brief Whether two tets share a vertex: all 16 comparisons without a branch each (about half the
-/// pairs tested share one, so early exits mispredict); on the CPU b's four vertices are compared with
-/// each of a's in one vector compare.
+/// @brief Whether two tets share a vertex: all 16 comparisons without a branch each (in a mesh many of
+/// the pairs tested share one, and which do is unpredictable, so early exits mispredict); on the CPU
+/// b's four vertices are compared with each of a's in one vector compare.
 KDET_HD inline bool share_vertex(const SpreadIndices& a, const TetIndices& b) {
     std::uint32_t lane[4];
     KDET_VECTOR_LOOP
