@@ -25,7 +25,7 @@
 
 #include "exec/cuda_exec.cuh"
 #include "geometry/tet_intersect.hpp"
-#include "pipeline/kernels.hpp"
+#include "pipeline/scene_view.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>

@@ -1,7 +1,9 @@
 // The execution layer's primitives and the pipeline's helpers around them, on the CPU backend.
 #include "exec/cpu_exec.hpp"
 #include "exec/radix_sort.hpp"
-#include "pipeline/kernels.hpp"
+#include "pipeline/bounding_boxes.hpp"
+#include "pipeline/pair_keys.hpp"
+#include "pipeline/scene_view.hpp"
 
 #include <gtest/gtest.h>
 

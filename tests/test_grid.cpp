@@ -4,7 +4,9 @@
 #include "exec/tuning.hpp"
 #include "geometry/enclosing_sphere.hpp"
 #include "grid/bucket_table.hpp"
-#include "pipeline/kernels.hpp"
+#include "pipeline/bounding_boxes.hpp"
+#include "pipeline/grid_sizing.hpp"
+#include "pipeline/scene_view.hpp"
 
 #include <gtest/gtest.h>
 

@@ -25,6 +25,7 @@
 namespace kdet {
 namespace {
 
+using test::error_message;
 using test::load_model;
 using test::moved;
 using test::random_soup;
@@ -872,6 +873,15 @@ TEST(Detector, OneOffFunctionsReturnFileOrderIndices) {
     const auto self_pairs = collide_self(a);
     for (const auto& p : self_pairs) EXPECT_LT(p.first, p.second);
     EXPECT_EQ(self_pairs.size(), run({a}, true, with_method(Method::brute_force_loop)).pairs.size());
+}
+
+TEST(Detector, OneOffFunctionsRefuseTheMethodWithoutPairs) {
+    const TetMesh a = random_soup(50, 2.0, 1.0, 63);
+    const DetectorOptions no_pairs = with_method(Method::kdet_no_pairs);
+    EXPECT_EQ(error_message([&] { collide(a, a, no_pairs); }),
+              "collide: method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector::detect().colliding");
+    EXPECT_EQ(error_message([&] { collide_self(a, no_pairs); }),
+              "collide_self: method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector::detect().colliding");
 }
 
 TEST(Detector, RejectsBadInputWithClearErrors) {

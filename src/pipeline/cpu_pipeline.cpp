@@ -1,10 +1,10 @@
 #include "exec/cpu_exec.hpp"
-#include "pipeline/pipeline.hpp"
+#include "pipeline/baselines.hpp"
 
 namespace kdet {
 
 std::unique_ptr<PipelineBase> make_cpu_pipeline(const DetectorOptions& options) {
-    return std::make_unique<Pipeline<CpuExec>>(options);
+    return make_pipeline<CpuExec>(options);
 }
 
 } // namespace kdet

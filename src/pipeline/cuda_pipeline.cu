@@ -1,10 +1,10 @@
 #include "exec/cuda_exec.cuh"
-#include "pipeline/pipeline.hpp"
+#include "pipeline/baselines.hpp"
 
 namespace kdet {
 
 std::unique_ptr<PipelineBase> make_cuda_pipeline(const DetectorOptions& options) {
-    return std::make_unique<Pipeline<CudaExec>>(options);
+    return make_pipeline<CudaExec>(options);
 }
 
 bool cuda_available(std::string* reason) {

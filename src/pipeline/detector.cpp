@@ -321,6 +321,13 @@ const DetectorOptions& Detector::options() const { return impl_->options; }
 
 namespace {
 
+/// @brief Throws when `options` ask for a method that builds no pairs, which a one-off query returns.
+void check_builds_pairs(const char* function, const DetectorOptions& options) {
+    if (options.method == Method::kdet_no_pairs)
+        throw Error(std::string(function) +
+                    ": method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector::detect().colliding");
+}
+
 std::vector<IndexPair> to_index_pairs(const FrameResult& result) {
     std::vector<IndexPair> pairs;
     pairs.reserve(result.pairs.size());
@@ -331,6 +338,7 @@ std::vector<IndexPair> to_index_pairs(const FrameResult& result) {
 } // namespace
 
 std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const DetectorOptions& options) {
+    check_builds_pairs("collide", options);
     Detector detector(options);
     detector.add_object(a);
     detector.add_object(b);
@@ -338,6 +346,7 @@ std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const Detecto
 }
 
 std::vector<IndexPair> collide_self(const TetMesh& mesh, const DetectorOptions& options) {
+    check_builds_pairs("collide_self", options);
     Detector detector(options);
     const ObjectId id = detector.add_object(mesh);
     detector.set_self_collision(id, true);

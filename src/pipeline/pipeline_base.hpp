@@ -1,9 +1,11 @@
 #pragma once
 /// @file pipeline_base.hpp
-/// @brief The interface a Detector drives; one implementation per backend, both from pipeline.hpp.
+/// @brief The interface a Detector drives: per backend Pipeline (pipeline.hpp) for Method::kdet and
+/// BaselinePipeline (baselines.hpp) for the thesis's baselines, chosen by make_pipeline.
 
 #include "pipeline/gather_positions.hpp"
-#include "pipeline/kernels.hpp"
+#include "pipeline/positions_check.hpp"
+#include "pipeline/scene_view.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/options.hpp>

@@ -1,3 +1,4 @@
+#include "pipeline/pair_keys.hpp"
 #include "pipeline/pipeline_base.hpp"
 
 #include <algorithm>
@@ -10,7 +11,7 @@ namespace {
 
 /// The object of global tet `global` and its index there. With few objects a count of the objects
 /// starting at or before it, without a branch: the objects of a pair's second tets alternate at
-/// random, and a binary search mispredicted about once per level.
+/// random, and a binary search would mispredict at every level.
 struct TetLocator {
     const std::vector<std::uint32_t>& begin; ///< [objects + 1]
     static constexpr std::size_t few_objects = 16;

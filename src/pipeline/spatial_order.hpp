@@ -2,8 +2,8 @@
 /// @file spatial_order.hpp
 /// @brief The order in which the pipeline stores an object's tets: close in space, close in memory.
 ///
-/// Meshes often list their tets in no spatial order (TetGen's output has consecutive tets about half
-/// the model apart). The grid stages gather the data of a tet's neighbours, so storing neighbours next
+/// Meshes often list their tets in no spatial order (TetGen's output puts consecutive tets far apart
+/// in the model). The grid stages gather the data of a tet's neighbours, so storing neighbours next
 /// to each other turns most of those gathers into cache hits. The order is computed once, when the
 /// object is added; a deforming mesh keeps its neighbours, so the order stays good. The vertices
 /// follow the tets (SceneTopology::add_object).

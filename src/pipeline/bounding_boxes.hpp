@@ -1,0 +1,90 @@
+#pragma once
+/// @file bounding_boxes.hpp
+/// @brief Stage 1, bounding boxes: each tet's box, each object's box, and which pairs of objects are
+/// checked this frame.
+
+#include "exec/atomic.hpp"
+#include "grid/bucket_table.hpp"
+#include "pipeline/scene_view.hpp"
+
+#include <cstdint>
+
+namespace kdet {
+
+/// @brief Stage 1: box of each tet; no size and no layer yet.
+struct TetBoundsKernel {
+    SceneView scene;
+    KDET_HD void operator()(std::uint64_t t) const {
+        vec3 v[4];
+        load_tet(scene, static_cast<std::uint32_t>(t), v);
+        scene.info[t] = TetInfo{tet_box(v), 0.0f, -1};
+    }
+};
+
+/// @brief Stage 1: the box of tet t, the value the per-object box reduction merges.
+struct TetBoxOf {
+    const TetInfo* info;
+    KDET_HD Aabb operator()(std::uint64_t t) const { return info[t].box; }
+};
+
+/// @brief The smallest box holding two boxes.
+struct BoxUnion {
+    KDET_HD Aabb operator()(const Aabb& a, const Aabb& b) const { return Aabb{min_v(a.lo, b.lo), max_v(a.hi, b.hi)}; }
+};
+
+/// @brief Stage 1: puts the box of each run of tets (one run per non-empty object: its tets are
+/// contiguous) at its object's place.
+struct ObjectBoxesKernel {
+    const std::uint32_t* run_objects;
+    const Aabb* run_boxes;
+    const std::uint32_t* run_count;
+    Aabb* object_boxes;
+    KDET_HD void operator()(std::uint64_t r) const {
+        if (r < *run_count) object_boxes[run_objects[r]] = run_boxes[r];
+    }
+};
+
+/// @brief A box as order-preserving integers (float_to_ordered), so that threads can merge boxes atomically.
+struct OrderedBox {
+    std::uint32_t lo[3], hi[3];
+};
+
+/// @brief Stage 1, one work item per object a: which pairs (a, b) are checked this frame (enabled,
+/// both objects hold tets, their boxes overlap; the diagonal is self-collision), and, when a is in
+/// one, its box merged into the region the grid covers and its tets counted. No tets counted: nothing
+/// can collide, and every later stage finds nothing to do.
+struct ObjectCullingKernel {
+    const std::uint8_t* pair_enabled; ///< [object_count * object_count]
+    std::uint8_t* pair_active;
+    std::uint32_t* checked_objects; ///< [object_count] SceneView::checked_objects
+    const Aabb* object_boxes;
+    const std::uint32_t* object_tet_begin; ///< [object_count + 1]
+    std::uint32_t object_count;
+    OrderedBox* region;
+    unsigned long long* involved_tets;
+
+    KDET_HD void operator()(std::uint64_t a) const {
+        const std::uint32_t tets = object_tet_begin[a + 1] - object_tet_begin[a];
+        bool involved = false;
+        std::uint32_t checked = 0;
+        for (std::uint32_t b = 0; b < object_count; ++b) {
+            const std::uint64_t k = a * object_count + b;
+            const bool on = tets && object_tet_begin[b + 1] != object_tet_begin[b] && pair_enabled[k] &&
+                            (a == b || boxes_overlap(object_boxes[a], object_boxes[b]));
+            pair_active[k] = on ? 1 : 0;
+            if (on) checked |= object_bit(b);
+            involved = involved || on;
+        }
+        // Checked against every object, a tet filters none: any_object spares its scans the blocks' objects.
+        checked_objects[a] = checked == all_object_bits(object_count) ? any_object : checked;
+        if (!involved) return;
+        const Aabb& box = object_boxes[a];
+        for (int axis = 0; axis < 3; ++axis) {
+            atomic_min(&region->lo[axis], float_to_ordered(component(box.lo, axis)));
+            atomic_max(&region->hi[axis], float_to_ordered(component(box.hi, axis)));
+        }
+        atomic_fetch_add(involved_tets, static_cast<unsigned long long>(tets));
+    }
+};
+
+} // namespace kdet
