@@ -87,19 +87,19 @@ int run_collide(int argc, char** argv) {
     std::string pairs_path, contacts_path;
     ReadOptions read_options;
 
-    ArgParser parser("collide");
+    CommandLine parser("collide");
     parser.positionals(2, meshes);
-    parser.flag("--self", [&] { self = true; });
-    parser.flag("--json", [&] { json = true; });
-    parser.flag("--allow-degenerate", [&] { read_options.allow_degenerate = true; });
-    parser.flag("--help", [&] { help = true; });
+    parser.flag("--self", self);
+    parser.flag("--json", json);
+    parser.flag("--allow-degenerate", read_options.allow_degenerate);
+    parser.flag("--help", help);
     parser.option("--pairs", "FILE", [&](const std::string& v) { pairs_path = v; });
     parser.option("--contacts", "FILE", [&](const std::string& v) { contacts_path = v; });
-    parser.flag("--check-exact", [&] { check = true; });
-    add_detector_options(parser, options);
+    parser.flag("--check-exact", check);
+    parser.detector_options(options, front_end_cli);
     parser.parse(argc, argv, 2);
     if (help) {
-        std::cout << collide_help << detector_options_help();
+        std::cout << collide_help << detector_options_help(front_end_cli);
         return exit_ok;
     }
     if (meshes.empty()) throw UsageError("collide: missing mesh A (see 'kdet collide --help')");
