@@ -302,9 +302,17 @@ std::vector<IndexPair> to_index_pairs(const FrameResult& result) {
     return pairs;
 }
 
+/// A one-off query answers with pairs, which kdet_no_pairs does not build.
+void require_pairs(const DetectorOptions& options) {
+    if (options.method == Method::kdet_no_pairs)
+        throw Error("method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use a Detector's "
+                    "colliding flags");
+}
+
 } // namespace
 
 std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const DetectorOptions& options) {
+    require_pairs(options);
     Detector detector(options);
     detector.add_object(a);
     detector.add_object(b);
@@ -312,6 +320,7 @@ std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const Detecto
 }
 
 std::vector<IndexPair> collide_self(const TetMesh& mesh, const DetectorOptions& options) {
+    require_pairs(options);
     Detector detector(options);
     const ObjectId id = detector.add_object(mesh);
     detector.set_self_collision(id, true);
