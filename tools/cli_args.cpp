@@ -47,7 +47,8 @@ void CommandLine::detector_options(DetectorOptions& options, FrontEnd front_end)
         if (!o.shown_on(front_end)) continue;
         const std::string flag = flag_of(o, front_end);
         // A missing value is named as before: "<method>" for a name, "<N>" for a number.
-        option(flag, o.type == OptionType::choice ? o.name : o.value_name, [&options, &o, flag](const std::string& v) { o.parse(v, options, flag); });
+        option(flag, o.type == OptionType::choice ? o.name : o.value_name,
+               [&options, &o, flag](const std::string& v) { o.parse(v, options, flag); });
     }
 }
 

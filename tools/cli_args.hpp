@@ -31,7 +31,7 @@ public:
     explicit CommandLine(std::string command);
     ~CommandLine();
 
-    /// @brief A flag without a value, e.g. --self; `--self=x` is refused.
+    /// @brief A flag without a value, e.g. --self; a value after it (`--self=1`) is refused.
     void flag(const std::string& name, bool& seen);
     /// @brief A flag followed by a value, e.g. --threads 4 (or --threads=4); the last one given wins.
     void option(const std::string& name, const std::string& value_name, std::function<void(const std::string&)> on_value);

@@ -53,7 +53,8 @@ std::string python_keywords() {
 const OptionInfo& keyword_option(const std::string& name) {
     const OptionInfo* o = find_option(name);
     if (!o || name != o->name || !o->shown_on(front_end_python))
-        throw nb::type_error(("unexpected keyword argument '" + name + "' (the options are " + python_keywords() + ")").c_str());
+        throw nb::type_error(
+            ("unexpected keyword argument '" + name + "' (the options are " + python_keywords() + ")").c_str());
     return *o;
 }
 
@@ -128,7 +129,7 @@ const char* detector_signature() {
             if (!o.shown_on(front_end_python)) continue;
             out += std::string(", ") + o.name + ": ";
             if (o.type == OptionType::choice) out += "str = '" + o.default_text() + "'";
-            else if (o.type == OptionType::boolean) out += std::string("bool = ") + (o.get(DetectorOptions{}) ? "True" : "False");
+            else if (o.type == OptionType::boolean) out += o.get(DetectorOptions{}) ? "bool = True" : "bool = False";
             else if (o.unset_by_default()) out += "int | None = None";
             else out += "int = " + o.default_text();
         }

@@ -151,7 +151,8 @@ const std::vector<OptionInfo>& option_table() {
     static const std::vector<OptionInfo> table = {
         choice<Backend, &O::backend>("backend", "backend", "--backend", "--backend", "backend", "B", ""),
         choice<Method, &O::method>("method", "method", "--method", "-c", "method", "M", ""),
-        choice<NarrowPhase, &O::narrow_phase>("test", "narrow_phase", "--test", "-o", "narrow phase", "T", "narrow phase"),
+        choice<NarrowPhase, &O::narrow_phase>("test", "narrow_phase", "--test", "-o", "narrow phase", "T",
+                                              "narrow phase"),
         choice<HashFunction, &O::hash>("hash", "hash", "--hash", "-h", "hash", "H", "grid hash"),
         number<int, &O::threads>("threads", "--threads", "--threads", "threads", "CPU threads (default: all)",
                                  OptionType::integer, 1, 1024, nullptr, every_front_end),
