@@ -2,6 +2,8 @@
 
 #include "commands.hpp"
 
+#include <kdet/error.hpp>
+
 #include <string>
 #include <vector>
 
@@ -30,19 +32,19 @@ scene: procedural (default; two deforming tori, no data files needed) or another
 
 thesis options (any order):
   -r N                 model resolution 1-4 (default 1)
-  -c M                 method: )" + option_help(defaults.method) + R"(
+  -c M                 method: )" + find_option("method")->values_help(defaults) + R"(
                        (the thesis's names: )" + thesis_names + R"()
-  -o T                 overlap test: )" + option_help(defaults.narrow_phase) + R"(
+  -o T                 overlap test: )" + find_option("test")->values_help(defaults) + R"(
   -g N                 CUDA block size: 16, 32, 64, 128 (default) or 256
   -n N                 runs 1-20 (default 10)
   -s yes|y|no|n        self-collisions of every object (default no)
-  -h H                 grid hash: )" + option_help(defaults.hash) + R"(  (-h is not help)
+  -h H                 grid hash: )" + find_option("hash")->values_help(defaults) + R"(  (-h is not help)
   -d DIR               output folder (default exports/benchmark_data)
 
 more options:
-  --backend B          where detection runs: )" + option_help(defaults.backend) + R"(; cuda needs a GPU
-  --threads N          CPU threads (default: all)
-)" + bucket_capacity_help + R"(  --frames A:B         run frames A to B only (0-based, inclusive)
+  --backend B          where detection runs: )" + find_option("backend")->values_help(defaults) + R"(; cuda needs a GPU
+)" + option_help_line(*find_option("threads"), front_end_bench, defaults) +
+           option_help_line(*find_option("bucket_capacity"), front_end_bench, defaults) + R"(  --frames A:B         run frames A to B only (0-based, inclusive)
   --quiet              no per-frame table and no progress bar; only the summary
   --help               this text
 
@@ -77,32 +79,25 @@ const std::vector<std::string>& bench_block_sizes() {
 BenchConfig parse_bench_args(int argc, char** argv, int first) {
     BenchConfig config;
     std::vector<std::string> scene;
-    ArgParser parser("bench");
+    CommandLine parser("bench");
     parser.positionals(1, scene);
-    parser.flag("--help", [&] { config.help = true; });
-    parser.flag("--quiet", [&] { config.quiet = true; });
+    parser.flag("--help", config.help);
+    parser.flag("--quiet", config.quiet);
     parser.option("-r", "resolution", [&](const std::string& v) {
         config.request.resolution = static_cast<int>(parse_integer("-r", v, 1, 4));
     });
-    parser.option("-c", "method", [&](const std::string& v) { config.options.method = parse_option<Method>("-c", v); });
-    parser.option("-o", "test", [&](const std::string& v) { config.options.narrow_phase = parse_option<NarrowPhase>("-o", v); });
-    parser.option("-g", "block size", [&](const std::string& v) {
-        config.options.block_size = std::stoi(parse_choice("-g", v, bench_block_sizes()));
+    parser.detector_options(config.options, front_end_bench);
+    // The thesis's block sizes, a few of those the library accepts.
+    const OptionInfo& block_size = *find_option("block_size");
+    parser.option(block_size.bench_flag, "block size", [&](const std::string& v) {
+        block_size.parse(parse_choice(block_size.bench_flag, v, bench_block_sizes()), config.options, block_size.bench_flag);
     });
     parser.option("-n", "runs", [&](const std::string& v) { config.runs = static_cast<int>(parse_integer("-n", v, 1, 20)); });
-    parser.option("-s", "yes|no", [&](const std::string& v) {
-        config.self = parse_choice("-s", v, {"yes", "y", "no", "n"})[0] == 'y';
-    });
-    parser.option("-h", "hash", [&](const std::string& v) { config.options.hash = parse_option<HashFunction>("-h", v); });
+    parser.option("-s", "yes|no", [&](const std::string& v) { config.self = parse_choice("-s", v, {"yes", "y", "no", "n"})[0] == 'y'; });
     parser.option("-d", "folder", [&](const std::string& v) {
         if (v.empty()) throw UsageError("invalid value '' for -d: expected a folder");
         config.output_dir = v;
     });
-    parser.option("--backend", "backend", [&](const std::string& v) { config.options.backend = parse_option<Backend>("--backend", v); });
-    parser.option("--threads", "N", [&](const std::string& v) {
-        config.options.threads = static_cast<int>(parse_integer("--threads", v, 1, 1024));
-    });
-    add_bucket_capacity_option(parser, config.options);
     const auto scene_length = [&](const std::string& flag, const std::string& v) {
         config.request.procedural.frames = static_cast<int>(parse_integer(flag, v, 1, 100000));
         if (config.procedural_flag.empty()) config.procedural_flag = flag;
@@ -113,7 +108,7 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
         try {
             config.first_frame = static_cast<int>(parse_integer("--frames", v.substr(0, colon), 0, 1000000));
             config.last_frame = static_cast<int>(parse_integer("--frames", v.substr(colon + 1), config.first_frame, 1000000));
-        } catch (const UsageError&) {
+        } catch (const Error&) {
             throw UsageError("invalid value '" + v + "' for --frames: expected A:B with 0 <= A <= B (0-based frames), " +
                              "or N (length of the procedural scene)");
         }

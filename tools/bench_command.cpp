@@ -81,7 +81,7 @@ void print_report(const BenchConfig& config, const Scene& scene, const BenchOutc
 int run_bench(int argc, char** argv) {
     const BenchConfig config = parse_bench_args(argc, argv, 2);
     if (config.help) {
-        std::cout << bench_help() << "\nknown scenes: " << join_choices(scene_names()) << "\n";
+        std::cout << bench_help() << "\nknown scenes: " << join_names(scene_names()) << "\n";
         return exit_ok;
     }
     std::string reason;

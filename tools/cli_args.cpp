@@ -1,90 +1,88 @@
 #include "cli_args.hpp"
 
-#include <cerrno>
-#include <cstdlib>
+#include <kdet/error.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
 
 namespace kdet::cli {
 
-void ArgParser::flag(const std::string& name, std::function<void()> on_seen) {
-    specs_.push_back(Spec{name, "", std::move(on_seen), nullptr});
+CommandLine::CommandLine(std::string command)
+    : command_(std::move(command)), app_(std::make_unique<CLI::App>(command_)) {
+    app_->set_help_flag();
+    // Unknown flags and surplus arguments are reported below in kdet's words, not CLI11's.
+    app_->allow_extras();
 }
 
-void ArgParser::option(const std::string& name, const std::string& value_name,
-                       std::function<void(const std::string&)> on_value) {
-    specs_.push_back(Spec{name, value_name, nullptr, std::move(on_value)});
+CommandLine::~CommandLine() = default;
+
+void CommandLine::flag(const std::string& name, bool& seen) { app_->add_flag(name, seen)->disable_flag_override(); }
+
+void CommandLine::option(const std::string& name, const std::string& value_name,
+                         std::function<void(const std::string&)> on_value) {
+    // Each value when it is read, in the order given: the last one wins, a flag that collects (`kdet
+    // prepare -r`) sees them all, and `kdet bench` knows which procedural-only flag came first.
+    app_->add_option(name, [on_value = std::move(on_value)](const CLI::results_t& values) {
+            for (const std::string& v : values) on_value(v);
+            return true;
+        })
+        ->type_name(value_name)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+        ->trigger_on_parse();
 }
 
-void ArgParser::positionals(std::size_t max_count, std::vector<std::string>& out) {
+void CommandLine::positionals(std::size_t max_count, std::vector<std::string>& out) {
     max_positionals_ = max_count;
     positionals_ = &out;
+    app_->add_option("arguments", out)->expected(0, CLI::detail::expected_max_vector_size);
 }
 
-const ArgParser::Spec* ArgParser::find(const std::string& name) const {
-    for (const Spec& s : specs_)
-        if (s.name == name) return &s;
-    return nullptr;
+std::string flag_of(const OptionInfo& option, FrontEnd front_end) {
+    return front_end == front_end_bench ? option.bench_flag : option.flag;
 }
 
-void ArgParser::parse(int argc, char** argv, int first) const {
-    bool only_positionals = false;
-    for (int i = first; i < argc; ++i) {
-        std::string arg = argv[i];
-        if (only_positionals || arg.size() < 2 || arg[0] != '-' || arg == "-") {
-            if (!positionals_ || positionals_->size() >= max_positionals_)
-                throw UsageError(command_ + ": unexpected argument '" + arg + "'");
-            positionals_->push_back(arg);
-            continue;
-        }
-        if (arg == "--") {
-            only_positionals = true;
-            continue;
-        }
-        std::string inline_value;
-        bool has_inline_value = false;
-        const auto equals = arg.find('=');
-        if (arg.rfind("--", 0) == 0 && equals != std::string::npos) {
-            inline_value = arg.substr(equals + 1);
-            arg = arg.substr(0, equals);
-            has_inline_value = true;
-        }
-        const Spec* spec = find(arg);
-        if (!spec) throw UsageError(command_ + ": unknown option '" + arg + "' (see '" + command_ + " --help')");
-        if (spec->on_flag) {
-            if (has_inline_value) throw UsageError(command_ + ": option '" + arg + "' takes no value");
-            spec->on_flag();
-            continue;
-        }
-        if (!has_inline_value) {
-            if (i + 1 >= argc) throw UsageError(command_ + ": option '" + arg + "' needs a value <" + spec->value_name + ">");
-            inline_value = argv[++i];
-        }
-        spec->on_value(inline_value);
+void CommandLine::detector_options(DetectorOptions& options, FrontEnd front_end) {
+    for (const OptionInfo& o : option_table()) {
+        if (!o.shown_on(front_end)) continue;
+        const std::string flag = flag_of(o, front_end);
+        // A missing value is named as before: "<method>" for a name, "<N>" for a number.
+        option(flag, o.type == OptionType::choice ? o.name : o.value_name,
+               [&options, &o, flag](const std::string& v) { o.parse(v, options, flag); });
     }
 }
 
-long long parse_integer(const std::string& flag, const std::string& text, long long lo, long long hi) {
-    errno = 0;
-    char* end = nullptr;
-    const long long value = std::strtoll(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || errno == ERANGE || value < lo || value > hi)
-        throw UsageError("invalid value '" + text + "' for " + flag + ": expected an integer in [" + std::to_string(lo) +
-                         ", " + std::to_string(hi) + "]");
-    return value;
-}
-
-std::string join_choices(const std::vector<std::string>& names) {
-    std::string out;
-    for (std::size_t i = 0; i < names.size(); ++i) {
-        if (i) out += i + 1 == names.size() ? " or " : ", ";
-        out += names[i];
+void CommandLine::parse(int argc, char** argv, int first) {
+    std::vector<std::string> args(argv + first, argv + argc);
+    std::reverse(args.begin(), args.end()); // CLI11 takes them last first
+    try {
+        app_->parse(args);
+    } catch (const CLI::ArgumentMismatch& e) {
+        // CLI11 starts this message with the option's name (with or without its dashes), the one name
+        // each of kdet's options has.
+        const std::string what = e.what();
+        const std::string name = what.substr(0, what.find_first_of(": "));
+        const CLI::Option* option = nullptr;
+        for (const char* dashes : {"", "-", "--"})
+            if (!option) option = app_->get_option_no_throw(std::string(dashes) + name);
+        if (!option) throw UsageError(command_ + ": " + what);
+        const std::string shown = option->get_name();
+        if (option->get_expected_max() == 0) throw UsageError(command_ + ": option '" + shown + "' takes no value");
+        throw UsageError(command_ + ": option '" + shown + "' needs a value <" + option->get_type_name() + ">");
+    } catch (const CLI::ParseError& e) {
+        throw UsageError(command_ + ": " + e.what());
+    } catch (const Error& e) {
+        throw UsageError(e.what());
     }
-    return out;
-}
-
-std::string parse_choice(const std::string& flag, const std::string& text, const std::vector<std::string>& accepted) {
-    for (const std::string& a : accepted)
-        if (a == text) return text;
-    throw UsageError("invalid value '" + text + "' for " + flag + ": expected " + join_choices(accepted));
+    if (positionals_ && positionals_->size() > max_positionals_)
+        throw UsageError(command_ + ": unexpected argument '" + (*positionals_)[max_positionals_] + "'");
+    for (const std::string& extra : app_->remaining()) {
+        if (extra == "--") continue; // what follows it was taken as positional arguments
+        if (extra.size() > 1 && extra[0] == '-')
+            throw UsageError(command_ + ": unknown option '" + extra.substr(0, extra.find('=')) + "' (see '" + command_ +
+                             " --help')");
+        throw UsageError(command_ + ": unexpected argument '" + extra + "'");
+    }
 }
 
 } // namespace kdet::cli

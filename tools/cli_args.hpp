@@ -1,13 +1,20 @@
 #pragma once
 /// @file cli_args.hpp
-/// @brief A small command-line parser that turns every mistake into a one-line UsageError.
+/// @brief The command lines of kdet's subcommands on CLI11, with every mistake a one-line UsageError
+/// worded as kdet words it, and the detector's flags taken from the library's option table.
 
+#include <kdet/option_table.hpp>
 #include <kdet/options.hpp>
 
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+namespace CLI {
+class App;
+}
 
 namespace kdet::cli {
 
@@ -17,65 +24,33 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-/// @brief Declares flags and positional arguments, then parses argv against them.
-class ArgParser {
+/// @brief One subcommand's flags and positional arguments (a CLI11 app), parsed from argv.
+/// CLI11's own help flag is off: `-h` is `kdet bench`'s hash, and each command prints its own --help.
+class CommandLine {
 public:
-    explicit ArgParser(std::string command) : command_(std::move(command)) {}
+    explicit CommandLine(std::string command);
+    ~CommandLine();
 
-    /// @brief A flag without a value, e.g. --self.
-    void flag(const std::string& name, std::function<void()> on_seen);
-    /// @brief A flag followed by a value, e.g. --threads 4 (or --threads=4 for long flags).
+    /// @brief A flag without a value, e.g. --self; a value after it (`--self=1`) is refused.
+    void flag(const std::string& name, bool& seen);
+    /// @brief A flag followed by a value, e.g. --threads 4 (or --threads=4); the last one given wins.
     void option(const std::string& name, const std::string& value_name, std::function<void(const std::string&)> on_value);
-    /// @brief Collects positional arguments; more than `max_count` is an error.
+    /// @brief Collects up to @p max_count positional arguments; one more is an error.
     void positionals(std::size_t max_count, std::vector<std::string>& out);
+    /// @brief The table's options shown on @p front_end, each under its flag for that front end.
+    void detector_options(DetectorOptions& options, FrontEnd front_end);
 
-    void parse(int argc, char** argv, int first) const;
-
-    const std::string& command() const { return command_; }
+    /// @brief Parses `argv[first..argc)`; throws UsageError, also for a value the library refuses (kdet::Error).
+    void parse(int argc, char** argv, int first);
 
 private:
-    struct Spec {
-        std::string name, value_name;
-        std::function<void()> on_flag;
-        std::function<void(const std::string&)> on_value;
-    };
-    const Spec* find(const std::string& name) const;
-
     std::string command_;
-    std::vector<Spec> specs_;
+    std::unique_ptr<CLI::App> app_;
     std::size_t max_positionals_ = 0;
     std::vector<std::string>* positionals_ = nullptr;
 };
 
-/// @brief Parses a whole decimal integer in [lo, hi] or throws a UsageError naming `flag`.
-long long parse_integer(const std::string& flag, const std::string& text, long long lo, long long hi);
-
-/// @brief Parses one of `accepted` (the error lists them all).
-std::string parse_choice(const std::string& flag, const std::string& text, const std::vector<std::string>& accepted);
-
-/// @brief Joins names for error messages: "a, b or c".
-std::string join_choices(const std::vector<std::string>& names);
-
-/// @brief Reads the value of an option flag (a Backend, Method, NarrowPhase or HashFunction) with the
-/// library's names (kdet::parse: any case, '-' or '_'), or throws a UsageError that lists them.
-template <class Option>
-Option parse_option(const std::string& flag, const std::string& text) {
-    Option value{};
-    if (!kdet::parse(text, value))
-        throw UsageError("invalid value '" + text + "' for " + flag + ": expected " + join_choices(option_names<Option>()));
-    return value;
-}
-
-/// @brief "a (default), b, c": the names of an option type for help texts, the default marked.
-template <class Option>
-std::string option_help(Option default_value) {
-    std::string out;
-    for (const std::string& name : option_names<Option>()) {
-        if (!out.empty()) out += ", ";
-        out += name;
-        if (name == to_string(default_value)) out += " (default)";
-    }
-    return out;
-}
+/// @brief The flag under which @p option appears on @p front_end (bench: its thesis flag).
+std::string flag_of(const OptionInfo& option, FrontEnd front_end);
 
 } // namespace kdet::cli

@@ -5,10 +5,12 @@
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 
+#include <nlohmann/json.hpp>
+
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <sstream>
 
 namespace kdet::cli {
 
@@ -31,29 +33,20 @@ options:
   --allow-degenerate   accept zero-volume tetrahedra (rejected by default)
 )";
 
-std::string json_string(const std::string& text) {
-    std::string out = "\"";
-    for (const char c : text) {
-        if (c == '"' || c == '\\') {
-            out += '\\';
-            out += c;
-        } else if (static_cast<unsigned char>(c) < 0x20) {
-            char escaped[8];
-            std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
-            out += escaped;
-        } else {
-            out += c;
-        }
-    }
-    return out + "\"";
+/// @brief @p value on one line with ", " and ": " between items, as kdet has always printed it
+/// (nlohmann/json writes either no spaces or one item per line). A line break in the dump is always
+/// structure: line breaks inside strings are escaped.
+std::string one_line(const nlohmann::ordered_json& value) {
+    const std::string lines = value.dump(0);
+    std::string out;
+    for (std::size_t i = 0; i < lines.size(); ++i)
+        if (lines[i] != '\n') out += lines[i];
+        else if (i > 0 && lines[i - 1] == ',') out += ' ';
+    return out;
 }
 
-std::string json_number(double value) {
-    std::ostringstream out;
-    out.precision(6);
-    out << std::fixed << value;
-    return out.str();
-}
+/// @brief Milliseconds to the nanosecond, printed as such rather than with the binary fraction's tail.
+double milliseconds(double value) { return std::round(value * 1e6) / 1e6; }
 
 /// @brief Writes one line per colliding pair; with contacts, depth and direction follow the indices.
 void write_pair_lines(const std::string& path, const FrameResult& result, bool with_contacts) {
@@ -87,19 +80,19 @@ int run_collide(int argc, char** argv) {
     std::string pairs_path, contacts_path;
     ReadOptions read_options;
 
-    ArgParser parser("collide");
+    CommandLine parser("collide");
     parser.positionals(2, meshes);
-    parser.flag("--self", [&] { self = true; });
-    parser.flag("--json", [&] { json = true; });
-    parser.flag("--allow-degenerate", [&] { read_options.allow_degenerate = true; });
-    parser.flag("--help", [&] { help = true; });
+    parser.flag("--self", self);
+    parser.flag("--json", json);
+    parser.flag("--allow-degenerate", read_options.allow_degenerate);
+    parser.flag("--help", help);
     parser.option("--pairs", "FILE", [&](const std::string& v) { pairs_path = v; });
     parser.option("--contacts", "FILE", [&](const std::string& v) { contacts_path = v; });
-    parser.flag("--check-exact", [&] { check = true; });
-    add_detector_options(parser, options);
+    parser.flag("--check-exact", check);
+    parser.detector_options(options, front_end_cli);
     parser.parse(argc, argv, 2);
     if (help) {
-        std::cout << collide_help << detector_options_help();
+        std::cout << collide_help << detector_options_help(front_end_cli);
         return exit_ok;
     }
     if (meshes.empty()) throw UsageError("collide: missing mesh A (see 'kdet collide --help')");
@@ -136,28 +129,35 @@ int run_collide(int argc, char** argv) {
     const FrameCounts& c = result.counts;
     const StageTimes& t = result.times;
     if (json) {
-        std::cout << "{\"mesh_a\": " << json_string(meshes[0]) << ", \"tets_a\": " << a.num_tets();
-        if (!self) std::cout << ", \"mesh_b\": " << json_string(meshes[1]) << ", \"tets_b\": " << b.num_tets();
-        std::cout << ", \"self\": " << (self ? "true" : "false") << ", \"method\": \"" << to_string(options.method)
-                  << "\", \"test\": \"" << to_string(options.narrow_phase) << "\", \"hash\": \""
-                  << to_string(options.hash) << "\", \"backend\": \"" << to_string(options.backend)
-                  << "\", \"candidates\": " << c.candidates << ", \"narrow_phase_candidates\": " << c.narrow_phase_candidates
-                  << ", \"colliding_pairs\": " << c.colliding_pairs << ", \"colliding_tets\": " << c.colliding_tets
-                  << ", \"buffer_regrows\": " << c.buffer_regrows << ", \"host_waits\": " << c.host_waits
-                  << ", \"exact_stage_pairs\": " << c.exact_stage_pairs
-                  << ", \"times_ms\": {\"bounding_boxes\": "
-                  << json_number(t.bounding_boxes) << ", \"populate_grid\": " << json_number(t.populate_grid)
-                  << ", \"find_candidates\": " << json_number(t.find_candidates)
-                  << ", \"sort_pairs\": " << json_number(t.sort_pairs)
-                  << ", \"narrow_phase\": " << json_number(t.narrow_phase) << "}, \"total_ms\": "
-                  << json_number(t.total) << ", \"memory_bytes\": " << result.memory_bytes;
+        nlohmann::ordered_json out;
+        out["mesh_a"] = meshes[0];
+        out["tets_a"] = a.num_tets();
+        if (!self) {
+            out["mesh_b"] = meshes[1];
+            out["tets_b"] = b.num_tets();
+        }
+        out["self"] = self;
+        for (const char* name : {"method", "test", "hash", "backend"}) out[name] = find_option(name)->text(options);
+        out["candidates"] = c.candidates;
+        out["narrow_phase_candidates"] = c.narrow_phase_candidates;
+        out["colliding_pairs"] = c.colliding_pairs;
+        out["colliding_tets"] = c.colliding_tets;
+        out["buffer_regrows"] = c.buffer_regrows;
+        out["host_waits"] = c.host_waits;
+        out["exact_stage_pairs"] = c.exact_stage_pairs;
+        out["times_ms"] = {{"bounding_boxes", milliseconds(t.bounding_boxes)},
+                           {"populate_grid", milliseconds(t.populate_grid)},
+                           {"find_candidates", milliseconds(t.find_candidates)},
+                           {"sort_pairs", milliseconds(t.sort_pairs)},
+                           {"narrow_phase", milliseconds(t.narrow_phase)}};
+        out["total_ms"] = milliseconds(t.total);
+        out["memory_bytes"] = result.memory_bytes;
         if (check)
-            std::cout << ", \"exact\": {\"pairs_checked\": " << exact.pairs_checked
-                      << ", \"true_pairs\": " << exact.true_pairs
-                      << ", \"false_positives\": " << exact.false_positives.size()
-                      << ", \"false_negatives\": " << exact.false_negatives.size()
-                      << ", \"skipped_degenerate\": " << exact.skipped_degenerate << "}";
-        std::cout << "}\n";
+            out["exact"] = {{"pairs_checked", exact.pairs_checked}, {"true_pairs", exact.true_pairs},
+                            {"false_positives", exact.false_positives.size()},
+                            {"false_negatives", exact.false_negatives.size()},
+                            {"skipped_degenerate", exact.skipped_degenerate}};
+        std::cout << one_line(out) << "\n";
         return exit_ok;
     }
     std::printf("meshes            %s (%zu tets)", meshes[0].c_str(), a.num_tets());

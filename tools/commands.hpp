@@ -16,16 +16,10 @@ enum ExitCode { exit_ok = 0, exit_failure = 1, exit_usage = 2 };
 int run_collide(int argc, char** argv);
 int run_bench(int argc, char** argv);
 
-/// @brief Adds --method, --test, --hash, --threads, --backend, --block-size, --bucket-capacity to a parser.
-void add_detector_options(ArgParser& parser, DetectorOptions& options);
+/// @brief The help line of one option of the table as @p front_end shows it (flag, placeholder, text).
+std::string option_help_line(const OptionInfo& option, FrontEnd front_end, const DetectorOptions& defaults);
 
-/// @brief Help lines for the options of add_detector_options.
-std::string detector_options_help();
-
-/// @brief --bucket-capacity alone (part of add_detector_options), for `kdet bench`, whose other flags are the thesis's.
-void add_bucket_capacity_option(ArgParser& parser, DetectorOptions& options);
-
-/// @brief The help line of --bucket-capacity.
-extern const char* const bucket_capacity_help;
+/// @brief Help lines of the table's options shown on @p front_end, @p defaults' choices marked.
+std::string detector_options_help(FrontEnd front_end, const DetectorOptions& defaults = {});
 
 } // namespace kdet::cli

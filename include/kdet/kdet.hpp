@@ -7,5 +7,6 @@
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 #include <kdet/mesh.hpp>
+#include <kdet/option_table.hpp>
 #include <kdet/options.hpp>
 #include <kdet/results.hpp>

@@ -1,5 +1,6 @@
 // The kdet._kdet extension module: the library's API with NumPy arrays in and out. The pure-Python
-// part of the package (python/src/kdet/__init__.py) re-exports it and adds collide() and collide_self().
+// part of the package (python/src/kdet/__init__.py) re-exports it, and its collide() and collide_self()
+// take meshio meshes and (vertices, tets) pairs as well before calling the library's.
 #include "arrays.hpp"
 #include "fields.hpp"
 #ifdef KDET_HAS_CUDA
@@ -29,34 +30,55 @@ namespace {
 using namespace nb::literals;
 
 // ---------------------------------------------------------------------------------------------
-// Options: every name goes through the library's one table (kdet::parse, kdet::option_names), so a
-// new method, test, hash or backend appears here without a change to this file.
+// Options: every keyword is an entry of the library's option table (kdet/option_table.hpp), which reads
+// and checks its value and words the message; a new option appears here without a change to this file.
+// What stays here is Python's side: types (TypeError), None for an unset number, and the CUDA stream.
 
-std::string join_names(const std::vector<std::string>& names) {
-    std::string out;
-    for (std::size_t i = 0; i < names.size(); ++i) out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-    return out;
-}
-
-template <class Option>
-Option parse_option(const char* argument, const std::string& text) {
-    Option value{};
-    if (!kdet::parse(text, value))
-        throw Error("invalid value '" + text + "' for " + argument + ": expected " + join_names(option_names<Option>()));
-    return value;
-}
-
-template <class Option>
-nb::tuple names_of() {
+nb::tuple names_of(const char* option) {
     nb::list names;
-    for (const std::string& name : option_names<Option>()) names.append(name);
+    for (const std::string& name : find_option(option)->names()) names.append(name);
     return nb::tuple(names);
 }
 
-std::uint32_t positive_u32(const char* argument, std::int64_t value) {
-    if (value < 1 || value > 0xffffffffll)
-        throw Error(std::string(argument) + ": expected a positive number below 2^32, got " + std::to_string(value));
-    return static_cast<std::uint32_t>(value);
+/// "backend, method, ... or cuda_stream": the keywords of Detector().
+std::string python_keywords() {
+    std::vector<std::string> names;
+    for (const OptionInfo& o : option_table())
+        if (o.shown_on(front_end_python)) names.emplace_back(o.name);
+    names.emplace_back("cuda_stream");
+    return join_names(names);
+}
+
+/// The table's entry of keyword @p name, or a TypeError as Python words an unknown keyword.
+const OptionInfo& keyword_option(const std::string& name) {
+    const OptionInfo* o = find_option(name);
+    if (!o || name != o->name || !o->shown_on(front_end_python))
+        throw nb::type_error(
+            ("unexpected keyword argument '" + name + "' (the options are " + python_keywords() + ")").c_str());
+    return *o;
+}
+
+void set_option(const OptionInfo& o, nb::handle value, DetectorOptions& options) {
+    const auto wrong_type = [&](const char* expected) {
+        return nb::type_error((std::string(o.name) + ": expected " + expected + ", got " + type_label(value)).c_str());
+    };
+    switch (o.type) {
+    case OptionType::choice:
+        if (!nb::isinstance<nb::str>(value)) throw wrong_type("a str");
+        return o.parse(nb::cast<std::string>(value), options, o.name);
+    case OptionType::boolean:
+        if (!PyBool_Check(value.ptr())) throw wrong_type("a bool");
+        return o.set_number(options, value.ptr() == Py_True);
+    case OptionType::integer:
+        if (value.is_none() && o.unset_by_default()) return o.put(options, o.get(DetectorOptions{}));
+        if (!PyLong_Check(value.ptr()) || PyBool_Check(value.ptr()))
+            throw wrong_type(o.unset_by_default() ? "an int or None" : "an int");
+        int overflow = 0;
+        const long long number = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
+        if (overflow)
+            throw Error(std::string(o.label) + " " + nb::cast<std::string>(nb::str(value)) + " out of range");
+        return o.set_number(options, number);
+    }
 }
 
 /// A CUDA stream as the GPU libraries hand it out: None (the default stream), a cudaStream_t as an int, or
@@ -86,29 +108,34 @@ void* cuda_stream_handle(nb::handle stream) {
     return reinterpret_cast<void*>(static_cast<std::uintptr_t>(handle));
 }
 
-DetectorOptions make_options(const std::string& backend, const std::string& method, const std::string& test,
-                             const std::string& hash, std::optional<std::int64_t> threads, bool contacts,
-                             std::int64_t block_size, std::int64_t bucket_capacity,
-                             std::int64_t initial_candidate_capacity, nb::handle cuda_stream, bool results_to_host) {
+/// DetectorOptions from Detector()'s keywords (those of collide() and collide_self() too).
+DetectorOptions options_from_keywords(const nb::kwargs& keywords) {
     DetectorOptions options;
-    options.backend = parse_option<Backend>("backend", backend);
-    options.method = parse_option<Method>("method", method);
-    options.narrow_phase = parse_option<NarrowPhase>("test", test);
-    options.hash = parse_option<HashFunction>("hash", hash);
-    options.threads = threads ? static_cast<int>(std::min<std::uint32_t>(positive_u32("threads", *threads), 1u << 20)) : 0;
-    options.contacts = contacts;
-    options.block_size = static_cast<int>(std::min<std::uint32_t>(positive_u32("block_size", block_size), 1u << 20));
-    if (bucket_capacity < 0 || bucket_capacity > 0xffffffffll)
-        throw Error("bucket_capacity: expected 0 (chosen from the scene) or a positive number, got " +
-                    std::to_string(bucket_capacity));
-    options.bucket_capacity = static_cast<std::uint32_t>(bucket_capacity);
-    if (initial_candidate_capacity < 0)
-        throw Error("initial_candidate_capacity: expected 0 (sized from the tets) or a positive number, got " +
-                    std::to_string(initial_candidate_capacity));
-    options.initial_candidate_capacity = static_cast<std::size_t>(initial_candidate_capacity);
-    options.cuda_stream = cuda_stream_handle(cuda_stream);
-    options.results_to_host = results_to_host;
+    for (auto [key, value] : keywords) {
+        const std::string name = nb::cast<std::string>(key);
+        if (name == "cuda_stream")
+            options.cuda_stream = cuda_stream_handle(value);
+        else
+            set_option(keyword_option(name), value, options);
+    }
     return options;
+}
+
+/// Detector()'s signature for help() and the type stubs: every keyword of the table with its default.
+const char* detector_signature() {
+    static const std::string signature = [] {
+        std::string out = "def __init__(self, *";
+        for (const OptionInfo& o : option_table()) {
+            if (!o.shown_on(front_end_python)) continue;
+            out += std::string(", ") + o.name + ": ";
+            if (o.type == OptionType::choice) out += "str = '" + o.default_text() + "'";
+            else if (o.type == OptionType::boolean) out += o.get(DetectorOptions{}) ? "bool = True" : "bool = False";
+            else if (o.unset_by_default()) out += "int | None = None";
+            else out += "int = " + o.default_text();
+        }
+        return out + ", cuda_stream: object = None) -> None";
+    }();
+    return signature.c_str();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -320,20 +347,27 @@ nb::object finish(nb::handle handle, bool device_results) {
     return completed_frame(handle, device_results, &Detector::finish, "finish");
 }
 
-nb::dict options_dict(const DetectorOptions& o) {
+nb::dict options_dict(const DetectorOptions& options) {
     nb::dict d;
-    d["backend"] = to_string(o.backend);
-    d["method"] = to_string(o.method);
-    d["test"] = to_string(o.narrow_phase);
-    d["hash"] = to_string(o.hash);
-    d["threads"] = o.threads ? nb::cast(o.threads) : nb::none();
-    d["contacts"] = o.contacts;
-    d["block_size"] = o.block_size;
-    d["bucket_capacity"] = o.bucket_capacity;
-    d["initial_candidate_capacity"] = o.initial_candidate_capacity;
-    d["cuda_stream"] = o.cuda_stream ? nb::cast(reinterpret_cast<std::uintptr_t>(o.cuda_stream)) : nb::none();
-    d["results_to_host"] = o.results_to_host;
+    for (const OptionInfo& o : option_table()) {
+        if (!o.shown_on(front_end_python)) continue;
+        const long long value = o.get(options);
+        if (o.type == OptionType::choice) d[o.name] = o.text(options);
+        else if (o.type == OptionType::boolean) d[o.name] = value != 0;
+        else if (o.unset_by_default() && value == o.get(DetectorOptions{})) d[o.name] = nb::none();
+        else d[o.name] = value;
+    }
+    d["cuda_stream"] = options.cuda_stream ? nb::cast(reinterpret_cast<std::uintptr_t>(options.cuda_stream)) : nb::none();
     return d;
+}
+
+/// "Detector(backend='cpu', method='kdet', ...": the names of the options that are choices.
+std::string detector_repr(const Detector& detector) {
+    std::string out = "Detector(";
+    for (const OptionInfo& o : option_table())
+        if (o.type == OptionType::choice && o.shown_on(front_end_python))
+            out += std::string(o.name) + "='" + o.text(detector.options()) + "', ";
+    return out + std::to_string(detector.object_count()) + " objects)";
 }
 
 /// Calls @p f with the lock held and the GIL released.
@@ -344,23 +378,47 @@ auto locked(PyDetector& self, F&& f) {
     return f();
 }
 
-} // namespace
+/// Pairs as a (k, 2) uint32 array that owns a copy of them.
+nb::ndarray<nb::numpy, std::uint32_t, nb::shape<-1, 2>> pair_array(const std::vector<IndexPair>& pairs) {
+    auto* flat = new std::vector<std::uint32_t>();
+    flat->reserve(2 * pairs.size() + 2); // never a null pointer, even without pairs
+    for (const IndexPair& p : pairs) flat->insert(flat->end(), {p.first, p.second});
+    nb::capsule owner(flat, [](void* held) noexcept { delete static_cast<std::vector<std::uint32_t>*>(held); });
+    return {flat->data(), {pairs.size(), 2}, owner};
+}
 
-} // namespace kdet::python
+/// kdet.OPTIONS: Detector's keywords as the library's table describes them.
+nb::dict options_table() {
+    const nb::dict defaults = options_dict(DetectorOptions{});
+    nb::dict table;
+    for (const OptionInfo& o : option_table()) {
+        if (!o.shown_on(front_end_python)) continue;
+        nb::dict entry;
+        const char* types[] = {"choice", "integer", "boolean"};
+        entry["type"] = types[static_cast<int>(o.type)];
+        entry["default"] = defaults[o.name];
+        if (o.type == OptionType::choice) entry["choices"] = names_of(o.name);
+        if (o.type == OptionType::integer) entry["range"] = nb::make_tuple(o.min, o.max);
+        entry["help"] = o.help;
+        entry["flag"] = o.shown_on(front_end_cli) ? nb::cast(o.flag) : nb::none();
+        entry["bench_flag"] = o.shown_on(front_end_bench) ? nb::cast(o.bench_flag) : nb::none();
+        table[o.name] = entry;
+    }
+    return table;
+}
 
-NB_MODULE(_kdet, m) {
-    using namespace kdet;
-    using namespace kdet::python;
+void bind_module(nb::module_& m) {
     m.doc() = "kdet's extension module; use the kdet package, which re-exports it.";
 
     nb::exception<Error> error(m, "Error", PyExc_ValueError);
     error.attr("__doc__") = "Bad input to kdet (a file, an array, an index, a coordinate, an option): the "
                             "library's one-line message. A ValueError.";
 
-    m.attr("BACKENDS") = names_of<Backend>();
-    m.attr("METHODS") = names_of<Method>();
-    m.attr("TESTS") = names_of<NarrowPhase>();
-    m.attr("HASHES") = names_of<HashFunction>();
+    m.attr("BACKENDS") = names_of("backend");
+    m.attr("METHODS") = names_of("method");
+    m.attr("TESTS") = names_of("test");
+    m.attr("HASHES") = names_of("hash");
+    m.attr("OPTIONS") = options_table();
     m.attr("__version__") = KDET_VERSION_STRING;
     m.def("version", &kdet::version, "The version, with the git commit the library was built from when known.");
     m.def(
@@ -374,7 +432,9 @@ NB_MODULE(_kdet, m) {
             return reason;
         },
         "Why the CUDA backend cannot run here, or None when it can.");
+}
 
+void bind_mesh(nb::module_& m) {
     nb::class_<TetMesh>(m, "TetMesh",
                         "A tetrahedral mesh: vertices (n, 3) float64 and tets (m, 4) uint32, 0-based. Both are views "
                         "of the mesh's own memory (no copies).")
@@ -428,7 +488,9 @@ NB_MODULE(_kdet, m) {
         "and .vtk.");
     m.def("from_meshio", &from_meshio, "mesh"_a, nb::kw_only(), "allow_degenerate"_a = false,
           "A TetMesh from a meshio.Mesh: its points and its 'tetra' (and 'tetra10' corner) cells.");
+}
 
+void bind_results(nb::module_& m) {
     bind_fields<FrameCounts>(m, "FrameCounts", "Sizes of one detection.");
     bind_fields<StageTimes>(m, "StageTimes", "Milliseconds spent in each stage of one detection.");
 
@@ -492,30 +554,21 @@ NB_MODULE(_kdet, m) {
         .def_ro("counts", &DeviceFrame::counts)
         .def_ro("times", &DeviceFrame::times)
         .def_ro("memory_bytes", &DeviceFrame::memory_bytes);
+}
 
-    const DetectorOptions defaults;
+void bind_detector(nb::module_& m) {
     nb::class_<PyDetector>(m, "Detector",
                            "Finds colliding tets frame after frame, keeping its buffers between frames: add objects, "
                            "then per frame set_positions() for those that moved and detect(). Pairs of different "
                            "objects are checked, self-collision is off, until switched.")
         .def(
             "__init__",
-            [](PyDetector* self, const std::string& backend, const std::string& method, const std::string& test,
-               const std::string& hash, std::optional<std::int64_t> threads, bool contacts, std::int64_t block_size,
-               std::int64_t bucket_capacity, std::int64_t initial_candidate_capacity, nb::handle cuda_stream,
-               bool results_to_host) {
-                const DetectorOptions options =
-                    make_options(backend, method, test, hash, threads, contacts, block_size, bucket_capacity,
-                                 initial_candidate_capacity, cuda_stream, results_to_host);
+            [](PyDetector* self, const nb::kwargs& keywords) {
+                const DetectorOptions options = options_from_keywords(keywords);
                 nb::gil_scoped_release release;
                 new (self) PyDetector(options);
             },
-            nb::kw_only(), "backend"_a = to_string(defaults.backend), "method"_a = to_string(defaults.method),
-            "test"_a = to_string(defaults.narrow_phase), "hash"_a = to_string(defaults.hash), "threads"_a = nb::none(),
-            "contacts"_a = defaults.contacts, "block_size"_a = defaults.block_size,
-            "bucket_capacity"_a = defaults.bucket_capacity,
-            "initial_candidate_capacity"_a = defaults.initial_candidate_capacity, "cuda_stream"_a = nb::none(),
-            "results_to_host"_a = defaults.results_to_host,
+            nb::sig(detector_signature()),
             "Names (backend, method, test, hash) are those of kdet.BACKENDS, METHODS, TESTS and HASHES, in any case, "
             "'-' or '_'. threads=None uses all cores. contacts=True adds depth and direction per pair. cuda_stream "
             "(backend='cuda'): the stream all of the detector's GPU work runs on, as an int or a stream object "
@@ -577,10 +630,49 @@ NB_MODULE(_kdet, m) {
         .def_prop_ro(
             "options", [](PyDetector& self) { return options_dict(self.detector.options()); },
             "The detector's settings, names as the library spells them.")
-        .def("__repr__", [](PyDetector& self) {
-            const DetectorOptions& o = self.detector.options();
-            return std::string("Detector(backend='") + to_string(o.backend) + "', method='" + to_string(o.method) +
-                   "', test='" + to_string(o.narrow_phase) + "', hash='" + to_string(o.hash) + "', " +
-                   std::to_string(self.detector.object_count()) + " objects)";
-        });
+        .def("__repr__", [](PyDetector& self) { return detector_repr(self.detector); });
+}
+
+void bind_collide(nb::module_& m) {
+    m.def(
+        "collide",
+        [](const TetMesh& a, const TetMesh& b, const nb::kwargs& keywords) {
+            const DetectorOptions options = options_from_keywords(keywords);
+            std::vector<IndexPair> pairs;
+            {
+                nb::gil_scoped_release release;
+                pairs = kdet::collide(a, b, options);
+            }
+            return pair_array(pairs);
+        },
+        "a"_a, "b"_a, "options"_a,
+        "The library's one-off collide(): the colliding pairs (tet of a, tet of b) as a (k, 2) uint32 array, "
+        "sorted. options are Detector's keywords.");
+    m.def(
+        "collide_self",
+        [](const TetMesh& mesh, const nb::kwargs& keywords) {
+            const DetectorOptions options = options_from_keywords(keywords);
+            std::vector<IndexPair> pairs;
+            {
+                nb::gil_scoped_release release;
+                pairs = kdet::collide_self(mesh, options);
+            }
+            return pair_array(pairs);
+        },
+        "mesh"_a, "options"_a,
+        "The library's one-off collide_self(): the colliding pairs i < j inside one mesh as a (k, 2) uint32 "
+        "array, sorted. options are Detector's keywords.");
+}
+
+} // namespace
+
+} // namespace kdet::python
+
+NB_MODULE(_kdet, m) {
+    using namespace kdet::python;
+    bind_module(m);
+    bind_mesh(m);
+    bind_results(m);
+    bind_detector(m);
+    bind_collide(m);
 }

@@ -1,6 +1,11 @@
+#include <kdet/error.hpp>
+#include <kdet/option_table.hpp>
 #include <kdet/options.hpp>
 
 #include <cctype>
+#include <cerrno>
+#include <cstdlib>
+#include <limits>
 
 namespace kdet {
 
@@ -97,4 +102,180 @@ std::vector<std::string> aliases(Method value) {
     return out;
 }
 
+namespace {
+
+/// A choice's accessors for OptionInfo, from its enum and its DetectorOptions member.
+template <class Enum, Enum DetectorOptions::*member>
+struct ChoiceField {
+    static long long get(const DetectorOptions& o) { return static_cast<long long>(o.*member); }
+    static void put(DetectorOptions& o, long long v) { o.*member = static_cast<Enum>(v); }
+    static const std::vector<std::string>& names() { return option_names<Enum>(); }
+    static bool read_name(const std::string& text, long long& index) {
+        Enum value{};
+        if (!parse(text, value)) return false;
+        index = static_cast<long long>(value);
+        return true;
+    }
+};
+
+template <class Number, Number DetectorOptions::*member>
+struct NumberField {
+    static long long get(const DetectorOptions& o) { return static_cast<long long>(o.*member); }
+    static void put(DetectorOptions& o, long long v) { o.*member = static_cast<Number>(v); }
+};
+
+constexpr unsigned text_front_ends = front_end_cli | front_end_bench | front_end_view;
+constexpr unsigned every_front_end = text_front_ends | front_end_panel | front_end_python;
+constexpr long long no_limit = std::numeric_limits<long long>::max();
+
+template <class Enum, Enum DetectorOptions::*member>
+OptionInfo choice(const char* name, const char* field, const char* flag, const char* bench_flag, const char* label,
+                  const char* value_name, const char* help) {
+    using F = ChoiceField<Enum, member>;
+    return OptionInfo{name, field, flag, bench_flag, label, value_name, help, OptionType::choice, 0, 0, nullptr,
+                      every_front_end, &F::get, &F::put, &F::names, &F::read_name};
+}
+
+template <class Number, Number DetectorOptions::*member>
+OptionInfo number(const char* name, const char* flag, const char* bench_flag, const char* label, const char* help,
+                  OptionType type, long long min, long long max, const char* zero_means, unsigned front_ends) {
+    using F = NumberField<Number, member>;
+    return OptionInfo{name, name, flag, bench_flag, label, type == OptionType::integer ? "N" : "", help, type, min, max,
+                      zero_means, front_ends, &F::get, &F::put, nullptr, nullptr};
+}
+
+} // namespace
+
+const std::vector<OptionInfo>& option_table() {
+    using O = DetectorOptions;
+    static const std::vector<OptionInfo> table = {
+        choice<Backend, &O::backend>("backend", "backend", "--backend", "--backend", "backend", "B", ""),
+        choice<Method, &O::method>("method", "method", "--method", "-c", "method", "M", ""),
+        choice<NarrowPhase, &O::narrow_phase>("test", "narrow_phase", "--test", "-o", "narrow phase", "T",
+                                              "narrow phase"),
+        choice<HashFunction, &O::hash>("hash", "hash", "--hash", "-h", "hash", "H", "grid hash"),
+        number<int, &O::threads>("threads", "--threads", "--threads", "threads", "CPU threads (default: all)",
+                                 OptionType::integer, 1, 1024, nullptr, every_front_end),
+        number<int, &O::block_size>("block_size", "--block-size", "-g", "block size",
+                                    "CUDA threads per block (default 128)", OptionType::integer, 1, 1024, nullptr,
+                                    // `kdet bench -g` takes the thesis's sizes only, a few of these.
+                                    every_front_end & ~front_end_bench),
+        number<std::uint32_t, &O::bucket_capacity>(
+            "bucket_capacity", "--bucket-capacity", "--bucket-capacity", "bucket capacity",
+            "tet ids per grid bucket before an overflow bucket is chained, 1-4096\n"
+            "(default 0: chosen from the scene, 4-32)",
+            OptionType::integer, 0, max_bucket_capacity, "chosen from the scene", text_front_ends | front_end_python),
+        number<std::size_t, &O::initial_candidate_capacity>(
+            "initial_candidate_capacity", "", "", "initial candidate capacity",
+            "pairs the candidate buffer holds at first (0: sized from the tets); it grows as needed",
+            OptionType::integer, 0, no_limit, "sized from the tets", front_end_python),
+        number<bool, &O::contacts>("contacts", "", "", "contacts", "depth and direction per colliding pair",
+                                   OptionType::boolean, 0, 1, nullptr, front_end_python),
+        number<bool, &O::results_to_host>("results_to_host", "", "", "results to host",
+                                          "copy pairs, flags and contacts to the host after each frame",
+                                          OptionType::boolean, 0, 1, nullptr, front_end_python),
+    };
+    return table;
+}
+
+const OptionInfo* find_option(const std::string& name) {
+    std::string wanted = normalized(name);
+    wanted.erase(0, wanted.find_first_not_of('_'));
+    for (const OptionInfo& o : option_table())
+        if (wanted == o.name || wanted == o.field) return &o;
+    return nullptr;
+}
+
+std::string join_names(const std::vector<std::string>& names) {
+    std::string out;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        if (i) out += i + 1 == names.size() ? " or " : ", ";
+        out += names[i];
+    }
+    return out;
+}
+
+std::string invalid_value_message(const std::string& shown, const std::string& text, const std::string& expected) {
+    return "invalid value '" + text + "' for " + shown + ": expected " + expected;
+}
+
+long long parse_integer(const std::string& shown, const std::string& text, long long lo, long long hi) {
+    errno = 0;
+    char* end = nullptr;
+    const long long value = std::strtoll(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || errno == ERANGE || value < lo || value > hi)
+        throw Error(invalid_value_message(shown, text, "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]"));
+    return value;
+}
+
+std::string parse_choice(const std::string& shown, const std::string& text, const std::vector<std::string>& accepted) {
+    for (const std::string& a : accepted)
+        if (a == text) return text;
+    throw Error(invalid_value_message(shown, text, join_names(accepted)));
+}
+
+std::string OptionInfo::text(const DetectorOptions& options) const {
+    const long long value = get(options);
+    switch (type) {
+    case OptionType::choice: return names()[static_cast<std::size_t>(value)];
+    case OptionType::boolean: return value ? "true" : "false";
+    case OptionType::integer: break;
+    }
+    return std::to_string(value);
+}
+
+std::string OptionInfo::default_text() const { return text(DetectorOptions{}); }
+
+bool OptionInfo::unset_by_default() const {
+    const long long value = get(DetectorOptions{});
+    return type == OptionType::integer && (value < min || value > max);
+}
+
+std::string OptionInfo::expected() const {
+    switch (type) {
+    case OptionType::choice: return join_names(names());
+    case OptionType::boolean: return "true or false";
+    case OptionType::integer: break;
+    }
+    return "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+}
+
+std::string OptionInfo::values_help(const DetectorOptions& defaults) const {
+    if (type != OptionType::choice) return expected();
+    const std::string chosen = text(defaults);
+    std::string out;
+    for (const std::string& n : names()) out += (out.empty() ? "" : ", ") + n + (n == chosen ? " (default)" : "");
+    return out;
+}
+
+void OptionInfo::parse(const std::string& text, DetectorOptions& options, const std::string& shown) const {
+    long long value = 0;
+    switch (type) {
+    case OptionType::choice:
+        if (!read_name(text, value)) throw Error(invalid_value_message(shown, text, expected()));
+        break;
+    case OptionType::boolean: {
+        const std::string word = normalized(text);
+        if (word != "true" && word != "false") throw Error(invalid_value_message(shown, text, expected()));
+        value = word == "true";
+        break;
+    }
+    case OptionType::integer: value = parse_integer(shown, text, min, max); break;
+    }
+    put(options, value);
+}
+
+void OptionInfo::set_number(DetectorOptions& options, long long value) const {
+    if (value < min) {
+        const std::string zero = zero_means ? "0 (" + std::string(zero_means) + ") or " : "";
+        throw Error(std::string(name) + ": expected " + (min > 1 ? "a number from " + std::to_string(min) : zero + "a positive number") +
+                    ", got " + std::to_string(value));
+    }
+    if (value > max)
+        throw Error(std::string(label) + " " + std::to_string(value) + " out of range [" + std::to_string(min) + ", " +
+                    std::to_string(max) + "]");
+    put(options, value);
+}
+
 } // namespace kdet
+

@@ -12,6 +12,8 @@
 #include "viewer.hpp"
 
 #include <kdet/detector.hpp>
+#include <kdet/error.hpp>
+#include <kdet/option_table.hpp>
 #include <kdet/scenes.hpp>
 
 #include <gtest/gtest.h>
@@ -283,6 +285,27 @@ TEST(ViewArgs, MistakesAreOneLineErrors) {
     EXPECT_NE(usage_error({"--method", "fast"}).find("--method"), std::string::npos);
     EXPECT_NE(usage_error({"a", "b", "c"}).find("unexpected argument 'c'"), std::string::npos);
     EXPECT_NE(usage_error({"--bogus"}).find("unknown option '--bogus'"), std::string::npos);
+}
+
+TEST(ViewArgs, EveryDetectorOptionOfTheTableIsReadAndRefusedAsTheLibraryDoes) {
+    std::size_t shown = 0;
+    for (const OptionInfo& o : option_table()) {
+        if (!o.shown_on(front_end_view)) continue;
+        SCOPED_TRACE(o.name);
+        ++shown;
+        const std::string good = o.unset_by_default() ? std::to_string(o.min) : o.default_text();
+        EXPECT_EQ(o.text(parse({o.flag, good}).options), good);
+        const std::string bad = o.type == OptionType::choice ? "nope" : std::to_string(o.max + 1);
+        std::string expected;
+        try {
+            DetectorOptions options;
+            o.parse(bad, options, o.flag);
+        } catch (const Error& e) {
+            expected = e.what();
+        }
+        EXPECT_EQ(usage_error({o.flag, bad}), expected);
+    }
+    EXPECT_GE(shown, 7u);
 }
 
 // ---- session ----

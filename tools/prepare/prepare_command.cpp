@@ -63,11 +63,11 @@ int run_prepare(int argc, char** argv) {
     std::string surface, out;
     long long tets = 0;
 
-    ArgParser parser("prepare");
+    CommandLine parser("prepare");
     parser.positionals(thesis_models().size(), models);
-    parser.flag("--help", [&] { help = true; });
-    parser.flag("--force", [&] { force = true; });
-    parser.flag("--verbose", [&] { verbose = true; });
+    parser.flag("--help", help);
+    parser.flag("--force", force);
+    parser.flag("--verbose", verbose);
     parser.option("-r", "resolution", [&](const std::string& v) { resolutions.push_back(static_cast<int>(parse_integer("-r", v, 1, 4))); });
     parser.option("--surface", "FILE", [&](const std::string& v) { surface = v; });
     parser.option("--tets", "N", [&](const std::string& v) { tets = parse_integer("--tets", v, 1, 100000000); });
@@ -87,7 +87,11 @@ int run_prepare(int argc, char** argv) {
 
     std::vector<std::string> known;
     for (const ModelInfo& model : thesis_models()) known.push_back(model.name);
-    for (std::string& model : models) model = parse_choice("prepare", model, known);
+    try {
+        for (std::string& model : models) model = parse_choice("prepare", model, known);
+    } catch (const Error& e) {
+        throw UsageError(e.what());
+    }
     if (models.empty()) models = known;
     if (resolutions.empty()) resolutions = {1, 2, 3, 4};
 

@@ -2,42 +2,76 @@
 
 #include "viewer.hpp"
 
-#include "bench_args.hpp"
-
 #include <kdet/scenes.hpp>
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <cstdio>
-#include <functional>
+#include <limits>
 
 namespace kdet::view {
 
 namespace {
 
-/// @brief A combo box of every name of an option type (the library's table); `usable` may grey out
-/// values this machine cannot run, with the reason as a tooltip.
-template <class Option>
-bool option_combo(const char* label, Option& value, const std::function<bool(Option, std::string*)>& usable = nullptr) {
-    bool changed = false;
-    if (ImGui::BeginCombo(label, to_string(value))) {
-        for (const std::string& name : option_names<Option>()) {
-            Option v{};
-            parse(name, v);
-            std::string reason;
-            const bool enabled = !usable || usable(v, &reason);
-            if (ImGui::Selectable(name.c_str(), v == value, enabled ? 0 : ImGuiSelectableFlags_Disabled) && v != value) {
-                value = v;
-                changed = true;
+/// @brief Whether the panel lets @p option change under @p options: the hash is the grid's, the block
+/// size the GPU's, the thread count the CPU's.
+bool applies(const OptionInfo& option, const DetectorOptions& options) {
+    const std::string name = option.name;
+    if (name == "hash") return options.method == Method::kdet || options.method == Method::kdet_no_pairs;
+    if (name == "block_size") return options.backend == Backend::cuda;
+    if (name == "threads") return options.backend == Backend::cpu;
+    return true;
+}
+
+/// @brief Whether this machine can run value @p index of a choice; @p reason says why not.
+bool usable(const OptionInfo& option, long long index, std::string* reason) {
+    return std::string(option.name) != "backend" || static_cast<Backend>(index) != Backend::cuda || cuda_available(reason);
+}
+
+/// @brief The widget of one option of the library's table: a combo box of a choice's names (those this
+/// machine cannot run greyed out, the reason as a tooltip), an integer input, or a checkbox.
+bool option_widget(const OptionInfo& option, DetectorOptions& options) {
+    const long long current = option.get(options);
+    switch (option.type) {
+    case OptionType::choice: {
+        bool changed = false;
+        if (ImGui::BeginCombo(option.label, option.text(options).c_str())) {
+            const std::vector<std::string>& names = option.names();
+            for (long long i = 0; i < static_cast<long long>(names.size()); ++i) {
+                std::string reason;
+                const bool enabled = usable(option, i, &reason);
+                const std::string& name = names[static_cast<std::size_t>(i)];
+                if (ImGui::Selectable(name.c_str(), i == current, enabled ? 0 : ImGuiSelectableFlags_Disabled) && i != current) {
+                    option.put(options, i);
+                    changed = true;
+                }
+                if (!enabled && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", reason.c_str());
             }
-            if (!enabled && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("%s", reason.c_str());
+            ImGui::EndCombo();
         }
-        ImGui::EndCombo();
+        return changed;
     }
-    return changed;
+    case OptionType::boolean: {
+        bool on = current != 0;
+        if (!ImGui::Checkbox(option.label, &on)) return false;
+        option.put(options, on);
+        return true;
+    }
+    case OptionType::integer: break;
+    }
+    // An unset number (threads: OpenMP's default) shows as 0, and 0 sets it back.
+    const bool unset = current < option.min || current > option.max;
+    int value = unset ? 0 : static_cast<int>(current);
+    if (!ImGui::InputInt(option.label, &value, 1, 16, ImGuiInputTextFlags_EnterReturnsTrue)) return false;
+    if (value == 0 && option.unset_by_default()) {
+        option.put(options, option.get(DetectorOptions{}));
+    } else {
+        const long long max = std::min<long long>(option.max, std::numeric_limits<int>::max());
+        option.put(options, std::clamp<long long>(value, option.min, max));
+    }
+    return option.get(options) != current;
 }
 
 std::string mebibytes(std::size_t bytes) {
@@ -186,33 +220,13 @@ void Viewer::panel_detection() {
     ImGui::BeginDisabled(bench_job_ != nullptr);
     DetectorOptions o = session_.options();
     bool changed = false;
-    changed |= option_combo("method", o.method);
-    changed |= option_combo("narrow phase", o.narrow_phase);
-    ImGui::BeginDisabled(o.method != Method::kdet && o.method != Method::kdet_no_pairs);
-    changed |= option_combo("hash", o.hash);
-    ImGui::EndDisabled();
-    changed |= option_combo<Backend>("backend", o.backend, [](Backend b, std::string* reason) {
-        return b != Backend::cuda || cuda_available(reason);
-    });
-    ImGui::BeginDisabled(o.backend != Backend::cuda);
-    if (ImGui::BeginCombo("block size", std::to_string(o.block_size).c_str())) {
-        for (const std::string& size : cli::bench_block_sizes()) {
-            const int b = std::stoi(size);
-            if (ImGui::Selectable(size.c_str(), b == o.block_size) && b != o.block_size) {
-                o.block_size = b;
-                changed = true;
-            }
-        }
-        ImGui::EndCombo();
+    for (const OptionInfo& option : option_table()) {
+        if (!option.shown_on(front_end_panel)) continue;
+        ImGui::BeginDisabled(!applies(option, o));
+        changed |= option_widget(option, o);
+        if (*option.help && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", option.help);
+        ImGui::EndDisabled();
     }
-    ImGui::EndDisabled();
-    ImGui::BeginDisabled(o.backend != Backend::cpu);
-    int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
-    if (ImGui::SliderInt("threads", &threads, 1, std::max(omp_get_num_procs(), 1))) {
-        o.threads = threads;
-        changed = true;
-    }
-    ImGui::EndDisabled();
     if (changed) apply(o);
     ImGui::EndDisabled();
 }

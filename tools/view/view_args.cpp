@@ -3,6 +3,7 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 
+#include <kdet/error.hpp>
 #include <kdet/scenes.hpp>
 
 #include <algorithm>
@@ -86,18 +87,17 @@ float parse_float(const std::string& flag, const std::string& text, float lo, fl
     char* end = nullptr;
     const double value = std::strtod(text.c_str(), &end);
     if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(value) || value < lo || value > hi)
-        throw cli::UsageError("invalid value '" + text + "' for " + flag + ": expected a number in [" +
-                              std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        throw Error(invalid_value_message(flag, text, "a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]"));
     return static_cast<float>(value);
 }
 
 void parse_size(const std::string& text, ViewConfig& config) {
     const auto x = text.find('x');
     try {
-        if (x == std::string::npos) throw cli::UsageError("");
-        config.width = static_cast<int>(cli::parse_integer("--size", text.substr(0, x), 16, 8192));
-        config.height = static_cast<int>(cli::parse_integer("--size", text.substr(x + 1), 16, 8192));
-    } catch (const cli::UsageError&) {
+        if (x == std::string::npos) throw Error("");
+        config.width = static_cast<int>(parse_integer("--size", text.substr(0, x), 16, 8192));
+        config.height = static_cast<int>(parse_integer("--size", text.substr(x + 1), 16, 8192));
+    } catch (const Error&) {
         throw cli::UsageError("invalid value '" + text + "' for --size: expected WxH, e.g. 1280x800 (16 to 8192 each)");
     }
 }
@@ -138,57 +138,54 @@ std::array<float, 4> clip_plane(const DisplaySettings& display, const Bounds& sc
 const char* controls_help() { return controls; }
 
 std::string view_help() {
-    return std::string(help_text) + cli::detector_options_help() + display_help + "\nmouse and keys:\n" +
+    return std::string(help_text) + cli::detector_options_help(front_end_view) + display_help + "\nmouse and keys:\n" +
            wrapped(controls, 100, "  ");
 }
 
 ViewConfig parse_view_args(int argc, char** argv, int first) {
     ViewConfig config;
     std::vector<std::string> positionals;
-    std::string procedural_flag, headless_only_flag;
-    cli::ArgParser parser("view");
+    std::string procedural_flag;
+    cli::CommandLine parser("view");
     parser.positionals(2, positionals);
-    parser.flag("--help", [&] { config.help = true; });
-    parser.flag("--self", [&] { config.self = true; });
-    parser.flag("--allow-degenerate", [&] { config.source.read_options.allow_degenerate = true; });
-    cli::add_detector_options(parser, config.options);
+    parser.flag("--help", config.help);
+    parser.flag("--self", config.self);
+    parser.flag("--allow-degenerate", config.source.read_options.allow_degenerate);
+    parser.detector_options(config.options, front_end_view);
     const auto resolution = [&](const std::string& flag, const std::string& v) {
-        config.source.request.resolution = static_cast<int>(cli::parse_integer(flag, v, 1, 4));
+        config.source.request.resolution = static_cast<int>(parse_integer(flag, v, 1, 4));
     };
     parser.option("--res", "N", [&](const std::string& v) { resolution("--res", v); });
     parser.option("-r", "N", [&](const std::string& v) { resolution("-r", v); });
     parser.option("--tets", "N", [&](const std::string& v) {
-        config.source.request.procedural.total_tets = static_cast<std::size_t>(cli::parse_integer("--tets", v, 100, 20000000));
+        config.source.request.procedural.total_tets = static_cast<std::size_t>(parse_integer("--tets", v, 100, 20000000));
         if (procedural_flag.empty()) procedural_flag = "--tets";
     });
     parser.option("--scene-frames", "N", [&](const std::string& v) {
-        config.source.request.procedural.frames = static_cast<int>(cli::parse_integer("--scene-frames", v, 1, 100000));
+        config.source.request.procedural.frames = static_cast<int>(parse_integer("--scene-frames", v, 1, 100000));
         if (procedural_flag.empty()) procedural_flag = "--scene-frames";
     });
     parser.option("--frame", "N", [&](const std::string& v) {
-        config.frame = static_cast<int>(cli::parse_integer("--frame", v, 0, 1000000));
+        config.frame = static_cast<int>(parse_integer("--frame", v, 0, 1000000));
     });
     parser.option("--screenshot", "FILE", [&](const std::string& v) {
         if (v.empty()) throw cli::UsageError("invalid value '' for --screenshot: expected a file name");
         config.screenshot = v;
     });
-    parser.flag("--profile", [&] { config.profile = true; });
+    parser.flag("--profile", config.profile);
     parser.option("--size", "WxH", [&](const std::string& v) { parse_size(v, config); });
-    parser.flag("--panel", [&] {
-        config.panel = true;
-        if (headless_only_flag.empty()) headless_only_flag = "--panel";
-    });
+    parser.flag("--panel", config.panel);
     parser.option("--samples", "N", [&](const std::string& v) {
-        config.samples = std::stoi(cli::parse_choice("--samples", v, {"1", "2", "4", "8"}));
+        config.samples = std::stoi(parse_choice("--samples", v, {"1", "2", "4", "8"}));
     });
     parser.option("--opacity", "A", [&](const std::string& v) {
         config.display.surface_opacity = parse_float("--opacity", v, 0.0f, 1.0f);
     });
-    parser.flag("--only-colliding", [&] { config.display.only_colliding = true; });
-    parser.flag("--wireframe", [&] { config.display.wireframe = true; });
-    parser.flag("--normals", [&] { config.display.contact_normals = true; });
+    parser.flag("--only-colliding", config.display.only_colliding);
+    parser.flag("--wireframe", config.display.wireframe);
+    parser.flag("--normals", config.display.contact_normals);
     parser.option("--clip", "AXIS", [&](const std::string& v) {
-        const std::string axis = cli::parse_choice("--clip", v, {"x", "y", "z", "-x", "-y", "-z"});
+        const std::string axis = parse_choice("--clip", v, {"x", "y", "z", "-x", "-y", "-z"});
         config.display.clip = true;
         config.display.clip_flip = axis[0] == '-';
         config.display.clip_axis = axis.back() - 'x';
@@ -199,7 +196,7 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     parser.option("--camera", "YAW,PITCH", [&](const std::string& v) { parse_camera(v, config.camera); });
     parser.option("--zoom", "F", [&](const std::string& v) { config.camera.zoom = parse_float("--zoom", v, 0.01f, 100.0f); });
     parser.option("--focus", "colliding|all", [&](const std::string& v) {
-        config.camera.focus_colliding = cli::parse_choice("--focus", v, {"colliding", "all"}) == "colliding";
+        config.camera.focus_colliding = parse_choice("--focus", v, {"colliding", "all"}) == "colliding";
     });
     parser.parse(argc, argv, first);
     if (config.help) return config;
@@ -214,8 +211,7 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
         throw cli::UsageError("view: " + procedural_flag + " applies to the procedural scene only");
     if (!config.screenshot.empty() && config.profile)
         throw cli::UsageError("view: --screenshot and --profile are two different runs; give one");
-    if (!headless_only_flag.empty() && config.screenshot.empty())
-        throw cli::UsageError("view: " + headless_only_flag + " applies to --screenshot only");
+    if (config.panel && config.screenshot.empty()) throw cli::UsageError("view: --panel applies to --screenshot only");
     return config;
 }
 

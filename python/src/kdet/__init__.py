@@ -18,8 +18,9 @@ Frame by frame (buffers persist between frames)::
         result.pairs                      # (k, 4) uint32: object_a, tet_a, object_b, tet_b
 
 Two tets collide when their closed sets share a point; tets of one object that share a vertex are
-adjacent and never reported. Option names are those of BACKENDS, METHODS, TESTS and HASHES (any
-case, '-' or '_'). Bad input raises kdet.Error (a ValueError) with the library's one-line message;
+adjacent and never reported. OPTIONS describes every keyword of Detector (and of collide()): its
+type, default, choices or range, help, and its flags on the command line. Names are those of
+BACKENDS, METHODS, TESTS and HASHES (any case, '-' or '_'). Bad input raises kdet.Error (a ValueError) with the library's one-line message;
 wrong types raise TypeError naming the argument.
 """
 
@@ -29,10 +30,12 @@ from typing import Any, Tuple, Union
 
 import numpy as np
 
+from . import _kdet
 from ._kdet import (
     BACKENDS,
     HASHES,
     METHODS,
+    OPTIONS,
     TESTS,
     Detector,
     DeviceFrameResult,
@@ -54,6 +57,7 @@ __all__ = [
     "BACKENDS",
     "HASHES",
     "METHODS",
+    "OPTIONS",
     "TESTS",
     "Detector",
     "DeviceFrameResult",
@@ -87,30 +91,16 @@ def _as_tet_mesh(mesh: MeshLike, name: str) -> TetMesh:
     raise TypeError(f"{name}: expected a kdet.TetMesh, a meshio.Mesh or a (vertices, tets) pair, got {type(mesh).__name__}")
 
 
-def _tet_pairs(detector: Detector) -> np.ndarray:
-    if detector.options["method"] == "kdet_no_pairs":
-        raise Error("method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector.detect().colliding")
-    # Columns 1 and 3 of (object_a, tet_a, object_b, tet_b): the tet indices in each mesh's own order.
-    return np.ascontiguousarray(detector.detect().pairs[:, [1, 3]])
-
-
 def collide(a: MeshLike, b: MeshLike, **options: Any) -> np.ndarray:
     """All colliding pairs (i in a, j in b) as a (k, 2) uint32 array, sorted.
 
     options are Detector's keyword arguments (backend, method, test, hash, threads, ...)."""
-    mesh_a, mesh_b = _as_tet_mesh(a, "a"), _as_tet_mesh(b, "b")
-    detector = Detector(**options)
-    detector.add_object(mesh_a)
-    detector.add_object(mesh_b)
-    return _tet_pairs(detector)
+    return _kdet.collide(_as_tet_mesh(a, "a"), _as_tet_mesh(b, "b"), **options)
 
 
 def collide_self(mesh: MeshLike, **options: Any) -> np.ndarray:
     """All colliding pairs i < j inside one mesh (self-collision) as a (k, 2) uint32 array, sorted.
 
     Tets that share a vertex are adjacent and never reported. options are Detector's keyword arguments."""
-    tet_mesh = _as_tet_mesh(mesh, "mesh")
-    detector = Detector(**options)
-    detector.set_self_collision(detector.add_object(tet_mesh))
-    return _tet_pairs(detector)
+    return _kdet.collide_self(_as_tet_mesh(mesh, "mesh"), **options)
 
