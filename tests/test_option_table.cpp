@@ -119,11 +119,11 @@ TEST(OptionTable, KdetBenchAcceptsAndRefusesEveryOptionItShowsAsTheLibraryDoes) 
         o.parse(valid_text(o), expected, flag);
         EXPECT_EQ(o.get(bench_words({flag, valid_text(o)}).options), o.get(expected)) << flag;
         const std::string bad = invalid_text(o);
-        EXPECT_EQ(bench_refusal({flag, bad}), refusal(o, flag, bad));
+        EXPECT_EQ(bench_refusal({flag, bad}), "bench: " + refusal(o, flag, bad));
     }
     // -g keeps the thesis's block sizes, a few of those the library accepts.
     EXPECT_EQ(bench_words({"-g", "64"}).options.block_size, 64);
-    EXPECT_EQ(bench_refusal({"-g", "100"}), "invalid value '100' for -g: expected 16, 32, 64, 128 or 256");
+    EXPECT_EQ(bench_refusal({"-g", "100"}), "bench: invalid value '100' for -g: expected 16, 32, 64, 128 or 256");
 }
 
 TEST(OptionTable, KdetBenchTakesTheThesissExampleCommandUnchanged) {
@@ -165,7 +165,7 @@ TEST(OptionTable, KdetCollideAcceptsAndRefusesEveryOptionItShowsAsTheLibraryDoes
         const std::string bad = invalid_text(o);
         const CliRun refused = kdet_cli("collide " + mesh + " --self " + flag + " " + bad);
         EXPECT_EQ(refused.exit_code, 2);
-        EXPECT_EQ(refused.out, "kdet " + refusal(o, flag, bad) + "\n");
+        EXPECT_EQ(refused.out, "kdet collide: " + refusal(o, flag, bad) + "\n");
     }
 }
 #endif

@@ -72,7 +72,7 @@ void CommandLine::parse(int argc, char** argv, int first) {
     } catch (const CLI::ParseError& e) {
         throw UsageError(command_ + ": " + e.what());
     } catch (const Error& e) {
-        throw UsageError(e.what());
+        throw UsageError(command_ + ": " + e.what());
     }
     if (positionals_ && positionals_->size() > max_positionals_)
         throw UsageError(command_ + ": unexpected argument '" + (*positionals_)[max_positionals_] + "'");

@@ -68,7 +68,7 @@ def test_a_refused_name_reads_as_on_the_command_line(name, cli: Path):
     for command, flag in (("collide", entry["flag"]), ("bench", entry["bench_flag"])):
         run = subprocess.run([str(cli), command, flag, "nope"], capture_output=True, text=True)
         assert run.returncode == 2
-        assert run.stderr == "kdet " + str(refused.value).replace(f" for {name}:", f" for {flag}:") + "\n"
+        assert run.stderr == f"kdet {command}: " + str(refused.value).replace(f" for {name}:", f" for {flag}:") + "\n"
 
 
 def test_collide_takes_the_same_keywords(octopus):

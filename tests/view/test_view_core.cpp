@@ -303,7 +303,7 @@ TEST(ViewArgs, EveryDetectorOptionOfTheTableIsReadAndRefusedAsTheLibraryDoes) {
         } catch (const Error& e) {
             expected = e.what();
         }
-        EXPECT_EQ(usage_error({o.flag, bad}), expected);
+        EXPECT_EQ(usage_error({o.flag, bad}), "view: " + expected);
     }
     EXPECT_GE(shown, 7u);
 }
