@@ -98,6 +98,31 @@ TEST(Edges, PowerOfTwoScalesGiveTheSamePairsForEveryFloatTest) {
     }
 }
 
+TEST(Edges, ContactsScaleWithTheScene) {
+    // Depth and direction come from the 44-axis SAT in the pair's local frame: scaled by a power of two,
+    // the depth scales exactly and the direction stays.
+    const auto contacts = [](const MeshPair& pair) {
+        DetectorOptions options;
+        options.contacts = true;
+        Detector detector(options);
+        detector.add_object(pair.a);
+        detector.add_object(pair.b);
+        return detector.detect().contacts;
+    };
+    const std::vector<Contact> reference = contacts(octopus_pair());
+    ASSERT_GT(reference.size(), 10000u);
+    for (const double scale : {0x1p-100, 0x1p100}) {
+        SCOPED_TRACE(scale_name(scale));
+        const std::vector<Contact> scaled_contacts = contacts(scaled(octopus_pair(), scale));
+        ASSERT_EQ(scaled_contacts.size(), reference.size());
+        for (std::size_t k = 0; k < reference.size(); ++k) {
+            ASSERT_EQ(static_cast<double>(scaled_contacts[k].depth), static_cast<double>(reference[k].depth) * scale) << k;
+            for (int axis = 0; axis < 3; ++axis)
+                ASSERT_EQ(scaled_contacts[k].direction[axis], reference[k].direction[axis]) << k;
+        }
+    }
+}
+
 /// @brief kdet's pairs and flags equal brute force's with the exact test on the same float input.
 void expect_brute_force_answer(const MeshPair& pair) {
     const Answer reference = detect(pair, Method::brute_force_pairs, NarrowPhase::exact, true);
