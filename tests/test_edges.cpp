@@ -3,6 +3,7 @@
 // every size; far from the origin and across nearly all of float's range, every method gives the
 // brute-force answer of the exact test.
 
+#include "near_touching.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -119,6 +120,24 @@ TEST(Edges, ContactsScaleWithTheScene) {
             ASSERT_EQ(static_cast<double>(scaled_contacts[k].depth), static_cast<double>(reference[k].depth) * scale) << k;
             for (int axis = 0; axis < 3; ++axis)
                 ASSERT_EQ(scaled_contacts[k].direction[axis], reference[k].direction[axis]) << k;
+        }
+    }
+}
+
+TEST(Edges, NearTouchingPairsKeepEveryTestsAnswerAtEveryScale) {
+    // Pairs around the pre-test's margins and the tests' tolerance, where the float filter of the exact
+    // test and the float tests decide by the finest amounts: scaled by a power of two, each test gives the
+    // same pairs, with and without the grid.
+    const NearTouchingPairs near = near_touching_pairs(64, 11);
+    const MeshPair unit{in_float(near.first, 0.0, 1.0), in_float(near.second, 0.0, 1.0)};
+    for (const NarrowPhase test : every_narrow_phase_test()) {
+        SCOPED_TRACE(to_string(test));
+        const std::vector<TetPair> reference = detect(unit, Method::brute_force_loop, test, false).pairs;
+        EXPECT_GT(reference.size(), 20u);
+        for (const double scale : {0x1p-100, 0x1p-60, 0x1p60, 0x1p100}) {
+            const MeshPair pair = scaled(unit, scale);
+            EXPECT_EQ(detect(pair, Method::brute_force_loop, test, false).pairs, reference) << scale_name(scale);
+            EXPECT_EQ(detect(pair, Method::kdet, test, false).pairs, reference) << scale_name(scale);
         }
     }
 }
