@@ -81,6 +81,16 @@ options = st.fixed_dictionaries({
 })
 
 
+def solid_only(mesh: kdet.TetMesh) -> kdet.TetMesh | None:
+    """The mesh's tets of clearly non-zero volume (as the readers' check), or None when there is none."""
+    v = mesh.vertices[mesh.tets.astype(np.int64)]
+    e = v[:, 1:] - v[:, :1]
+    volume = np.abs(np.einsum("ij,ij->i", e[:, 0], np.cross(e[:, 1], e[:, 2])))
+    longest = np.linalg.norm(v[:, :, None] - v[:, None, :], axis=-1).max(axis=(1, 2))
+    keep = volume > 1e-6 * longest**3
+    return kdet.TetMesh(mesh.vertices, mesh.tets[keep]) if keep.any() else None
+
+
 def exactly_scaled(mesh: kdet.TetMesh, exponent: int) -> kdet.TetMesh | None:
     """The mesh times 2^exponent in float32, or None where that is not exact (a coordinate would be subnormal)."""
     v = mesh.vertices.astype(np.float32)
@@ -102,7 +112,13 @@ def test_every_method_gives_the_brute_force_answer(a, b, chosen, self_a, self_b)
 @given(a=soups(), b=soups(), test=st.sampled_from(kdet.TESTS), hash=st.sampled_from(kdet.HASHES),
        exponent=st.sampled_from([-90, 0, 90]))
 def test_the_grid_gives_brute_force_pairs_for_every_test(a, b, test, hash, exponent):
-    # Whatever the test, the grid and its pre-tests change no answer of it, at any size.
+    # Whatever the test, the grid and its pre-tests change no answer of it, at any size. The float tests
+    # get tets of non-zero volume only: on a zero-volume tet they find too few axes and may call pairs
+    # far apart colliding, which the pre-test separates (a point and a segment 0.18 apart: sat, sat_mtv
+    # and fast say colliding under brute force, not in the grid).
+    if test != "exact":
+        a, b = solid_only(a), solid_only(b)
+        hypothesis.assume(a is not None and b is not None)
     sa, sb = exactly_scaled(a, exponent), exactly_scaled(b, exponent)
     hypothesis.assume(sa is not None and sb is not None)
     assert_same("kdet", detect([sa, sb], method="kdet", test=test, hash=hash, self_collision=[0]),
