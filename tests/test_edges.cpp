@@ -9,6 +9,7 @@
 #include <kdet/detector.hpp>
 
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -155,6 +156,36 @@ TEST(Edges, NearTheLargestFloatEveryMethodGivesTheExactAnswer) {
     expect_brute_force_answer(scaled(octopus_pair(), 6e38));
     // 1e22: the size at which every pair was lost while squared sizes overflowed.
     expect_brute_force_answer(scaled(octopus_pair(), 1e22));
+}
+
+TEST(Edges, TetsWhoseEdgesOverflowFloatGiveTheExactAnswer) {
+    // Random tets with coordinates up to 3e38 of both signs, whose edges no float holds, beside small
+    // tets at the origin: the face-plane pre-test once took such a pair's longest edge from the small
+    // tet alone (the large one's was NaN) and proved pairs 4e37 apart intersecting.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> huge(-3e38, 3e38), size(0.1, 1.0);
+    MeshPair pair;
+    for (std::uint32_t t = 0; t < 40; ++t) {
+        for (int k = 0; k < 4; ++k)
+            for (int axis = 0; axis < 3; ++axis) pair.a.positions.push_back(static_cast<float>(huge(rng)));
+        const double s = size(rng);
+        const double corner[4][3] = {{0, 0, 0}, {s, 0, 0}, {0, s, 0}, {0, 0, s}};
+        for (const auto& c : corner)
+            for (const double x : c) pair.b.positions.push_back(static_cast<float>(x + 2.0 * (t % 4)));
+        for (std::uint32_t k = 0; k < 4; ++k) {
+            pair.a.tets.push_back(4 * t + k);
+            pair.b.tets.push_back(4 * t + k);
+        }
+    }
+    const Answer reference = detect(pair, Method::brute_force_pairs, NarrowPhase::exact, true);
+    EXPECT_GT(reference.pairs.size(), 10u);
+    for (const Method method : {Method::kdet, Method::kdet_no_pairs, Method::brute_force_loop}) {
+        const Answer found = detect(pair, method, NarrowPhase::exact, true);
+        if (method != Method::kdet_no_pairs) {
+            EXPECT_EQ(found.pairs, reference.pairs) << to_string(method);
+        }
+        EXPECT_EQ(found.colliding, reference.colliding) << to_string(method);
+    }
 }
 
 TEST(Edges, SubnormalCoordinatesGiveTheExactAnswer) {

@@ -1,6 +1,6 @@
 """Property-based tests (Hypothesis): random tet soups, meshes with shared and coincident vertices,
-slivers and zero-volume tets, scales from 1e-30 to 1e30 and offsets to 1e7, random options and random
-sequences of frames on one Detector.
+slivers and zero-volume tets, scales from 1e-30 to 3e38 (where tets' edges overflow float) and offsets
+to 1e7, random options and random sequences of frames on one Detector.
 
 The oracle is the brute-force method with the exact test on the same float32 coordinates, and, for a
 scene scaled by a power of two (exact in float32 while nothing becomes subnormal), the answer for the
@@ -142,8 +142,23 @@ def test_two_tets_scaled_by_2_to_the_100_keep_their_pairs():
                     ({(0, 0, 1, 0)}, [np.ones(1, bool), np.ones(1, bool)]))
 
 
+def test_tets_whose_edges_overflow_float_keep_the_exact_answer():
+    # Regression (found by a longer random search): tets with coordinates up to 3e38 of both signs beside
+    # small tets; the face-plane pre-test took such a pair's longest edge from the small tet alone and
+    # proved pairs 4e37 apart intersecting.
+    rng = np.random.default_rng(7)
+    tets = np.arange(160, dtype=np.uint32).reshape(40, 4)
+    large = kdet.TetMesh(rng.uniform(-3e38, 3e38, (160, 3)).astype(np.float32).astype(np.float64), tets,
+                         allow_degenerate=True)
+    corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], np.float64)
+    small = kdet.TetMesh(np.vstack([corners * rng.uniform(0.1, 1) + 2 * (t % 4) for t in range(40)]), tets)
+    reference = detect([large, small], self_collision=[0])
+    for method in kdet.METHODS:
+        assert_same(method, detect([large, small], method=method, self_collision=[0]), reference)
+
+
 @PROPERTY
-@given(a=soups(), b=soups(), decade=st.floats(-30, 30), offset=st.tuples(*[st.floats(-1e7, 1e7)] * 3),
+@given(a=soups(), b=soups(), decade=st.floats(-30, 38.2), offset=st.tuples(*[st.floats(-1e7, 1e7)] * 3),
        chosen=options)
 def test_any_scale_and_offset_gives_the_brute_force_answer(a, b, decade, offset, chosen):
     def moved(mesh):
