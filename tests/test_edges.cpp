@@ -188,6 +188,23 @@ TEST(Edges, TetsWhoseEdgesOverflowFloatGiveTheExactAnswer) {
     }
 }
 
+TEST(Edges, SegmentsLongerThanTheLargestFloatGiveTheExactAnswer) {
+    // Found by the property tests: zero-volume tets (segments) through the origin whose lengths exceed
+    // the largest float. Every size was infinite, which read as no tet at all (the pair was lost), or
+    // the region was wider than the largest float and a box spanned 2^30 cells per axis (out of memory).
+    const auto segment = [](double x, double y, double z, double u, double v, double w) {
+        return TetMesh{{x, y, z, x, y, z, x, y, z, u, v, w}, {0, 1, 2, 3}};
+    };
+    const MeshPair crossing{segment(0, 0, 0, 0, 1.5399265e38, 3.0798531e38), segment(0, 0, 1.9249082e38, 0, 0, -1.5399265e38)};
+    const MeshPair touching{segment(0, 0, 0, 0, 0, 2.6670430e38), segment(0, 0, 0, 0, 0, -1.0001410e38)};
+    for (const MeshPair* pair : {&crossing, &touching}) {
+        const Answer reference = detect(*pair, Method::brute_force_pairs, NarrowPhase::exact, true);
+        EXPECT_EQ(reference.pairs.size(), 1u);
+        EXPECT_EQ(detect(*pair, Method::kdet, NarrowPhase::exact, true).pairs, reference.pairs);
+        EXPECT_EQ(detect(*pair, Method::kdet_no_pairs, NarrowPhase::exact, true).colliding, reference.colliding);
+    }
+}
+
 TEST(Edges, SubnormalCoordinatesGiveTheExactAnswer) {
     // Edges of about 2^-147: every coordinate is subnormal, and the input no longer the octopus exactly.
     expect_brute_force_answer(scaled(octopus_pair(), 0x1p-140));

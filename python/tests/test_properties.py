@@ -5,7 +5,7 @@ to 1e7, random options and random sequences of frames on one Detector.
 The oracle is the brute-force method with the exact test on the same float32 coordinates, and, for a
 scene scaled by a power of two (exact in float32 while nothing becomes subnormal), the answer for the
 unscaled scene. Runs are derandomized (the same examples every run) and bounded to a few seconds per
-property. A failing example that Hypothesis found is kept below as a plain test.
+property. Failing examples that Hypothesis found are kept below as plain tests.
 """
 
 from __future__ import annotations
@@ -155,6 +155,20 @@ def test_tets_whose_edges_overflow_float_keep_the_exact_answer():
     reference = detect([large, small], self_collision=[0])
     for method in kdet.METHODS:
         assert_same(method, detect([large, small], method=method, self_collision=[0]), reference)
+
+
+def test_segments_longer_than_the_largest_float_keep_their_pair():
+    # Regression (found by the arbitrary-scale property in a longer run): zero-volume tets through the
+    # origin whose lengths exceed the largest float; the pair was lost, or the frame ran out of memory.
+    def segment(end_a, end_b):
+        return kdet.TetMesh([end_a, end_a, end_a, end_b], [[0, 1, 2, 3]], allow_degenerate=True)
+
+    for a, b in [(segment([0, 0, 0], [0, 1.5399265e38, 3.0798531e38]), segment([0, 0, 1.9249082e38], [0, 0, -1.5399265e38])),
+                 (segment([0, 0, 0], [0, 0, 2.6670430e38]), segment([0, 0, 0], [0, 0, -1.0001410e38]))]:
+        reference = detect([a, b])
+        assert reference[0] == {(0, 0, 1, 0)}
+        for method in kdet.METHODS:
+            assert_same(method, detect([a, b], method=method), reference)
 
 
 @PROPERTY
