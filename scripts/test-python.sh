@@ -4,8 +4,8 @@
 # pytest runs python/tests, which compare the pairs with those of the C++ command build/kdet (or
 # $KDET_CLI) on the models in ../shared/models (or $KDET_DATA_DIR). Both pip calls share one CMake
 # build folder (build-python/cmake), so the library is compiled once (--config-settings, not -C: Debian's
-# pip 23.0 lacks the short form). pytest, meshio and matplotlib come from PyPI. Extra arguments go to
-# pytest.
+# pip 23.0 lacks the short form). pytest, Hypothesis (the property-based tests), meshio and matplotlib
+# come from PyPI. Extra arguments go to pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$PATH:/usr/local/cuda/bin"
@@ -18,7 +18,7 @@ rm -rf "$venv" build-python/dist
 python3 -m venv "$venv"
 python=("$venv/bin/python")
 pip=("${python[@]}" -m pip --disable-pip-version-check)
-"${pip[@]}" install -q --timeout 60 pytest meshio matplotlib
+"${pip[@]}" install -q --timeout 60 pytest hypothesis meshio matplotlib
 # Warnings are errors here as in build/ (the bindings are held to them too), which also keeps the library's
 # compile commands equal to build/'s for a compiler cache (scripts/compiler-cache.sh).
 settings=(--config-settings=build-dir=build-python/cmake --config-settings=cmake.define.KDET_WARNINGS_AS_ERRORS=ON)

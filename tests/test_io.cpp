@@ -492,6 +492,17 @@ TEST(IoErrors, NonFiniteCoordinates) {
     expect_file_error([&] { kdet::read_tetgen(node); }, node, 4, "coordinate 'nan' is not finite");
 }
 
+TEST(IoErrors, CoordinatesBeyondFloatRange) {
+    // Finite doubles that float32 cannot hold: refused where read, not later as a zero-volume tet.
+    TempDir dir;
+    const std::string path = dir.write("huge.mesh", two_tets_medit_with("0 0 1 0", "0 0 1e39 0"));
+    expect_file_error([&] { kdet::read_medit(path); }, path, 8,
+                      "coordinate '1e39' is beyond float range (|x| <= 3.4e38: positions are float32)");
+    // The largest float itself is accepted.
+    const std::string largest = dir.write("largest.mesh", two_tets_medit_with("0 0 1 0", "0 0 3.4028235e38 0"));
+    EXPECT_NO_THROW(kdet::read_tet_mesh(largest, kdet::ReadOptions{true}));
+}
+
 TEST(IoErrors, DuplicatePointIndex) {
     TempDir dir;
     const std::string node =
@@ -611,6 +622,9 @@ TEST(IoValidate, NamesTheTetOrVertex) {
     not_finite.positions[3 * 3 + 1] = std::nan("");
     EXPECT_EQ(error_message([&] { kdet::validate_tet_mesh(not_finite, "scene"); }),
               "scene: vertex 3: coordinate y is not finite (nan)");
+    not_finite.positions[3 * 3 + 1] = -1e39;
+    EXPECT_EQ(error_message([&] { kdet::validate_tet_mesh(not_finite, "scene"); }),
+              "scene: vertex 3: coordinate y (-1e+39) is beyond float range (|x| <= 3.4e38: positions are float32)");
 
     kdet::TetMesh repeated = two_tets();
     repeated.tets[6] = repeated.tets[4];

@@ -8,9 +8,15 @@
 
 #include "geometry/vec3.hpp"
 
+#include <cfloat>
+#include <cmath>
+
 namespace kdet {
 
 namespace sphere_detail {
+
+/// @brief local_frame's answer for a tet whose coordinate differences overflow float.
+constexpr int sphere_unbounded = 1000;
 
 struct Candidate {
     vec3 center;
@@ -33,11 +39,22 @@ KDET_HD inline void consider(const vec3 p[4], vec3 center, float radius_squared,
     best = Candidate{center, radius_squared, true};
 }
 
-/// @brief The points in a frame whose origin is the first of them: the formulas stay accurate far
-/// from the origin.
-KDET_HD inline void local_frame(const vec3 v[4], vec3 p[4]) {
+/// @brief The points in a frame whose origin is the first of them, scaled by the power of two that
+/// brings their largest coordinate into [1/2, 1): the formulas stay accurate far from the origin, and
+/// no square overflows or underflows, however large or small the tet. Returns the exponent that
+/// undoes the scaling, or sphere_unbounded when a coordinate difference overflows (or is not finite).
+KDET_HD inline int local_frame(const vec3 v[4], vec3 p[4]) {
     p[0] = make_vec3(0.0f, 0.0f, 0.0f);
-    for (int k = 1; k < 4; ++k) p[k] = v[k] - v[0];
+    float largest = 0.0f;
+    for (int k = 1; k < 4; ++k) {
+        p[k] = v[k] - v[0];
+        largest = max_f(largest, max_abs(p[k]));
+    }
+    if (!(largest <= FLT_MAX)) return sphere_unbounded;
+    int exponent = 0;
+    frexpf(largest, &exponent);
+    for (int k = 1; k < 4; ++k) p[k] = times_power_of_two(p[k], -exponent);
+    return exponent;
 }
 
 KDET_HD inline float longest_edge_squared(const vec3 p[4]) {
@@ -50,11 +67,14 @@ KDET_HD inline float longest_edge_squared(const vec3 p[4]) {
 } // namespace sphere_detail
 
 /// @brief Diameter of the smallest sphere enclosing the four points (never smaller than the true one
-/// by more than rounding, never larger than the longest-edge bound sqrt(3) * true diameter).
+/// by more than rounding, never larger than the longest-edge bound sqrt(3) * true diameter), or the
+/// largest float where no float holds it: the grid needs sizes only monotone, and finite (an infinite
+/// smallest size would read as no tet at all).
 KDET_HD inline float enclosing_sphere_diameter(const vec3 v[4]) {
     using sphere_detail::consider;
     vec3 p[4];
-    sphere_detail::local_frame(v, p);
+    const int exponent = sphere_detail::local_frame(v, p);
+    if (exponent == sphere_detail::sphere_unbounded) return FLT_MAX;
     const float scale_squared = sphere_detail::longest_edge_squared(p);
 
     sphere_detail::Candidate best{make_vec3(0.0f, 0.0f, 0.0f), 3.4e38f, false};
@@ -86,14 +106,16 @@ KDET_HD inline float enclosing_sphere_diameter(const vec3 v[4]) {
     vec3 center = best.center;
     if (!best.valid) center = (p[0] + p[1] + p[2] + p[3]) * 0.25f; // only for non-finite input
     const float radius = sqrtf(sphere_detail::farthest_squared(p, center));
-    return 2.0f * radius * (1.0f + 4.0f * 1.1920929e-7f);
+    return min_f(times_power_of_two(2.0f * radius * (1.0f + 4.0f * 1.1920929e-7f), exponent), FLT_MAX);
 }
 
-/// @brief The longest edge of the tet, in the frame enclosing_sphere_diameter computes in.
+/// @brief The longest edge of the tet, in the frame enclosing_sphere_diameter computes in (at most the
+/// largest float, as that).
 KDET_HD inline float longest_edge(const vec3 v[4]) {
     vec3 p[4];
-    sphere_detail::local_frame(v, p);
-    return sqrtf(sphere_detail::longest_edge_squared(p));
+    const int exponent = sphere_detail::local_frame(v, p);
+    if (exponent == sphere_detail::sphere_unbounded) return FLT_MAX;
+    return min_f(times_power_of_two(sqrtf(sphere_detail::longest_edge_squared(p)), exponent), FLT_MAX);
 }
 
 /// @brief Bounds on enclosing_sphere_diameter from the tet's longest edge D. The sphere holds both ends

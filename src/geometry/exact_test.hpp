@@ -80,28 +80,52 @@ struct FilterPair {
 KDET_HD inline float norm1(vec3 v) { return fabsf(v.x) + fabsf(v.y) + fabsf(v.z); }
 KDET_HD inline vec3 abs_v(vec3 v) { return {fabsf(v.x), fabsf(v.y), fabsf(v.z)}; }
 
+/// @brief Below this largest coordinate of the translated pair, make_filter_pair scales the pair up.
+constexpr float k_float_tiny = 0x1p-30f;
+
 /// @brief Fills f; false when the coordinates are too large for the float level (k_float_range).
+/// A tiny pair, whose products would underflow and leave every axis to the double level, is scaled
+/// up by the power of two that brings its largest translated coordinate into [1/2, 1) first: each
+/// row is then still one rounded difference of the input points (times that power, exactly, since
+/// scaling up loses no bit), and no determinant changes its sign, so the bounds above hold as they do
+/// at ordinary sizes.
 KDET_HD inline bool make_filter_pair(const vec3 a[4], const vec3 b[4], FilterPair& f) {
     const vec3 origin = a[0];
-    vec3 extent{0.0f, 0.0f, 0.0f};
+    float largest = 0.0f;
     for (int i = 0; i < 4; ++i) {
         f.a[i] = a[i] - origin;
         f.b[i] = b[i] - origin;
-        extent = max_v(extent, max_v(abs_v(f.a[i]), abs_v(f.b[i])));
+        largest = max_f(largest, max_f(max_abs(f.a[i]), max_abs(f.b[i])));
     }
-    float longest = 0.0f;
     for (int k = 0; k < 6; ++k) {
         f.edge_a[k] = a[edge_second(k)] - a[edge_first(k)];
         f.edge_b.set(k, b[edge_second(k)] - b[edge_first(k)]);
+    }
+    if (largest < k_float_tiny && largest > 0.0f) {
+        int exponent = 0;
+        frexpf(largest, &exponent);
+        for (int i = 0; i < 4; ++i) {
+            f.a[i] = times_power_of_two(f.a[i], -exponent);
+            f.b[i] = times_power_of_two(f.b[i], -exponent);
+        }
+        for (int k = 0; k < 6; ++k) {
+            f.edge_a[k] = times_power_of_two(f.edge_a[k], -exponent);
+            f.edge_b.set(k, times_power_of_two(f.edge_b[k], -exponent));
+        }
+    }
+    vec3 extent{0.0f, 0.0f, 0.0f};
+    for (int i = 0; i < 4; ++i) extent = max_v(extent, max_v(abs_v(f.a[i]), abs_v(f.b[i])));
+    float longest = 0.0f;
+    for (int k = 0; k < 6; ++k) {
         f.norm_a[k] = norm1(f.edge_a[k]);
         f.norm_b[k] = norm1(f.edge_b[k]);
         longest = max_f(longest, max_f(f.norm_a[k], f.norm_b[k]));
     }
     f.edge_b.pad(f.norm_b);
-    const float largest = max_f(extent.x, max_f(extent.y, extent.z));
-    f.relative = k_float_gap_bound * largest;
+    const float span = max_f(extent.x, max_f(extent.y, extent.z));
+    f.relative = k_float_gap_bound * span;
     f.absolute = k_float_smallest * (8.0f * (extent.x + extent.y + extent.z) + 16.0f);
-    return longest * longest * largest < k_float_range; // false for non-finite values too
+    return longest * longest * span < k_float_range; // false for non-finite values too
 }
 
 /// @brief What the float level knows about one axis.

@@ -49,7 +49,8 @@
 ///
 /// The bounds need every intermediate value normal: a tet is used only when its coordinates relative
 /// to its vertex 0 lie within [2^-60, 2^60] in magnitude and its shortest edge is at least 2^-20 of
-/// its longest (a thinner tet's margin exceeds what any pair could show anyway). Its normals are built
+/// its longest (a thinner tet's margin exceeds what any pair could show anyway), and a pair is decided
+/// only when both tets' longest edges are at most 2^100 (a tet whose edges overflow float has none). Its normals are built
 /// from the edges scaled by a power of two (exact), so no square underflows or overflows. Every face of
 /// an unused tet, and every face too thin to give a normal, gets an infinite separation scale: every
 /// margin involving it is infinite or NaN, and decides nothing.
@@ -79,6 +80,9 @@ constexpr int k_plane_exponent_range = 60;
 
 /// @brief ... and its shortest edge is at least this fraction of its longest.
 constexpr float k_plane_min_edge_ratio = 0x1p-20f;
+
+/// @brief A pair decides something only when both tets' longest edges are at most this.
+constexpr float k_plane_longest_limit = 0x1p100f;
 
 /// @brief The four face planes of one tet, relative to its vertex 0, coordinate by coordinate so that
 /// the four faces are evaluated together (vector instructions on the CPU).
@@ -288,6 +292,10 @@ enum class PlaneVerdict { unsure, separated, intersecting };
 /// id order). With `separation_only`, an intersection is not looked for (the caller only rejects).
 KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
                                                const vec3 b[4], bool separation_only) {
+    // The margins bound the rounding only while the pair's longest edge, and so every distance, is a
+    // normal float far from overflow; a tet whose edges overflow has a NaN longest edge, which max_f
+    // could drop in favour of the other tet's.
+    if (!(pa.longest <= k_plane_longest_limit && pb.longest <= k_plane_longest_limit)) return PlaneVerdict::unsure;
     const float longest = max_f(pa.longest, pb.longest);
     const PlaneSides a_by_b = plane_sides(pb, a, longest);
     if (a_by_b.separated) return PlaneVerdict::separated;

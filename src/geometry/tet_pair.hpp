@@ -75,7 +75,8 @@ KDET_HD inline int edge_first(int k) { return k < 3 ? 0 : (k < 5 ? 1 : 2); }
 KDET_HD inline int edge_second(int k) { return k < 3 ? k + 1 : (k < 5 ? k - 1 : 3); }
 
 /// @brief Fills p with the pair in the local frame. Returns false when every edge of both tets has
-/// zero length (two points), where no frame of unit size exists.
+/// zero length (two points), where no frame of unit size exists. Tets of any size whose edges are
+/// finite floats get the same frame as the same tets scaled by a power of two.
 KDET_HD inline bool make_local_pair(const vec3 a[4], const vec3 b[4], LocalPair& p) {
     const vec3 origin = a[0];
     for (int i = 0; i < 4; ++i) {
@@ -88,9 +89,31 @@ KDET_HD inline bool make_local_pair(const vec3 a[4], const vec3 b[4], LocalPair&
         p.edge_b.set(k, p.b[edge_second(k)] - p.b[edge_first(k)]);
         longest2 = max_f(longest2, max_f(length_squared(p.edge_a[k]), length_squared(p.edge_b[k])));
     }
-    if (!(longest2 > 0.0f)) return false;
-    p.scale = sqrtf(longest2);
-    const float inverse = 1.0f / p.scale;
+    // Where a square may have under- or overflowed, the pair is first scaled by the power of two that
+    // brings its largest edge coordinate into [1/2, 1) (exact, as is every later step's rounding, which
+    // scales with it): then the answer does not depend on the pair's size.
+    int exponent = 0;
+    if (!(longest2 >= 0x1p-100f && longest2 <= 0x1p100f)) {
+        float largest = 0.0f;
+        for (int k = 0; k < 6; ++k) largest = max_f(largest, max_f(max_abs(p.edge_a[k]), max_abs(p.edge_b[k])));
+        if (!(largest > 0.0f)) return false;
+        if (largest <= 3.4028235e38f) {
+            frexpf(largest, &exponent);
+            for (int i = 0; i < 4; ++i) {
+                p.a[i] = times_power_of_two(p.a[i], -exponent);
+                p.b[i] = times_power_of_two(p.b[i], -exponent);
+            }
+            longest2 = 0.0f;
+            for (int k = 0; k < 6; ++k) {
+                p.edge_a[k] = times_power_of_two(p.edge_a[k], -exponent);
+                p.edge_b.set(k, times_power_of_two(p.edge_b[k], -exponent));
+                longest2 = max_f(longest2, max_f(length_squared(p.edge_a[k]), length_squared(p.edge_b[k])));
+            }
+        }
+    }
+    const float local_scale = sqrtf(longest2);
+    p.scale = times_power_of_two(local_scale, exponent);
+    const float inverse = 1.0f / local_scale;
     for (int i = 0; i < 4; ++i) {
         p.a[i] = p.a[i] * inverse;
         p.b[i] = p.b[i] * inverse;

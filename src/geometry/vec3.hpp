@@ -95,6 +95,11 @@ KDET_HD inline vec3 cross(vec3 a, vec3 b) {
 KDET_HD inline float length_squared(vec3 a) { return dot(a, a); }
 KDET_HD inline float min_f(float a, float b) { return a < b ? a : b; }
 KDET_HD inline float max_f(float a, float b) { return a > b ? a : b; }
+KDET_HD inline float max_abs(vec3 a) { return max_f(fabsf(a.x), max_f(fabsf(a.y), fabsf(a.z))); }
+/// @brief a * 2^exponent coordinate by coordinate (times_power_of_two).
+KDET_HD inline vec3 times_power_of_two(vec3 a, int exponent) {
+    return {times_power_of_two(a.x, exponent), times_power_of_two(a.y, exponent), times_power_of_two(a.z, exponent)};
+}
 KDET_HD inline vec3 min_v(vec3 a, vec3 b) { return {min_f(a.x, b.x), min_f(a.y, b.y), min_f(a.z, b.z)}; }
 KDET_HD inline vec3 max_v(vec3 a, vec3 b) { return {max_f(a.x, b.x), max_f(a.y, b.y), max_f(a.z, b.z)}; }
 KDET_HD inline float component(vec3 a, int axis) { return axis == 0 ? a.x : (axis == 1 ? a.y : a.z); }

@@ -60,8 +60,10 @@ KDET_HD inline float layer_scale(int layer) { return power_of_two(-layer); }
 
 /// @brief Cell index along one axis on `layer`; monotone in x, clamped, and safe for NaN.
 KDET_HD inline std::uint32_t cell_index(const GridParams& grid, float x, float origin, int layer) {
-    // Scaling by a power of two keeps the map monotone, which the completeness argument needs.
-    float scaled = (x - origin) * grid.inv_cell_size0 * layer_scale(layer);
+    // Scaling by a power of two keeps the map monotone, which the completeness argument needs. Halved
+    // first (exact but for subnormals, and monotone), the difference cannot overflow: across a region
+    // wider than the largest float it became infinite, and a box spanned 2^30 cells per axis.
+    float scaled = (x * 0.5f - origin * 0.5f) * (grid.inv_cell_size0 * 2.0f) * layer_scale(layer);
     const float limit = 1073741824.0f; // 2^30: stays exact and inside uint32
     if (!(scaled >= 0.0f)) scaled = 0.0f;
     if (scaled > limit) scaled = limit;

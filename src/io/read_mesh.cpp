@@ -336,6 +336,9 @@ void validate_tet_mesh(const TetMesh& mesh, const std::string& source, const Rea
                 fail("vertex " + std::to_string(v) + ": coordinate " + "xyz"[axis] + " is not finite (" +
                      short_number(value) + ")");
             }
+            if (!fits_float(value))
+                fail("vertex " + std::to_string(v) + ": coordinate " + "xyz"[axis] + " (" + short_number(value) + ") is " +
+                     float_range);
         }
     }
     for (std::size_t t = 0; t < mesh.num_tets(); ++t) {

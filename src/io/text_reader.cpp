@@ -275,6 +275,7 @@ double read_coordinate(const TextFile& file, const Token& token) {
     case NumberParse::ok: break;
     }
     if (!std::isfinite(value)) file.fail(token, "coordinate " + excerpt(token.text) + " is not finite");
+    if (!fits_float(value)) file.fail(token, "coordinate " + excerpt(token.text) + " is " + float_range);
     return value;
 }
 
@@ -386,6 +387,7 @@ double NumberStream::coordinate(Scalar type) {
     }
     const double value = real(type, "a coordinate");
     if (!std::isfinite(value)) fail("coordinate " + short_number(value) + " is not finite");
+    if (!fits_float(value)) fail("coordinate " + short_number(value) + " is " + float_range);
     return value;
 }
 

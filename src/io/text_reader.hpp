@@ -33,6 +33,11 @@ std::string excerpt(std::string_view text);
 /// @brief A double for a message, with 3 significant digits.
 std::string short_number(double value);
 
+/// @brief Whether a coordinate read as a double stays finite as the float32 the detector stores (from
+/// 2^128 - 2^103 on, a double rounds to infinity); float_range names that range in messages.
+inline bool fits_float(double value) { return value < 0x1.ffffffp127 && value > -0x1.ffffffp127; }
+constexpr const char* float_range = "beyond float range (|x| <= 3.4e38: positions are float32)";
+
 /// @brief The whole content of @p path; throws "path: cannot open file" and the like.
 std::string load_file(const std::string& path);
 
