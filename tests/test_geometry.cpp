@@ -128,4 +128,20 @@ TEST(PowerOfTwo, ScalesAsLdexpfRoundsWhereTheFirstHalfStepIsExact) {
     for (int exponent = -126; exponent <= 127; ++exponent) ASSERT_EQ(power_of_two(exponent), std::ldexp(1.0f, exponent));
 }
 
+TEST(PowerOfTwo, FrexpExponentIsFrexpfsForEveryFiniteFloat) {
+    // Every binary exponent, normal and subnormal, each with a few mantissas and both signs.
+    for (int e = -149; e <= 127; ++e)
+        for (const float m : {1.0f, 1.5f, 1.9999999f})
+            for (const float sign : {1.0f, -1.0f}) {
+                const float x = sign * std::ldexp(m, e);
+                if (x == 0.0f || !std::isfinite(x)) continue;
+                int expected = 0;
+                std::frexp(x, &expected);
+                ASSERT_EQ(frexp_exponent(x), expected) << x;
+            }
+    EXPECT_EQ(frexp_exponent(0.0f), 0);
+    EXPECT_EQ(frexp_exponent(FLT_MAX), 128);
+    EXPECT_EQ(frexp_exponent(FLT_TRUE_MIN), -148);
+}
+
 } // namespace kdet

@@ -39,10 +39,13 @@ KDET_HD inline void consider(const vec3 p[4], vec3 center, float radius_squared,
     best = Candidate{center, radius_squared, true};
 }
 
-/// @brief The points in a frame whose origin is the first of them, scaled by the power of two that
-/// brings their largest coordinate into [1/2, 1): the formulas stay accurate far from the origin, and
-/// no square overflows or underflows, however large or small the tet. Returns the exponent that
-/// undoes the scaling, or sphere_unbounded when a coordinate difference overflows (or is not finite).
+/// @brief The points in a frame whose origin is the first of them: the formulas stay accurate far from
+/// the origin. A tet whose largest coordinate difference lies outside [2^-16, 2^16] is also scaled by
+/// the power of two that brings it into [1/2, 1), so that no product of the formulas (up to the fifth
+/// power of a length) overflows or underflows, however large or small the tet; inside that range the
+/// scaling would change no bit of the result (it is exact), so it is skipped. Returns the exponent that
+/// undoes the scaling (0 when unscaled), or sphere_unbounded when a coordinate difference overflows
+/// (or is not finite).
 KDET_HD inline int local_frame(const vec3 v[4], vec3 p[4]) {
     p[0] = make_vec3(0.0f, 0.0f, 0.0f);
     float largest = 0.0f;
@@ -50,11 +53,16 @@ KDET_HD inline int local_frame(const vec3 v[4], vec3 p[4]) {
         p[k] = v[k] - v[0];
         largest = max_f(largest, max_abs(p[k]));
     }
+    if (largest >= 0x1p-16f && largest <= 0x1p16f) return 0;
     if (!(largest <= FLT_MAX)) return sphere_unbounded;
-    int exponent = 0;
-    frexpf(largest, &exponent);
+    const int exponent = frexp_exponent(largest);
     for (int k = 1; k < 4; ++k) p[k] = times_power_of_two(p[k], -exponent);
     return exponent;
+}
+
+/// @brief A length computed in local_frame's frame, in the caller's: at most the largest float.
+KDET_HD inline float unscaled_length(float length, int exponent) {
+    return exponent == 0 ? length : min_f(times_power_of_two(length, exponent), FLT_MAX);
 }
 
 KDET_HD inline float longest_edge_squared(const vec3 p[4]) {
@@ -106,7 +114,7 @@ KDET_HD inline float enclosing_sphere_diameter(const vec3 v[4]) {
     vec3 center = best.center;
     if (!best.valid) center = (p[0] + p[1] + p[2] + p[3]) * 0.25f; // only for non-finite input
     const float radius = sqrtf(sphere_detail::farthest_squared(p, center));
-    return min_f(times_power_of_two(2.0f * radius * (1.0f + 4.0f * 1.1920929e-7f), exponent), FLT_MAX);
+    return sphere_detail::unscaled_length(2.0f * radius * (1.0f + 4.0f * 1.1920929e-7f), exponent);
 }
 
 /// @brief The longest edge of the tet, in the frame enclosing_sphere_diameter computes in (at most the
@@ -115,7 +123,7 @@ KDET_HD inline float longest_edge(const vec3 v[4]) {
     vec3 p[4];
     const int exponent = sphere_detail::local_frame(v, p);
     if (exponent == sphere_detail::sphere_unbounded) return FLT_MAX;
-    return min_f(times_power_of_two(sqrtf(sphere_detail::longest_edge_squared(p)), exponent), FLT_MAX);
+    return sphere_detail::unscaled_length(sqrtf(sphere_detail::longest_edge_squared(p)), exponent);
 }
 
 /// @brief Bounds on enclosing_sphere_diameter from the tet's longest edge D. The sphere holds both ends

@@ -102,8 +102,7 @@ KDET_HD inline bool make_filter_pair(const vec3 a[4], const vec3 b[4], FilterPai
         f.edge_b.set(k, b[edge_second(k)] - b[edge_first(k)]);
     }
     if (largest < k_float_tiny && largest > 0.0f) {
-        int exponent = 0;
-        frexpf(largest, &exponent);
+        const int exponent = frexp_exponent(largest);
         for (int i = 0; i < 4; ++i) {
             f.a[i] = times_power_of_two(f.a[i], -exponent);
             f.b[i] = times_power_of_two(f.b[i], -exponent);

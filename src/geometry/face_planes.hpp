@@ -107,8 +107,7 @@ KDET_HD inline TetPlanes tet_planes(const vec3 v[4]) {
     const vec3 q[4] = {make_vec3(0.0f, 0.0f, 0.0f), v[1] - v[0], v[2] - v[0], v[3] - v[0]};
     float largest = 0.0f;
     for (int i = 1; i < 4; ++i) largest = max_f(largest, max_f(fabsf(q[i].x), max_f(fabsf(q[i].y), fabsf(q[i].z))));
-    int exponent = 0;
-    frexpf(largest, &exponent);
+    const int exponent = frexp_exponent(largest);
     // Scaled by a power of two, edges keep their exact directions and ratios, and their squares stay normal.
     const float scale = times_power_of_two(1.0f, -exponent);
     // Corner k relative to vertex 0 as rows, one lane a corner (q, and e scaled), from which the faces'

@@ -98,7 +98,7 @@ KDET_HD inline bool make_local_pair(const vec3 a[4], const vec3 b[4], LocalPair&
         for (int k = 0; k < 6; ++k) largest = max_f(largest, max_f(max_abs(p.edge_a[k]), max_abs(p.edge_b[k])));
         if (!(largest > 0.0f)) return false;
         if (largest <= 3.4028235e38f) {
-            frexpf(largest, &exponent);
+            exponent = frexp_exponent(largest);
             for (int i = 0; i < 4; ++i) {
                 p.a[i] = times_power_of_two(p.a[i], -exponent);
                 p.b[i] = times_power_of_two(p.b[i], -exponent);

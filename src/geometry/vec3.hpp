@@ -74,6 +74,20 @@ KDET_HD inline float power_of_two(int exponent) {
     return value;
 }
 
+/// @brief The exponent e of a finite x = m 2^e with 1/2 <= |m| < 1 (0 for 0), as frexpf gives it, without
+/// a library call: the per-tet and per-pair frames ask for it on every element.
+KDET_HD inline int frexp_exponent(float x) {
+    std::uint32_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    const int biased = static_cast<int>((bits >> 23) & 0xffu);
+    if (biased != 0) return biased - 126;
+    if (x == 0.0f) return 0;
+    // Subnormal: made normal by an exact scaling first.
+    const float normal = x * power_of_two(64);
+    memcpy(&bits, &normal, sizeof bits);
+    return static_cast<int>((bits >> 23) & 0xffu) - 126 - 64;
+}
+
 /// @brief x * 2^exponent for |exponent| <= 252 without a library call: rounded once, as ldexpf rounds
 /// it, wherever x * 2^(exponent / 2) is a normal float or 0 (the first product is then exact).
 KDET_HD inline float times_power_of_two(float x, int exponent) {
