@@ -8,6 +8,8 @@ packages=(cmake g++ make libgtest-dev libbenchmark-dev libcgal-dev python3 pytho
   clang libclang-rt-14-dev tetgen)
 # The kdet command: CLI11 parses its command lines, nlohmann/json writes `kdet collide --json`.
 packages+=(libcli11-dev nlohmann-json3-dev)
+# kdet::mpi, distributed detection, and its tests under mpirun: Debian's OpenMPI.
+packages+=(openmpi-bin libopenmpi-dev)
 # `kdet view`: GLFW, Dear ImGui (with its GLFW and OpenGL 3 backends), libepoxy, libpng; its tests draw
 # under Xvfb with Mesa's software renderer (llvmpipe).
 packages+=(pkg-config libglfw3-dev libimgui-dev libepoxy-dev libpng-dev xvfb xauth libgl1-mesa-dri)

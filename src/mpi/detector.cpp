@@ -1,0 +1,716 @@
+/// @file detector.cpp
+/// @brief kdet::mpi::Detector: a thin distributed layer over kdet::Detector (see docs/distributed.md).
+
+#include "agree.hpp"
+
+#include <kdet/error.hpp>
+#include <kdet/mpi.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <set>
+#include <string>
+#include <tuple>
+#include <utility>
+
+namespace kdet::mpi {
+
+namespace {
+
+/// Cells per axis of the coarse grid over each rank's part of each object: which of them the part
+/// occupies travels with its bounds, so that a tet goes only where it may meet a tet (a slab of a
+/// curved object fills little of its box). 16^3 cells are 512 bytes per object and rank.
+constexpr int grid_cells = 16;
+constexpr int cell_words = grid_cells * grid_cells * grid_cells / 64;
+
+/// The local detector's limit on tets, checked on owned tets before they are exchanged.
+constexpr std::size_t max_local_tets = (std::size_t{1} << 29) - 1;
+
+struct Box {
+    float lo[3] = {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
+                   std::numeric_limits<float>::infinity()};
+    float hi[3] = {-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                   -std::numeric_limits<float>::infinity()};
+    bool empty() const { return !(lo[0] <= hi[0]); }
+    void add(const float* p) {
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = std::min(lo[k], p[k]);
+            hi[k] = std::max(hi[k], p[k]);
+        }
+    }
+    bool overlaps(const Box& o) const {
+        for (int k = 0; k < 3; ++k)
+            if (o.hi[k] < lo[k] || hi[k] < o.lo[k]) return false;
+        return true;
+    }
+};
+
+/// What every rank gathers about every other rank's part of one object.
+struct PartSummary {
+    Box box;
+    std::uint64_t cells[cell_words];
+};
+
+/// The coarse cell of coordinate @p x along axis @p k of @p box's grid. Monotone in x, and computed
+/// alike by the rank that marks a cell and the one that tests it, so two boxes sharing a point share a
+/// cell: a tet meeting a tet of the part overlaps one of the part's marked cells.
+int cell_of(const Box& box, int k, float x) {
+    const double extent = static_cast<double>(box.hi[k]) - static_cast<double>(box.lo[k]);
+    if (!(extent > 0)) return 0;
+    const double c = std::floor((static_cast<double>(x) - static_cast<double>(box.lo[k])) * (grid_cells / extent));
+    return static_cast<int>(std::clamp(c, 0.0, static_cast<double>(grid_cells - 1)));
+}
+
+struct CellRange {
+    int lo[3], hi[3];
+};
+
+CellRange cell_range(const Box& grid, const Box& box) {
+    CellRange r{};
+    for (int k = 0; k < 3; ++k) {
+        r.lo[k] = cell_of(grid, k, box.lo[k]);
+        r.hi[k] = cell_of(grid, k, box.hi[k]);
+    }
+    return r;
+}
+
+int cell_index(int x, int y, int z) { return (z * grid_cells + y) * grid_cells + x; }
+
+/// One tet on its way to another rank: its object, global id, global vertex ids and positions.
+struct TetRecord {
+    std::uint32_t object, tet;
+    std::uint32_t vertex[4];
+    float position[12];
+};
+static_assert(sizeof(TetRecord) == 72, "tet records travel as raw bytes");
+
+/// A position of a caller's view as the float32 kdet stores (the conversion kdet::Detector makes).
+void read_position(const PositionsView& view, std::size_t v, float* out) {
+    for (int k = 0; k < 3; ++k) {
+        const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(v) * view.row_stride + k * view.column_stride;
+        out[k] = view.is_double ? static_cast<float>(static_cast<const double*>(view.data)[at])
+                                : static_cast<const float*>(view.data)[at];
+    }
+}
+
+/// Reads @p view into float32 x y z, or says why not (a wrong count, null data, a non-finite value).
+std::string convert_positions(ObjectId object, const PositionsView& view, const std::vector<std::uint32_t>& ids,
+                              std::vector<float>& out) {
+    const std::size_t expected = ids.size();
+    const std::string name = "object " + std::to_string(object) + ": ";
+    if (view.vertex_count != expected)
+        return name + "got " + std::to_string(view.vertex_count) + " vertices, expected " + std::to_string(expected);
+    if (expected > 0 && !view.data) return name + "the positions' data pointer is null";
+    out.resize(3 * expected);
+    for (std::size_t v = 0; v < expected; ++v) {
+        read_position(view, v, &out[3 * v]);
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(out[3 * v + k]))
+                return name + "vertex " + std::to_string(ids[v]) +
+                       " has a non-finite coordinate (or one beyond float range)";
+    }
+    return {};
+}
+
+} // namespace
+
+ObjectPart MeshPart::view() const {
+    ObjectPart part;
+    part.global_vertex_count = global_vertex_count;
+    part.global_tet_count = global_tet_count;
+    part.vertex_ids = vertex_ids.data();
+    part.positions = PositionsView{positions.data(), true, vertex_ids.size(), 3, 1};
+    part.tet_ids = tet_ids.data();
+    part.tets = tets.data();
+    part.tet_count = tet_ids.size();
+    return part;
+}
+
+struct Detector::Impl {
+    /// This rank's part of one object.
+    struct Object {
+        std::size_t global_vertices = 0, global_tets = 0;
+        std::vector<std::uint32_t> vertex_ids;  ///< held vertices, caller's order
+        std::vector<float> positions;           ///< x y z per held vertex
+        std::vector<std::uint32_t> sorted_ids;  ///< vertex_ids sorted, for lookups
+        std::vector<std::uint32_t> sorted_slot; ///< index into vertex_ids of each sorted id
+        std::vector<std::uint32_t> tet_ids;     ///< owned tets' global ids
+        std::vector<std::uint32_t> tets;        ///< 4 indices into vertex_ids per owned tet
+        bool self = false;
+
+        /// The held index of global vertex @p id, or -1.
+        std::ptrdiff_t held(std::uint32_t id) const {
+            const auto it = std::lower_bound(sorted_ids.begin(), sorted_ids.end(), id);
+            if (it == sorted_ids.end() || *it != id) return -1;
+            return sorted_slot[static_cast<std::size_t>(it - sorted_ids.begin())];
+        }
+    };
+
+    /// One object as the local detector holds it: owned tets first, then the received ones (ghosts)
+    /// sorted by global id; local vertices are the held ones, then those only ghosts use, by global id.
+    struct LocalObject {
+        std::vector<std::uint32_t> ghost_ids;
+        std::vector<std::uint32_t> tets;
+        std::vector<float> positions;
+    };
+
+    MPI_Comm comm = MPI_COMM_NULL;
+    int rank = 0, size = 1;
+    DetectorOptions options;
+    std::vector<Object> objects;
+    std::set<std::pair<ObjectId, ObjectId>> pairs_off;
+    std::string pending_error; ///< from set_positions, reported by the next detect()
+
+    std::vector<LocalObject> local_objects;
+    std::unique_ptr<kdet::Detector> local;
+    FrameResult result;
+
+    bool checks(ObjectId a, ObjectId b) const {
+        if (a == b) return objects[a].self;
+        return !pairs_off.count({std::min(a, b), std::max(a, b)});
+    }
+
+    /// Every rank must check the same pairs: a hash of the switches is compared each frame.
+    std::uint64_t switches_hash() const {
+        std::uint64_t h = 1469598103934665603ull;
+        const auto mix = [&h](std::uint64_t v) { h = (h ^ v) * 1099511628211ull; };
+        mix(objects.size());
+        for (const Object& o : objects) mix(o.self);
+        for (const auto& p : pairs_off) mix((std::uint64_t{p.first} << 32) | p.second);
+        return h;
+    }
+
+    void check_object(ObjectId object) const {
+        if (object >= objects.size())
+            throw Error("object id " + std::to_string(object) + " out of range (" + std::to_string(objects.size()) +
+                        " objects)");
+    }
+
+    ObjectId add(const ObjectPart& part);
+    std::string validate(const ObjectPart& part, Object& out) const;
+    std::string check_directory(const Object& object) const;
+
+    const FrameResult& detect();
+    std::string summarize(std::vector<unsigned char>& record) const;
+    void exchange(const std::vector<PartSummary>& summaries, std::vector<TetRecord>& received);
+    std::string build_local(std::vector<TetRecord>& received, bool& rebuilt);
+    void collect_pairs(const kdet::FrameResult& frame);
+};
+
+/// Checks a part on this rank alone and fills @p out; returns why it is refused, or "".
+std::string Detector::Impl::validate(const ObjectPart& part, Object& out) const {
+    const ObjectId id = static_cast<ObjectId>(objects.size());
+    const std::string name = "object " + std::to_string(id) + ": ";
+    const std::size_t nv = part.positions.vertex_count;
+    if (part.global_vertex_count > std::numeric_limits<std::uint32_t>::max() ||
+        part.global_tet_count > std::numeric_limits<std::uint32_t>::max())
+        return name + "global counts beyond 32-bit ids";
+    if ((nv && !part.vertex_ids) || (part.tet_count && (!part.tet_ids || !part.tets)))
+        return name + "a null array with a non-zero count";
+    if (part.tet_count > max_local_tets)
+        return name + std::to_string(part.tet_count) + " tets on one rank, more than a detector holds";
+    out.global_vertices = part.global_vertex_count;
+    out.global_tets = part.global_tet_count;
+    out.vertex_ids.assign(part.vertex_ids, part.vertex_ids + nv);
+    for (std::size_t v = 0; v < nv; ++v)
+        if (out.vertex_ids[v] >= part.global_vertex_count)
+            return name + "vertex id " + std::to_string(out.vertex_ids[v]) + " out of range (" +
+                   std::to_string(part.global_vertex_count) + " vertices)";
+    std::string bad = convert_positions(id, part.positions, out.vertex_ids, out.positions);
+    if (!bad.empty()) return bad;
+    std::vector<std::uint32_t> order(nv);
+    for (std::size_t v = 0; v < nv; ++v) order[v] = static_cast<std::uint32_t>(v);
+    std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return out.vertex_ids[x] < out.vertex_ids[y]; });
+    out.sorted_ids.resize(nv);
+    out.sorted_slot = order;
+    for (std::size_t k = 0; k < nv; ++k) {
+        out.sorted_ids[k] = out.vertex_ids[order[k]];
+        if (k > 0 && out.sorted_ids[k] == out.sorted_ids[k - 1])
+            return name + "vertex id " + std::to_string(out.sorted_ids[k]) + " given twice";
+    }
+    out.tet_ids.assign(part.tet_ids, part.tet_ids + part.tet_count);
+    out.tets.resize(4 * part.tet_count);
+    for (std::size_t t = 0; t < part.tet_count; ++t) {
+        if (out.tet_ids[t] >= part.global_tet_count)
+            return name + "tet id " + std::to_string(out.tet_ids[t]) + " out of range (" +
+                   std::to_string(part.global_tet_count) + " tets)";
+        for (int c = 0; c < 4; ++c) {
+            const std::uint32_t g = part.tets[4 * t + c];
+            const std::ptrdiff_t h = out.held(g);
+            if (h < 0)
+                return name + "tet " + std::to_string(out.tet_ids[t]) + " uses vertex " + std::to_string(g) +
+                       (g >= part.global_vertex_count ? ", out of range (" + std::to_string(part.global_vertex_count) + " vertices)"
+                                                      : ", which this rank does not hold");
+            out.tets[4 * t + c] = static_cast<std::uint32_t>(h);
+        }
+    }
+    std::vector<std::uint32_t> ids = out.tet_ids;
+    std::sort(ids.begin(), ids.end());
+    const auto twice = std::adjacent_find(ids.begin(), ids.end());
+    if (twice != ids.end()) return name + "tet id " + std::to_string(*twice) + " given twice";
+    return {};
+}
+
+/// Collective: each vertex id and tet id goes to a directory rank (blocks of ids), which finds a tet
+/// owned by two ranks or a vertex held with two positions. Returns this rank's finding, or "".
+std::string Detector::Impl::check_directory(const Object& object) const {
+    struct Entry {
+        std::uint32_t id, kind; // kind 0: vertex, 1: tet
+        float position[3];
+        std::int32_t from;
+    };
+    const auto home = [&](std::uint64_t id, std::uint64_t count) {
+        return static_cast<int>(id * static_cast<std::uint64_t>(size) / std::max<std::uint64_t>(count, 1));
+    };
+    std::vector<std::vector<Entry>> out(static_cast<std::size_t>(size));
+    for (std::size_t v = 0; v < object.vertex_ids.size(); ++v) {
+        Entry e{object.vertex_ids[v], 0, {object.positions[3 * v], object.positions[3 * v + 1], object.positions[3 * v + 2]}, rank};
+        out[static_cast<std::size_t>(home(e.id, object.global_vertices))].push_back(e);
+    }
+    for (std::uint32_t t : object.tet_ids)
+        out[static_cast<std::size_t>(home(t, object.global_tets))].push_back(Entry{t, 1, {0, 0, 0}, rank});
+    std::vector<int> send_counts(static_cast<std::size_t>(size)), recv_counts(static_cast<std::size_t>(size));
+    std::vector<int> send_at(static_cast<std::size_t>(size)), recv_at(static_cast<std::size_t>(size));
+    std::vector<Entry> send;
+    for (int r = 0; r < size; ++r) {
+        send_at[static_cast<std::size_t>(r)] = static_cast<int>(send.size());
+        send_counts[static_cast<std::size_t>(r)] = static_cast<int>(out[static_cast<std::size_t>(r)].size());
+        send.insert(send.end(), out[static_cast<std::size_t>(r)].begin(), out[static_cast<std::size_t>(r)].end());
+    }
+    MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm);
+    int total = 0;
+    for (int r = 0; r < size; ++r) {
+        recv_at[static_cast<std::size_t>(r)] = total;
+        total += recv_counts[static_cast<std::size_t>(r)];
+    }
+    std::vector<Entry> got(static_cast<std::size_t>(total));
+    MPI_Datatype entry_type;
+    MPI_Type_contiguous(sizeof(Entry), MPI_BYTE, &entry_type);
+    MPI_Type_commit(&entry_type);
+    MPI_Alltoallv(send.data(), send_counts.data(), send_at.data(), entry_type, got.data(), recv_counts.data(),
+                  recv_at.data(), entry_type, comm);
+    MPI_Type_free(&entry_type);
+    std::sort(got.begin(), got.end(), [](const Entry& x, const Entry& y) {
+        return std::tie(x.kind, x.id, x.from) < std::tie(y.kind, y.id, y.from);
+    });
+    const std::string name = "object " + std::to_string(objects.size()) + ": ";
+    for (std::size_t k = 1; k < got.size(); ++k) {
+        const Entry &a = got[k - 1], &b = got[k];
+        if (a.kind != b.kind || a.id != b.id) continue;
+        if (a.kind == 1)
+            return name + "tet " + std::to_string(a.id) + " is owned by ranks " + std::to_string(a.from) + " and " +
+                   std::to_string(b.from);
+        if (std::memcmp(a.position, b.position, sizeof a.position) != 0)
+            return name + "vertex " + std::to_string(a.id) + " has different positions on ranks " +
+                   std::to_string(a.from) + " and " + std::to_string(b.from);
+    }
+    return {};
+}
+
+ObjectId Detector::Impl::add(const ObjectPart& part) {
+    Object object;
+    const std::string local_error = validate(part, object);
+    // One reduction carries the first bad rank and the spread of the global counts.
+    long long mine[5] = {local_error.empty() ? -size : -rank, static_cast<long long>(part.global_vertex_count),
+                         -static_cast<long long>(part.global_vertex_count), static_cast<long long>(part.global_tet_count),
+                         -static_cast<long long>(part.global_tet_count)};
+    long long all[5];
+    MPI_Allreduce(mine, all, 5, MPI_LONG_LONG, MPI_MAX, comm);
+    if (-all[0] < size) throw Error(detail::agree(comm, local_error, static_cast<int>(-all[0])));
+    const std::string name = "object " + std::to_string(objects.size()) + ": ";
+    if (all[1] != -all[2])
+        throw Error(name + "ranks give different global vertex counts (" + std::to_string(-all[2]) + " and " +
+                    std::to_string(all[1]) + ")");
+    if (all[3] != -all[4])
+        throw Error(name + "ranks give different global tet counts (" + std::to_string(-all[4]) + " and " +
+                    std::to_string(all[3]) + ")");
+    detail::agree_or_throw(comm, check_directory(object));
+    objects.push_back(std::move(object));
+    local.reset(); // the local detector's objects no longer match
+    return static_cast<ObjectId>(objects.size() - 1);
+}
+
+/// This rank's record for the frame's gather: its status, the switches' hash, and per object the
+/// box and occupied cells of its part. Returns this rank's pending error, if any.
+std::string Detector::Impl::summarize(std::vector<unsigned char>& record) const {
+    const std::uint32_t status = pending_error.empty() ? 0u : 1u;
+    const std::uint64_t hash = switches_hash();
+    std::memcpy(record.data(), &status, 4);
+    std::memcpy(record.data() + 8, &hash, 8);
+    for (std::size_t o = 0; o < objects.size(); ++o) {
+        const Object& object = objects[o];
+        PartSummary s{};
+        s.box = Box{};
+        std::vector<Box> boxes(object.tet_ids.size());
+        for (std::size_t t = 0; t < boxes.size(); ++t) {
+            for (int c = 0; c < 4; ++c) boxes[t].add(&object.positions[3 * object.tets[4 * t + c]]);
+            for (int k = 0; k < 3; ++k) {
+                s.box.lo[k] = std::min(s.box.lo[k], boxes[t].lo[k]);
+                s.box.hi[k] = std::max(s.box.hi[k], boxes[t].hi[k]);
+            }
+        }
+        for (const Box& b : boxes) {
+            const CellRange r = cell_range(s.box, b);
+            for (int z = r.lo[2]; z <= r.hi[2]; ++z)
+                for (int y = r.lo[1]; y <= r.hi[1]; ++y)
+                    for (int x = r.lo[0]; x <= r.hi[0]; ++x) {
+                        const int c = cell_index(x, y, z);
+                        s.cells[c / 64] |= std::uint64_t{1} << (c % 64);
+                    }
+        }
+        std::memcpy(record.data() + 16 + o * sizeof(PartSummary), &s, sizeof s);
+    }
+    return pending_error;
+}
+
+/// Sends each owned tet to every other rank holding a part it may touch; fills @p received.
+void Detector::Impl::exchange(const std::vector<PartSummary>& summaries, std::vector<TetRecord>& received) {
+    const std::size_t n_objects = objects.size();
+    const auto summary = [&](int r, std::size_t o) -> const PartSummary& { return summaries[static_cast<std::size_t>(r) * n_objects + o]; };
+    // The ranks whose parts overlap this rank's at all: the only ones a tet may go to.
+    std::vector<int> near;
+    for (int r = 0; r < size; ++r) {
+        if (r == rank) continue;
+        bool any = false;
+        for (std::size_t a = 0; a < n_objects && !any; ++a)
+            for (std::size_t b = 0; b < n_objects && !any; ++b)
+                any = checks(static_cast<ObjectId>(a), static_cast<ObjectId>(b)) && !summary(rank, a).box.empty() &&
+                      !summary(r, b).box.empty() && summary(rank, a).box.overlaps(summary(r, b).box);
+        if (any) near.push_back(r);
+    }
+    std::vector<std::vector<TetRecord>> out(static_cast<std::size_t>(size));
+    for (std::size_t a = 0; a < n_objects; ++a) {
+        const Object& object = objects[a];
+        for (std::size_t t = 0; t < object.tet_ids.size(); ++t) {
+            Box box;
+            for (int c = 0; c < 4; ++c) box.add(&object.positions[3 * object.tets[4 * t + c]]);
+            for (int r : near) {
+                bool send = false;
+                for (std::size_t b = 0; b < n_objects && !send; ++b) {
+                    const PartSummary& s = summary(r, b);
+                    if (!checks(static_cast<ObjectId>(a), static_cast<ObjectId>(b)) || s.box.empty() || !s.box.overlaps(box))
+                        continue;
+                    const CellRange range = cell_range(s.box, box);
+                    for (int z = range.lo[2]; z <= range.hi[2] && !send; ++z)
+                        for (int y = range.lo[1]; y <= range.hi[1] && !send; ++y)
+                            for (int x = range.lo[0]; x <= range.hi[0] && !send; ++x) {
+                                const int cell = cell_index(x, y, z);
+                                send = (s.cells[cell / 64] >> (cell % 64)) & 1u;
+                            }
+                }
+                if (!send) continue;
+                TetRecord rec;
+                rec.object = static_cast<std::uint32_t>(a);
+                rec.tet = object.tet_ids[t];
+                for (int c = 0; c < 4; ++c) {
+                    const std::uint32_t h = object.tets[4 * t + c];
+                    rec.vertex[c] = object.vertex_ids[h];
+                    std::memcpy(&rec.position[3 * c], &object.positions[3 * h], 3 * sizeof(float));
+                }
+                out[static_cast<std::size_t>(r)].push_back(rec);
+            }
+        }
+    }
+    const std::size_t n = static_cast<std::size_t>(size);
+    std::vector<int> send_counts(n), recv_counts(n), send_at(n), recv_at(n);
+    std::size_t total_send = 0;
+    for (std::size_t r = 0; r < n; ++r) {
+        send_at[r] = static_cast<int>(total_send);
+        send_counts[r] = static_cast<int>(out[r].size());
+        total_send += out[r].size();
+        result.exchange.ranks_sent_to += out[r].empty() ? 0u : 1u;
+    }
+    std::vector<TetRecord> send;
+    send.reserve(total_send);
+    for (std::size_t r = 0; r < n; ++r) send.insert(send.end(), out[r].begin(), out[r].end());
+    MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm);
+    std::size_t total_recv = 0;
+    for (std::size_t r = 0; r < n; ++r) {
+        recv_at[r] = static_cast<int>(total_recv);
+        total_recv += static_cast<std::size_t>(recv_counts[r]);
+    }
+    received.resize(total_recv);
+    MPI_Datatype record_type;
+    MPI_Type_contiguous(sizeof(TetRecord), MPI_BYTE, &record_type);
+    MPI_Type_commit(&record_type);
+    MPI_Alltoallv(send.data(), send_counts.data(), send_at.data(), record_type, received.data(), recv_counts.data(),
+                  recv_at.data(), record_type, comm);
+    MPI_Type_free(&record_type);
+    result.exchange.tets_sent = total_send;
+    result.exchange.tets_received = total_recv;
+    result.exchange.bytes_sent += total_send * sizeof(TetRecord) + 2 * n * sizeof(int);
+    result.exchange.bytes_received += total_recv * sizeof(TetRecord) + 2 * n * sizeof(int);
+}
+
+/// Builds (or, when its tets are the same as last frame's, updates) the local detector from the owned
+/// tets and @p received. Returns an error found in the received positions, or "".
+std::string Detector::Impl::build_local(std::vector<TetRecord>& received, bool& rebuilt) {
+    std::sort(received.begin(), received.end(),
+              [](const TetRecord& x, const TetRecord& y) { return std::tie(x.object, x.tet) < std::tie(y.object, y.tet); });
+    rebuilt = !local || local_objects.size() != objects.size();
+    std::vector<LocalObject> next(objects.size());
+    std::size_t at = 0;
+    for (std::size_t o = 0; o < objects.size(); ++o) {
+        const Object& object = objects[o];
+        LocalObject& lo = next[o];
+        const std::size_t begin = at;
+        while (at < received.size() && received[at].object == o) lo.ghost_ids.push_back(received[at++].tet);
+        // Vertices only ghosts use, by global id; a vertex this rank holds, or that two ghosts share,
+        // must arrive with the one position every holder gives it.
+        struct Ghost {
+            std::uint32_t id;
+            const float* position;
+        };
+        std::vector<Ghost> extra;
+        for (std::size_t k = begin; k < at; ++k)
+            for (int c = 0; c < 4; ++c) {
+                const TetRecord& rec = received[k];
+                const std::ptrdiff_t h = object.held(rec.vertex[c]);
+                if (h < 0) {
+                    extra.push_back(Ghost{rec.vertex[c], &rec.position[3 * c]});
+                } else if (std::memcmp(&object.positions[3 * static_cast<std::size_t>(h)], &rec.position[3 * c], 3 * sizeof(float)) != 0) {
+                    return "object " + std::to_string(o) + ": vertex " + std::to_string(rec.vertex[c]) +
+                           " has different positions here and on the rank owning tet " + std::to_string(rec.tet);
+                }
+            }
+        std::sort(extra.begin(), extra.end(), [](const Ghost& x, const Ghost& y) { return x.id < y.id; });
+        std::vector<std::uint32_t> extra_ids;
+        const std::size_t held = object.vertex_ids.size();
+        lo.positions = object.positions;
+        for (std::size_t k = 0; k < extra.size(); ++k) {
+            if (k > 0 && extra[k].id == extra[k - 1].id) {
+                if (std::memcmp(extra[k].position, extra[k - 1].position, 3 * sizeof(float)) != 0)
+                    return "object " + std::to_string(o) + ": vertex " + std::to_string(extra[k].id) +
+                           " arrives with two different positions from other ranks";
+                continue;
+            }
+            extra_ids.push_back(extra[k].id);
+            lo.positions.insert(lo.positions.end(), extra[k].position, extra[k].position + 3);
+        }
+        lo.tets = object.tets;
+        for (std::size_t k = begin; k < at; ++k)
+            for (int c = 0; c < 4; ++c) {
+                const std::uint32_t g = received[k].vertex[c];
+                const std::ptrdiff_t h = object.held(g);
+                lo.tets.push_back(h >= 0 ? static_cast<std::uint32_t>(h)
+                                         : static_cast<std::uint32_t>(held + static_cast<std::size_t>(
+                                                                                 std::lower_bound(extra_ids.begin(), extra_ids.end(), g) -
+                                                                                 extra_ids.begin())));
+            }
+        if (!rebuilt && (lo.ghost_ids != local_objects[o].ghost_ids || lo.tets != local_objects[o].tets)) rebuilt = true;
+    }
+    local_objects = std::move(next);
+    if (rebuilt) {
+        local.reset();
+        auto fresh = std::make_unique<kdet::Detector>(options);
+        for (std::size_t o = 0; o < objects.size(); ++o) {
+            const LocalObject& lo = local_objects[o];
+            fresh->add_object(lo.positions.data(), lo.positions.size() / 3, lo.tets.data(), lo.tets.size() / 4);
+        }
+        for (std::size_t a = 0; a < objects.size(); ++a) {
+            fresh->set_self_collision(static_cast<ObjectId>(a), objects[a].self);
+            for (std::size_t b = a + 1; b < objects.size(); ++b)
+                fresh->set_pair_collision(static_cast<ObjectId>(a), static_cast<ObjectId>(b),
+                                          checks(static_cast<ObjectId>(a), static_cast<ObjectId>(b)));
+        }
+        local = std::move(fresh);
+    } else {
+        for (std::size_t o = 0; o < objects.size(); ++o)
+            local->set_positions(static_cast<ObjectId>(o), local_objects[o].positions.data(),
+                                 local_objects[o].positions.size() / 3);
+    }
+    return {};
+}
+
+/// Keeps the local pairs whose lower tet this rank owns, in global ids and order, and the owned flags.
+void Detector::Impl::collect_pairs(const kdet::FrameResult& frame) {
+    const auto global = [&](std::uint32_t object, std::uint32_t tet) {
+        const Object& o = objects[object];
+        return tet < o.tet_ids.size() ? o.tet_ids[tet] : local_objects[object].ghost_ids[tet - o.tet_ids.size()];
+    };
+    const bool with_contacts = !frame.contacts.empty();
+    struct Kept {
+        TetPair pair;
+        Contact contact;
+    };
+    std::vector<Kept> kept;
+    for (std::size_t k = 0; k < frame.pairs.size(); ++k) {
+        const TetPair& p = frame.pairs[k];
+        TetPair g{p.object_a, global(p.object_a, p.tet_a), p.object_b, global(p.object_b, p.tet_b)};
+        Contact c = with_contacts ? frame.contacts[k] : Contact{};
+        bool lower_is_a = true;
+        if (g.object_b < g.object_a || (g.object_b == g.object_a && g.tet_b < g.tet_a)) {
+            std::swap(g.object_a, g.object_b);
+            std::swap(g.tet_a, g.tet_b);
+            for (float& d : c.direction) d = -d; // the other tet moves: the opposite direction separates
+            lower_is_a = false;
+        }
+        const std::uint32_t lower_object = lower_is_a ? p.object_a : p.object_b;
+        const std::uint32_t lower_local = lower_is_a ? p.tet_a : p.tet_b;
+        if (lower_local < objects[lower_object].tet_ids.size()) kept.push_back(Kept{g, c});
+    }
+    std::sort(kept.begin(), kept.end(), [](const Kept& x, const Kept& y) { return x.pair < y.pair; });
+    result.pairs.resize(kept.size());
+    result.contacts.resize(with_contacts ? kept.size() : 0);
+    for (std::size_t k = 0; k < kept.size(); ++k) {
+        result.pairs[k] = kept[k].pair;
+        if (with_contacts) result.contacts[k] = kept[k].contact;
+    }
+    result.colliding.resize(objects.size());
+    for (std::size_t o = 0; o < objects.size(); ++o) {
+        const std::size_t owned = objects[o].tet_ids.size();
+        result.colliding[o].assign(frame.colliding[o].begin(), frame.colliding[o].begin() + static_cast<std::ptrdiff_t>(owned));
+    }
+    result.counts = frame.counts;
+    result.times = frame.times;
+    result.memory_bytes = frame.memory_bytes;
+}
+
+const FrameResult& Detector::Impl::detect() {
+    const double start = MPI_Wtime();
+    ExchangeStats stats;
+    result.exchange = stats;
+    const std::size_t record_bytes = 16 + objects.size() * sizeof(PartSummary);
+    std::vector<unsigned char> record(record_bytes), records(record_bytes * static_cast<std::size_t>(size));
+    const std::string mine = summarize(record);
+    MPI_Allgather(record.data(), static_cast<int>(record_bytes), MPI_BYTE, records.data(), static_cast<int>(record_bytes),
+                  MPI_BYTE, comm);
+    int first_bad = -1;
+    bool switches_differ = false;
+    std::vector<PartSummary> summaries(objects.size() * static_cast<std::size_t>(size));
+    for (int r = 0; r < size; ++r) {
+        const unsigned char* at = records.data() + static_cast<std::size_t>(r) * record_bytes;
+        std::uint32_t status;
+        std::uint64_t hash;
+        std::memcpy(&status, at, 4);
+        std::memcpy(&hash, at + 8, 8);
+        if (status && first_bad < 0) first_bad = r;
+        if (hash != switches_hash()) switches_differ = true;
+        if (!objects.empty())
+            std::memcpy(&summaries[static_cast<std::size_t>(r) * objects.size()], at + 16, objects.size() * sizeof(PartSummary));
+    }
+    if (first_bad >= 0) {
+        pending_error.clear();
+        throw Error(detail::agree(comm, mine, first_bad));
+    }
+    if (switches_differ)
+        throw Error("self-collision or pair switches differ between ranks (set them alike on every rank)");
+
+    std::vector<TetRecord> received;
+    exchange(summaries, received);
+    result.exchange.bytes_sent += record_bytes * static_cast<std::size_t>(size - 1);
+    result.exchange.bytes_received += record_bytes * static_cast<std::size_t>(size - 1);
+    const double exchanged = MPI_Wtime();
+
+    std::string error;
+    bool rebuilt = false;
+    try {
+        error = build_local(received, rebuilt);
+        if (error.empty()) collect_pairs(local->detect());
+    } catch (const Error& e) {
+        error = e.what();
+    }
+    if (!error.empty()) local.reset(); // rebuilt from the held state next frame
+    const double detected = MPI_Wtime();
+    detail::agree_or_throw(comm, error);
+
+    for (const Object& o : objects) result.exchange.owned_tets += o.tet_ids.size();
+    result.exchange.local_tets = result.exchange.owned_tets + result.exchange.tets_received;
+    result.exchange.rebuilt = rebuilt;
+    result.exchange.exchange_ms = (exchanged - start) * 1e3;
+    result.exchange.local_ms = (detected - exchanged) * 1e3;
+    result.exchange.total_ms = (MPI_Wtime() - start) * 1e3;
+    return result;
+}
+
+Detector::Detector(MPI_Comm comm, const DetectorOptions& options) : impl_(std::make_unique<Impl>()) {
+    if (!options.results_to_host)
+        throw Error("kdet::mpi::Detector needs results_to_host: it filters the local pairs on the host");
+    MPI_Comm_dup(comm, &impl_->comm);
+    MPI_Comm_rank(impl_->comm, &impl_->rank);
+    MPI_Comm_size(impl_->comm, &impl_->size);
+    impl_->options = options;
+}
+
+Detector::~Detector() {
+    if (impl_ && impl_->comm != MPI_COMM_NULL) {
+        int finalized = 0;
+        MPI_Finalized(&finalized);
+        if (!finalized) MPI_Comm_free(&impl_->comm);
+    }
+}
+Detector::Detector(Detector&&) noexcept = default;
+Detector& Detector::operator=(Detector&& other) noexcept {
+    if (this != &other) {
+        Detector dropped(std::move(*this));
+        impl_ = std::move(other.impl_);
+    }
+    return *this;
+}
+
+ObjectId Detector::add_object(const ObjectPart& part) { return impl_->add(part); }
+
+void Detector::set_positions(ObjectId object, const PositionsView& positions) {
+    impl_->check_object(object);
+    if (!impl_->pending_error.empty()) return; // the first bad call is what detect() reports
+    Impl::Object& o = impl_->objects[object];
+    std::vector<float> converted;
+    const std::string bad = convert_positions(object, positions, o.vertex_ids, converted);
+    if (bad.empty()) o.positions = std::move(converted);
+    else impl_->pending_error = bad;
+}
+void Detector::set_positions(ObjectId object, const double* positions, std::size_t vertex_count) {
+    set_positions(object, PositionsView{positions, true, vertex_count, 3, 1});
+}
+void Detector::set_positions(ObjectId object, const float* positions, std::size_t vertex_count) {
+    set_positions(object, PositionsView{positions, false, vertex_count, 3, 1});
+}
+
+void Detector::set_self_collision(ObjectId object, bool enabled) {
+    impl_->check_object(object);
+    impl_->objects[object].self = enabled;
+    impl_->local.reset();
+}
+void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
+    impl_->check_object(a);
+    impl_->check_object(b);
+    if (a == b) throw Error("set_pair_collision needs two different objects (use set_self_collision)");
+    const std::pair<ObjectId, ObjectId> key{std::min(a, b), std::max(a, b)};
+    if (enabled) impl_->pairs_off.erase(key);
+    else impl_->pairs_off.insert(key);
+    impl_->local.reset();
+}
+
+const FrameResult& Detector::detect() { return impl_->detect(); }
+
+std::vector<TetPair> Detector::gather_pairs(int root) const {
+    const Impl& d = *impl_;
+    const int count = static_cast<int>(d.result.pairs.size());
+    std::vector<int> counts(d.rank == root ? static_cast<std::size_t>(d.size) : 0), at(counts.size());
+    MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, d.comm);
+    std::vector<TetPair> all;
+    if (d.rank == root) {
+        int total = 0;
+        for (std::size_t r = 0; r < counts.size(); ++r) {
+            at[r] = total;
+            total += counts[r];
+        }
+        all.resize(static_cast<std::size_t>(total));
+    }
+    MPI_Datatype pair_type;
+    MPI_Type_contiguous(sizeof(TetPair), MPI_BYTE, &pair_type);
+    MPI_Type_commit(&pair_type);
+    MPI_Gatherv(d.result.pairs.data(), count, pair_type, all.data(), counts.data(), at.data(), pair_type, root, d.comm);
+    MPI_Type_free(&pair_type);
+    std::sort(all.begin(), all.end());
+    return all;
+}
+
+std::size_t Detector::object_count() const { return impl_->objects.size(); }
+MPI_Comm Detector::communicator() const { return impl_->comm; }
+int Detector::rank() const { return impl_->rank; }
+int Detector::size() const { return impl_->size; }
+
+} // namespace kdet::mpi
