@@ -65,4 +65,13 @@ if ! cmp -s "$work/out/expected.txt" "$work/out/pairs.txt"; then
   exit 1
 fi
 [[ -s "$work/out/pairs.txt" ]] || { echo "no colliding pairs: the meshes were meant to overlap" >&2; exit 1; }
+if [[ -x "$work/build/consumer_mpi" ]]; then
+  OMP_NUM_THREADS=1 mpirun -np 2 --oversubscribe --allow-run-as-root "$work/build/consumer_mpi" "$work/out" >/dev/null
+  if ! cmp -s "$work/out/expected.txt" "$work/out/pairs_mpi.txt"; then
+    echo "the consumer's distributed pairs differ from kdet collide's:" >&2
+    diff "$work/out/expected.txt" "$work/out/pairs_mpi.txt" | head >&2
+    exit 1
+  fi
+  echo "$mode: kdet::mpi on 2 ranks: the same pairs"
+fi
 echo "$mode: $(wc -l <"$work/out/pairs.txt") pairs, the same as kdet collide's"
