@@ -1,5 +1,6 @@
 #include "commands.hpp"
 #include "exact_check.hpp"
+#include "mpi_collide.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
@@ -31,6 +32,9 @@ options:
                        false positives and false negatives on these meshes
   --json               print one JSON object instead of text
   --allow-degenerate   accept zero-volume tetrahedra (rejected by default)
+  --mpi                run on the ranks of mpirun (kdet::mpi): rank 0 reads the meshes, splits them
+                       over the ranks and writes the pairs all ranks found
+  --partition P        with --mpi: slabs (along the longest axis, default) or random
 )";
 
 /// @brief @p value on one line with ", " and ": " between items, as kdet has always printed it
@@ -76,8 +80,8 @@ void print_examples(const char* what, const std::vector<IndexPair>& pairs) {
 int run_collide(int argc, char** argv) {
     DetectorOptions options;
     std::vector<std::string> meshes;
-    bool self = false, json = false, help = false, check = false;
-    std::string pairs_path, contacts_path;
+    bool self = false, json = false, help = false, check = false, mpi = false;
+    std::string pairs_path, contacts_path, partition;
     ReadOptions read_options;
 
     CommandLine parser("collide");
@@ -89,6 +93,8 @@ int run_collide(int argc, char** argv) {
     parser.option("--pairs", "FILE", [&](const std::string& v) { pairs_path = v; });
     parser.option("--contacts", "FILE", [&](const std::string& v) { contacts_path = v; });
     parser.flag("--check-exact", check);
+    parser.flag("--mpi", mpi);
+    parser.option("--partition", "slabs|random", [&](const std::string& v) { partition = v; });
     parser.detector_options(options, front_end_cli);
     parser.parse(argc, argv, 2);
     if (help) {
@@ -101,6 +107,10 @@ int run_collide(int argc, char** argv) {
     if (options.method == Method::kdet_no_pairs && (!pairs_path.empty() || !contacts_path.empty() || check))
         throw UsageError("collide: --pairs, --contacts and --check-exact need a method that builds pairs; "
                          "kdet_no_pairs only flags tets");
+    if (!partition.empty() && !mpi) throw UsageError("collide: --partition needs --mpi");
+    if (mpi && (json || check || !contacts_path.empty()))
+        throw UsageError("collide: --json, --contacts and --check-exact do not work with --mpi");
+    if (mpi) return run_collide_mpi({meshes, self, pairs_path, partition, read_options, options});
     std::string unavailable;
     if (check && !exact_check_available(&unavailable))
         throw UsageError("collide: --check-exact is not available: " + unavailable);

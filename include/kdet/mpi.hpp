@@ -25,6 +25,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace kdet::mpi {
@@ -128,6 +129,11 @@ private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
+
+/// @brief Collective: throws on every rank a kdet::Error with the message of the lowest rank whose
+/// @p local_error is not empty, prefixed "rank R: "; returns on every rank when none has one. For a
+/// caller's own steps on some ranks (reading a file on one) before collective calls.
+void agree_on_error(MPI_Comm comm, const std::string& local_error);
 
 /// @brief How partition_tets() splits a scene over ranks.
 enum class Partition {

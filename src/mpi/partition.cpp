@@ -61,6 +61,8 @@ std::vector<std::vector<int>> partition_tets(const std::vector<const TetMesh*>& 
     return owners;
 }
 
+void agree_on_error(MPI_Comm comm, const std::string& local_error) { detail::agree_or_throw(comm, local_error); }
+
 MeshPart scatter_mesh(MPI_Comm comm, const TetMesh* mesh, const std::vector<int>* owners, int root) {
     int rank = 0, size = 1;
     MPI_Comm_rank(comm, &rank);

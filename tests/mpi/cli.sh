@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# `kdet collide --mpi` under mpirun writes exactly the pairs `kdet collide` writes, with both partitions,
+# a file missing on rank 0 fails on every rank with one message, --partition alone is a usage error.
+#   cli.sh KDET MPIEXEC DATA_DIR WORK
+set -euo pipefail
+kdet="$1" mpiexec="$2" data="${KDET_DATA_DIR:-$3}" work="$4"
+rm -rf "$work" && mkdir -p "$work"
+run() { OMP_NUM_THREADS=1 "$mpiexec" -np 3 --oversubscribe --allow-run-as-root "$kdet" "$@"; }
+"$kdet" collide "$data/bunny.mesh" "$data/hand.mesh" --pairs "$work/expected.txt" >/dev/null
+[[ -s "$work/expected.txt" ]] || { echo "no pairs: the meshes were meant to overlap" >&2; exit 1; }
+for partition in slabs random; do
+  run collide "$data/bunny.mesh" "$data/hand.mesh" --mpi --partition "$partition" --pairs "$work/$partition.txt" \
+    >"$work/$partition.out"
+  cmp "$work/expected.txt" "$work/$partition.txt" || { echo "--partition $partition: other pairs" >&2; exit 1; }
+  grep -q "^ranks             3, partition $partition$" "$work/$partition.out"
+done
+if run collide "$work/missing.mesh" --self --mpi >"$work/missing.out" 2>&1; then
+  echo "a missing file did not fail" >&2
+  exit 1
+fi
+[[ "$(grep -c "missing.mesh: cannot open file" "$work/missing.out")" == 1 ]] || { cat "$work/missing.out" >&2; exit 1; }
+set +e
+"$kdet" collide "$data/bunny.mesh" --self --partition random 2>"$work/usage.out"
+status=$?
+set -e
+[[ $status == 2 && "$(cat "$work/usage.out")" == "kdet collide: --partition needs --mpi" ]] || { echo "exit $status" >&2; exit 1; }
+echo "kdet collide --mpi on 3 ranks: $(wc -l <"$work/expected.txt") pairs, the same as without --mpi"
