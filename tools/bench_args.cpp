@@ -46,6 +46,9 @@ more options:
 )" + option_help_line(*find_option("threads"), front_end_bench, defaults) +
            option_help_line(*find_option("bucket_capacity"), front_end_bench, defaults) + R"(  --frames A:B         run frames A to B only (0-based, inclusive)
   --quiet              no per-frame table and no progress bar; only the summary
+  --mpi                run on the ranks of mpirun (kdet::mpi), each on its part of the scene, and
+                       write per frame the tets and bytes they exchanged (DIR/STEM_mpi-npN-P.csv)
+  --partition P        with --mpi: slabs (along the longest axis at the first frame, default) or random
   --help               this text
 
 procedural scene only:
@@ -83,6 +86,8 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     parser.positionals(1, scene);
     parser.flag("--help", config.help);
     parser.flag("--quiet", config.quiet);
+    parser.flag("--mpi", config.mpi);
+    parser.option("--partition", "slabs|random", [&](const std::string& v) { config.partition = v; });
     parser.option("-r", "resolution", [&](const std::string& v) {
         config.request.resolution = static_cast<int>(parse_integer("-r", v, 1, 4));
     });
@@ -120,6 +125,7 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     });
     parser.parse(argc, argv, first);
     if (!scene.empty()) config.scene = scene[0];
+    if (!config.partition.empty() && !config.mpi) throw UsageError("bench: --partition needs --mpi");
     return config;
 }
 

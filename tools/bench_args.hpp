@@ -29,6 +29,8 @@ struct BenchConfig {
     std::string procedural_flag;                ///< first procedural-only flag given, for the error
     bool quiet = false;
     bool help = false;
+    bool mpi = false;                           ///< --mpi: run on the ranks of mpirun (kdet::mpi)
+    std::string partition;                      ///< --partition, with --mpi
 };
 
 /// @brief Parses `argv[first..argc)`; throws UsageError naming the flag and its accepted values.

@@ -3,6 +3,7 @@
 #include "bench_progress.hpp"
 #include "bench_runner.hpp"
 #include "commands.hpp"
+#include "mpi_commands.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
@@ -23,6 +24,8 @@ std::size_t column(const std::string& name) {
     return static_cast<std::size_t>(std::find(columns.begin(), columns.end(), name) - columns.begin());
 }
 
+} // namespace
+
 std::unique_ptr<Scene> open_bench_scene(const BenchConfig& config) {
     if (!config.procedural_flag.empty() && config.scene != "procedural")
         throw UsageError("bench: " + config.procedural_flag + " applies to the procedural scene only (scene is '" +
@@ -39,6 +42,8 @@ std::unique_ptr<Scene> open_bench_scene(const BenchConfig& config) {
                          std::to_string(scene->num_frames() - 1));
     return scene;
 }
+
+namespace {
 
 void print_report(const BenchConfig& config, const Scene& scene, const BenchOutcome& outcome, const BenchFiles& files) {
     const std::vector<FrameRow> mean = average_runs(outcome.runs);
@@ -84,6 +89,7 @@ int run_bench(int argc, char** argv) {
         std::cout << bench_help() << "\nknown scenes: " << join_names(scene_names()) << "\n";
         return exit_ok;
     }
+    if (config.mpi) return run_bench_mpi(config);
     std::string reason;
     if (config.options.backend == Backend::cuda && !cuda_available(&reason))
         throw Error("bench: --backend cuda is not available here: " + reason);

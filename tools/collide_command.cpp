@@ -1,6 +1,6 @@
 #include "commands.hpp"
 #include "exact_check.hpp"
-#include "mpi_collide.hpp"
+#include "mpi_commands.hpp"
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>

@@ -2,7 +2,7 @@
 /// @brief `kdet collide ... --mpi`: rank 0 reads the meshes and splits them over the ranks, all ranks
 /// run kdet::mpi::Detector, rank 0 writes the pairs and prints what each rank exchanged.
 
-#include "mpi_collide.hpp"
+#include "mpi_commands.hpp"
 
 #include "commands.hpp"
 
@@ -20,37 +20,38 @@ namespace kdet::cli {
 
 #ifndef KDET_HAS_MPI
 
-int run_collide_mpi(const MpiCollide&) {
-    throw Error("collide --mpi: this kdet was built without MPI (install an MPI, e.g. Debian's libopenmpi-dev, "
+namespace {
+[[noreturn]] void without_mpi(const std::string& command) {
+    throw Error(command + " --mpi: this kdet was built without MPI (install an MPI, e.g. Debian's libopenmpi-dev, "
                 "and build again)");
 }
+} // namespace
+
+int run_collide_mpi(const MpiCollide&) { without_mpi("collide"); }
+int run_bench_mpi(const BenchConfig&) { without_mpi("bench"); }
 
 #else
 
-namespace {
-
-/// MPI for the length of the command; MPI_Finalize also when it throws.
-struct MpiSession {
-    MpiSession() {
-        int ready = 0;
-        MPI_Initialized(&ready);
-        if (!ready) MPI_Init(nullptr, nullptr);
-        owned = !ready;
-    }
-    ~MpiSession() {
-        if (owned) MPI_Finalize();
-    }
-    bool owned = false;
-};
-
-mpi::Partition partition_of(const std::string& name) {
-    if (name.empty() || name == "slabs") return mpi::Partition::slabs;
-    if (name == "random") return mpi::Partition::random;
-    throw UsageError("collide: invalid value '" + name + "' for --partition: expected slabs or random");
+MpiSession::MpiSession() {
+    int ready = 0;
+    MPI_Initialized(&ready);
+    if (!ready) MPI_Init(nullptr, nullptr);
+    owned = !ready;
+}
+MpiSession::~MpiSession() {
+    if (owned) MPI_Finalize();
 }
 
+mpi::Partition partition_of(const std::string& command, const std::string& name) {
+    if (name.empty() || name == "slabs") return mpi::Partition::slabs;
+    if (name == "random") return mpi::Partition::random;
+    throw UsageError(command + ": invalid value '" + name + "' for --partition: expected slabs or random");
+}
+
+namespace {
+
 int run(const MpiCollide& request, int rank, int size) {
-    const mpi::Partition kind = partition_of(request.partition);
+    const mpi::Partition kind = partition_of("collide", request.partition);
     const MPI_Comm comm = MPI_COMM_WORLD;
     const std::size_t n_objects = request.self ? 1 : 2;
     std::vector<TetMesh> meshes(n_objects);
