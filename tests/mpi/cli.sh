@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # `kdet collide --mpi` under mpirun writes exactly the pairs `kdet collide` writes, with both partitions,
+# kdet bench --mpi finds the same pairs per frame on 1 and 2 ranks,
 # a file missing on rank 0 fails on every rank with one message, --partition alone is a usage error.
 #   cli.sh KDET MPIEXEC DATA_DIR WORK
 set -euo pipefail
@@ -19,6 +20,14 @@ if run collide "$work/missing.mesh" --self --mpi >"$work/missing.out" 2>&1; then
   exit 1
 fi
 [[ "$(grep -c "missing.mesh: cannot open file" "$work/missing.out")" == 1 ]] || { cat "$work/missing.out" >&2; exit 1; }
+# kdet bench --mpi: one row per frame, the same pairs on 2 ranks as on 1.
+for np in 1 2; do
+  OMP_NUM_THREADS=1 "$mpiexec" -np $np --oversubscribe --allow-run-as-root "$kdet" bench --tets 2000 --frames 58:61 -n 1 \
+    --mpi -d "$work/bench$np" --quiet >/dev/null
+done
+rows() { cut -d, -f1,3 "$1"/*.csv; }
+[[ "$(rows "$work/bench1" | wc -l)" == 5 && "$(rows "$work/bench1")" == "$(rows "$work/bench2")" ]] ||
+  { echo "kdet bench --mpi: other rows on 2 ranks" >&2; rows "$work/bench1" >&2; rows "$work/bench2" >&2; exit 1; }
 set +e
 "$kdet" collide "$data/bunny.mesh" --self --partition random 2>"$work/usage.out"
 status=$?
