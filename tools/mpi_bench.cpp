@@ -22,23 +22,6 @@ namespace kdet::cli {
 
 namespace {
 
-/// This rank's part of @p mesh: the tets @p owners gives it and the vertices they use.
-mpi::MeshPart part_of(const TetMesh& mesh, const std::vector<int>& owners, int rank) {
-    mpi::MeshPart part;
-    part.global_vertex_count = mesh.num_vertices();
-    part.global_tet_count = mesh.num_tets();
-    for (std::size_t t = 0; t < mesh.num_tets(); ++t) {
-        if (owners[t] != rank) continue;
-        part.tet_ids.push_back(static_cast<std::uint32_t>(t));
-        part.tets.insert(part.tets.end(), mesh.tets.begin() + 4 * std::ptrdiff_t(t), mesh.tets.begin() + 4 * std::ptrdiff_t(t) + 4);
-    }
-    part.vertex_ids = part.tets;
-    std::sort(part.vertex_ids.begin(), part.vertex_ids.end());
-    part.vertex_ids.erase(std::unique(part.vertex_ids.begin(), part.vertex_ids.end()), part.vertex_ids.end());
-    part.positions.resize(3 * part.vertex_ids.size());
-    return part;
-}
-
 /// One frame as the ranks saw it: sums, and the extremes that show the load balance.
 struct MpiFrameRow {
     int frame;
@@ -80,9 +63,7 @@ int run_bench_mpi(const BenchConfig& config) {
         mpi::Detector detector(comm, config.options);
         std::vector<mpi::MeshPart> parts;
         for (std::size_t o = 0; o < scene->num_objects(); ++o) {
-            parts.push_back(part_of(at_first[o], owners[o], rank));
-            for (std::size_t k = 0; k < parts[o].vertex_ids.size(); ++k)
-                std::copy_n(&at_first[o].positions[3 * std::size_t{parts[o].vertex_ids[k]}], 3, &parts[o].positions[3 * k]);
+            parts.push_back(mpi::local_part(at_first[o], owners[o], rank));
             detector.add_object(parts[o]);
         }
         for (std::size_t a = 0; a < scene->num_objects(); ++a) {

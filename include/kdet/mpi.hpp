@@ -146,6 +146,11 @@ enum class Partition {
 std::vector<std::vector<int>> partition_tets(const std::vector<const TetMesh*>& objects, int ranks, Partition kind,
                                              std::uint64_t seed = 1);
 
+/// @brief The part of @p mesh that @p owners (one rank per tet) gives @p rank: its tets in increasing
+/// id order and the vertices they use, by increasing id. For a caller holding the whole mesh on every
+/// rank (tests, benchmarks); scatter_mesh() sends each rank this part from one rank.
+MeshPart local_part(const TetMesh& mesh, const std::vector<int>& owners, int rank);
+
 /// @brief Collective: sends each rank its part of @p mesh (read on @p root only), the tets @p owners
 /// (also read on root only, one rank per tet) gives it, with the vertices those tets use. Global ids
 /// are the mesh's indices.

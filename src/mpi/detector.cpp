@@ -2,6 +2,7 @@
 /// @brief kdet::mpi::Detector: a thin distributed layer over kdet::Detector (see docs/distributed.md).
 
 #include "agree.hpp"
+#include "exchange.hpp"
 
 #include <kdet/error.hpp>
 #include <kdet/mpi.hpp>
@@ -271,27 +272,7 @@ std::string Detector::Impl::check_directory(const Object& object) const {
     }
     for (std::uint32_t t : object.tet_ids)
         out[static_cast<std::size_t>(home(t, object.global_tets))].push_back(Entry{t, 1, {0, 0, 0}, rank});
-    std::vector<int> send_counts(static_cast<std::size_t>(size)), recv_counts(static_cast<std::size_t>(size));
-    std::vector<int> send_at(static_cast<std::size_t>(size)), recv_at(static_cast<std::size_t>(size));
-    std::vector<Entry> send;
-    for (int r = 0; r < size; ++r) {
-        send_at[static_cast<std::size_t>(r)] = static_cast<int>(send.size());
-        send_counts[static_cast<std::size_t>(r)] = static_cast<int>(out[static_cast<std::size_t>(r)].size());
-        send.insert(send.end(), out[static_cast<std::size_t>(r)].begin(), out[static_cast<std::size_t>(r)].end());
-    }
-    MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm);
-    int total = 0;
-    for (int r = 0; r < size; ++r) {
-        recv_at[static_cast<std::size_t>(r)] = total;
-        total += recv_counts[static_cast<std::size_t>(r)];
-    }
-    std::vector<Entry> got(static_cast<std::size_t>(total));
-    MPI_Datatype entry_type;
-    MPI_Type_contiguous(sizeof(Entry), MPI_BYTE, &entry_type);
-    MPI_Type_commit(&entry_type);
-    MPI_Alltoallv(send.data(), send_counts.data(), send_at.data(), entry_type, got.data(), recv_counts.data(),
-                  recv_at.data(), entry_type, comm);
-    MPI_Type_free(&entry_type);
+    std::vector<Entry> got = detail::all_to_all(comm, out);
     std::sort(got.begin(), got.end(), [](const Entry& x, const Entry& y) {
         return std::tie(x.kind, x.id, x.from) < std::tie(y.kind, y.id, y.from);
     });
@@ -414,30 +395,13 @@ void Detector::Impl::exchange(const std::vector<PartSummary>& summaries, std::ve
         }
     }
     const std::size_t n = static_cast<std::size_t>(size);
-    std::vector<int> send_counts(n), recv_counts(n), send_at(n), recv_at(n);
     std::size_t total_send = 0;
-    for (std::size_t r = 0; r < n; ++r) {
-        send_at[r] = static_cast<int>(total_send);
-        send_counts[r] = static_cast<int>(out[r].size());
-        total_send += out[r].size();
-        result.exchange.ranks_sent_to += out[r].empty() ? 0u : 1u;
+    for (const auto& list : out) {
+        total_send += list.size();
+        result.exchange.ranks_sent_to += list.empty() ? 0u : 1u;
     }
-    std::vector<TetRecord> send;
-    send.reserve(total_send);
-    for (std::size_t r = 0; r < n; ++r) send.insert(send.end(), out[r].begin(), out[r].end());
-    MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm);
-    std::size_t total_recv = 0;
-    for (std::size_t r = 0; r < n; ++r) {
-        recv_at[r] = static_cast<int>(total_recv);
-        total_recv += static_cast<std::size_t>(recv_counts[r]);
-    }
-    received.resize(total_recv);
-    MPI_Datatype record_type;
-    MPI_Type_contiguous(sizeof(TetRecord), MPI_BYTE, &record_type);
-    MPI_Type_commit(&record_type);
-    MPI_Alltoallv(send.data(), send_counts.data(), send_at.data(), record_type, received.data(), recv_counts.data(),
-                  recv_at.data(), record_type, comm);
-    MPI_Type_free(&record_type);
+    received = detail::all_to_all(comm, out);
+    const std::size_t total_recv = received.size();
     result.exchange.tets_sent = total_send;
     result.exchange.tets_received = total_recv;
     result.exchange.bytes_sent += total_send * sizeof(TetRecord) + 2 * n * sizeof(int);

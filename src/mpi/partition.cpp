@@ -61,50 +61,51 @@ std::vector<std::vector<int>> partition_tets(const std::vector<const TetMesh*>& 
     return owners;
 }
 
+MeshPart local_part(const TetMesh& mesh, const std::vector<int>& owners, int rank) {
+    MeshPart part;
+    part.global_vertex_count = mesh.num_vertices();
+    part.global_tet_count = mesh.num_tets();
+    for (std::size_t t = 0; t < mesh.num_tets() && t < owners.size(); ++t) {
+        if (owners[t] != rank) continue;
+        part.tet_ids.push_back(static_cast<std::uint32_t>(t));
+        part.tets.insert(part.tets.end(), mesh.tets.begin() + 4 * static_cast<std::ptrdiff_t>(t),
+                         mesh.tets.begin() + 4 * static_cast<std::ptrdiff_t>(t) + 4);
+    }
+    part.vertex_ids = part.tets;
+    std::sort(part.vertex_ids.begin(), part.vertex_ids.end());
+    part.vertex_ids.erase(std::unique(part.vertex_ids.begin(), part.vertex_ids.end()), part.vertex_ids.end());
+    for (std::uint32_t v : part.vertex_ids)
+        part.positions.insert(part.positions.end(), mesh.positions.begin() + 3 * static_cast<std::ptrdiff_t>(v),
+                              mesh.positions.begin() + 3 * static_cast<std::ptrdiff_t>(v) + 3);
+    return part;
+}
+
 void agree_on_error(MPI_Comm comm, const std::string& local_error) { detail::agree_or_throw(comm, local_error); }
 
 MeshPart scatter_mesh(MPI_Comm comm, const TetMesh* mesh, const std::vector<int>* owners, int root) {
     int rank = 0, size = 1;
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &size);
-    const std::size_t n = static_cast<std::size_t>(size);
     std::string bad;
-    // Root builds every rank's part: [rank] tet ids, tets, vertex ids, positions.
-    std::vector<std::vector<std::uint32_t>> tet_ids(rank == root ? n : 0), tets(tet_ids.size()), vertex_ids(tet_ids.size());
-    std::vector<std::vector<double>> positions(tet_ids.size());
+    // Root builds every rank's part.
+    std::vector<MeshPart> parts;
     unsigned long long counts[2] = {0, 0}; // global vertices and tets
     if (rank == root) {
         if (!mesh || !owners) bad = "scatter_mesh: no mesh or owners on the root rank";
         else if (owners->size() != mesh->num_tets())
             bad = "scatter_mesh: " + std::to_string(owners->size()) + " owners for " + std::to_string(mesh->num_tets()) + " tets";
-        for (std::size_t t = 0; bad.empty() && t < mesh->num_tets(); ++t) {
-            const int owner = (*owners)[t];
-            if (owner < 0 || owner >= size) {
-                bad = "scatter_mesh: tet " + std::to_string(t) + " goes to rank " + std::to_string(owner) + ", not one of " +
-                      std::to_string(size);
-                break;
-            }
-            tet_ids[static_cast<std::size_t>(owner)].push_back(static_cast<std::uint32_t>(t));
-            for (int c = 0; c < 4; ++c) {
-                const std::uint32_t v = mesh->tets[4 * t + static_cast<std::size_t>(c)];
-                if (v >= mesh->num_vertices()) {
-                    bad = "scatter_mesh: tet " + std::to_string(t) + " uses vertex " + std::to_string(v) + ", out of range";
-                    break;
-                }
-                tets[static_cast<std::size_t>(owner)].push_back(v);
-            }
-        }
+        for (std::size_t t = 0; bad.empty() && t < mesh->num_tets(); ++t)
+            if ((*owners)[t] < 0 || (*owners)[t] >= size)
+                bad = "scatter_mesh: tet " + std::to_string(t) + " goes to rank " + std::to_string((*owners)[t]) +
+                      ", not one of " + std::to_string(size);
+        for (std::size_t i = 0; bad.empty() && i < mesh->tets.size(); ++i)
+            if (mesh->tets[i] >= mesh->num_vertices())
+                bad = "scatter_mesh: tet " + std::to_string(i / 4) + " uses vertex " + std::to_string(mesh->tets[i]) +
+                      ", out of range";
         if (bad.empty()) {
             counts[0] = mesh->num_vertices();
             counts[1] = mesh->num_tets();
-            for (std::size_t r = 0; r < n; ++r) {
-                vertex_ids[r] = tets[r];
-                std::sort(vertex_ids[r].begin(), vertex_ids[r].end());
-                vertex_ids[r].erase(std::unique(vertex_ids[r].begin(), vertex_ids[r].end()), vertex_ids[r].end());
-                for (std::uint32_t v : vertex_ids[r])
-                    positions[r].insert(positions[r].end(), mesh->positions.begin() + 3 * std::ptrdiff_t{v},
-                                        mesh->positions.begin() + 3 * std::ptrdiff_t{v} + 3);
-            }
+            for (int r = 0; r < size; ++r) parts.push_back(local_part(*mesh, *owners, r));
         }
     }
     detail::agree_or_throw(comm, bad);
@@ -127,10 +128,15 @@ MeshPart scatter_mesh(MPI_Comm comm, const TetMesh* mesh, const std::vector<int>
         out.resize(static_cast<std::size_t>(mine));
         MPI_Scatterv(flat.data(), sizes.data(), at.data(), type, out.data(), mine, type, root, comm);
     };
-    scatter(tet_ids, part.tet_ids, MPI_UINT32_T);
-    scatter(tets, part.tets, MPI_UINT32_T);
-    scatter(vertex_ids, part.vertex_ids, MPI_UINT32_T);
-    scatter(positions, part.positions, MPI_DOUBLE);
+    const auto field = [&](auto member) {
+        std::vector<std::decay_t<decltype(MeshPart{}.*member)>> per_rank;
+        for (MeshPart& p : parts) per_rank.push_back(std::move(p.*member));
+        return per_rank;
+    };
+    scatter(field(&MeshPart::tet_ids), part.tet_ids, MPI_UINT32_T);
+    scatter(field(&MeshPart::tets), part.tets, MPI_UINT32_T);
+    scatter(field(&MeshPart::vertex_ids), part.vertex_ids, MPI_UINT32_T);
+    scatter(field(&MeshPart::positions), part.positions, MPI_DOUBLE);
     return part;
 }
 

@@ -54,24 +54,6 @@ Scenario scenario(std::vector<TetMesh> meshes) {
     return s;
 }
 
-/// This rank's part of @p mesh under @p owners: its tets, and the vertices they use.
-mpi::MeshPart part_of(const TetMesh& mesh, const std::vector<int>& owners, int rank) {
-    mpi::MeshPart part;
-    part.global_vertex_count = mesh.num_vertices();
-    part.global_tet_count = mesh.num_tets();
-    for (std::size_t t = 0; t < mesh.num_tets(); ++t) {
-        if (owners[t] != rank) continue;
-        part.tet_ids.push_back(static_cast<std::uint32_t>(t));
-        for (int c = 0; c < 4; ++c) part.tets.push_back(mesh.tets[4 * t + c]);
-    }
-    part.vertex_ids = part.tets;
-    std::sort(part.vertex_ids.begin(), part.vertex_ids.end());
-    part.vertex_ids.erase(std::unique(part.vertex_ids.begin(), part.vertex_ids.end()), part.vertex_ids.end());
-    for (std::uint32_t v : part.vertex_ids)
-        for (int k = 0; k < 3; ++k) part.positions.push_back(mesh.positions[3 * v + k]);
-    return part;
-}
-
 std::vector<double> held_positions(const mpi::MeshPart& part, const std::vector<double>& all) {
     std::vector<double> out;
     for (std::uint32_t v : part.vertex_ids)
@@ -87,7 +69,7 @@ void expect_same_as_single(const Scenario& s, const std::vector<std::vector<int>
     Detector single(options);
     std::vector<mpi::MeshPart> parts;
     for (std::size_t o = 0; o < s.meshes.size(); ++o) {
-        parts.push_back(part_of(s.meshes[o], owners[o], rank));
+        parts.push_back(mpi::local_part(s.meshes[o], owners[o], rank));
         distributed.add_object(parts.back());
         single.add_object(s.meshes[o]);
         distributed.set_self_collision(static_cast<ObjectId>(o), s.self[o]);
@@ -238,7 +220,7 @@ TEST(Mpi, ScatterMeshGivesEachRankItsPart) {
         mpi::partition_tets({&soup}, world_size(), mpi::Partition::random, 5);
     const bool root = world_rank() == 0;
     const mpi::MeshPart got = mpi::scatter_mesh(MPI_COMM_WORLD, root ? &soup : nullptr, root ? &owners[0] : nullptr);
-    const mpi::MeshPart expected = part_of(soup, owners[0], world_rank());
+    const mpi::MeshPart expected = mpi::local_part(soup, owners[0], world_rank());
     EXPECT_EQ(got.global_tet_count, soup.num_tets());
     EXPECT_EQ(got.global_vertex_count, soup.num_vertices());
     EXPECT_EQ(got.tet_ids, expected.tet_ids);
@@ -284,7 +266,7 @@ TEST(Mpi, BadInputOnOneRankFailsOnEveryRank) {
     const TetMesh soup = random_soup(200, 1.0, 1.0, 41);
     std::vector<int> owners(soup.num_tets());
     for (std::size_t t = 0; t < owners.size(); ++t) owners[t] = static_cast<int>(t % static_cast<std::size_t>(size));
-    const mpi::MeshPart good = part_of(soup, owners, rank);
+    const mpi::MeshPart good = mpi::local_part(soup, owners, rank);
     mpi::Detector detector(MPI_COMM_WORLD, one_thread());
 
     mpi::MeshPart bad = good;
