@@ -404,8 +404,8 @@ void Detector::Impl::exchange(const std::vector<PartSummary>& summaries, std::ve
     const std::size_t total_recv = received.size();
     result.exchange.tets_sent = total_send;
     result.exchange.tets_received = total_recv;
-    result.exchange.bytes_sent += total_send * sizeof(TetRecord) + 2 * n * sizeof(int);
-    result.exchange.bytes_received += total_recv * sizeof(TetRecord) + 2 * n * sizeof(int);
+    result.exchange.bytes_sent += total_send * sizeof(TetRecord) + (n - 1) * sizeof(int);
+    result.exchange.bytes_received += total_recv * sizeof(TetRecord) + (n - 1) * sizeof(int);
 }
 
 /// Builds (or, when its tets are the same as last frame's, updates) the local detector from the owned

@@ -61,12 +61,14 @@ std::vector<double> held_positions(const mpi::MeshPart& part, const std::vector<
     return out;
 }
 
-/// Runs @p s split as @p owners on every rank and on one Detector, frame by frame, and compares.
+/// Runs @p s split as @p owners on every rank and on one CPU Detector, frame by frame, and compares.
 void expect_same_as_single(const Scenario& s, const std::vector<std::vector<int>>& owners,
                            const DetectorOptions& options = one_thread()) {
     const int rank = world_rank();
     mpi::Detector distributed(MPI_COMM_WORLD, options);
-    Detector single(options);
+    DetectorOptions reference = options; // one process on the CPU: the answer every backend must give
+    reference.backend = Backend::cpu;
+    Detector single(reference);
     std::vector<mpi::MeshPart> parts;
     for (std::size_t o = 0; o < s.meshes.size(); ++o) {
         parts.push_back(mpi::local_part(s.meshes[o], owners[o], rank));
@@ -212,6 +214,19 @@ TEST(Mpi, ContactsAsTheSingleDetectors) {
     options.narrow_phase = NarrowPhase::sat;
     std::vector<const TetMesh*> meshes{&s.meshes[0], &s.meshes[1]};
     expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), mpi::Partition::random, 3), options);
+}
+
+TEST(Mpi, CudaBackendOnEveryRankAsTheCpu) {
+    std::string reason;
+    if (!cuda_available(&reason)) GTEST_SKIP() << "CUDA backend not tested: " << reason;
+    Scenario s = scenario({random_soup(1500, 1.0, 1.5, 51), random_soup(1500, 1.0, 1.5, 52)});
+    s.self[1] = true;
+    s.frames.push_back(s.frames[0]);
+    for (std::size_t i = 0; i < s.frames.back()[0].size(); i += 3) s.frames.back()[0][i] += 0.05;
+    DetectorOptions cuda = one_thread();
+    cuda.backend = Backend::cuda; // every rank on the one GPU here; one GPU per rank in production
+    std::vector<const TetMesh*> meshes{&s.meshes[0], &s.meshes[1]};
+    expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), mpi::Partition::slabs, 9), cuda);
 }
 
 TEST(Mpi, ScatterMeshGivesEachRankItsPart) {
