@@ -126,6 +126,19 @@ void expect_same_with_both_partitions(const Scenario& s) {
 
 std::vector<int> all_to(const TetMesh& mesh, int rank) { return std::vector<int>(mesh.num_tets(), rank); }
 
+/// The message every rank got from @p action, checked to be the same on all ranks.
+std::string same_error_everywhere(const std::function<void()>& action) {
+    const std::string message = error_message(action);
+    unsigned long length = message.size(), longest = 0;
+    MPI_Allreduce(&length, &longest, 1, MPI_UNSIGNED_LONG, MPI_MAX, MPI_COMM_WORLD);
+    std::string padded = message;
+    padded.resize(longest, '\0');
+    std::string first = padded;
+    MPI_Bcast(first.data(), static_cast<int>(longest), MPI_CHAR, 0, MPI_COMM_WORLD);
+    EXPECT_EQ(padded, first) << "ranks disagree on the error";
+    return message;
+}
+
 TEST(Mpi, RandomSoupsOverFrames) {
     Scenario s = scenario({random_soup(1500, 1.0, 1.5, 11), random_soup(1500, 1.0, 1.5, 12)});
     s.self[0] = true;
@@ -229,6 +242,41 @@ TEST(Mpi, CudaBackendOnEveryRankAsTheCpu) {
     expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), mpi::Partition::slabs, 9), cuda);
 }
 
+TEST(Mpi, NoObjectsNoPairs) {
+    mpi::Detector detector(MPI_COMM_WORLD, one_thread());
+    EXPECT_TRUE(detector.detect().pairs.empty());
+    EXPECT_TRUE(detector.gather_pairs(0).empty());
+}
+
+TEST(Mpi, SharedVertexMovedOnOneRankFailsOnEveryRank) {
+    const int size = world_size(), rank = world_rank();
+    if (size < 2) GTEST_SKIP() << "needs two ranks";
+    const TetMesh box = make_box_mesh(8, 2, 2, 1.0);
+    const std::vector<int> owners = mpi::partition_tets({&box}, size, mpi::Partition::slabs)[0];
+    // A vertex that tets of rank 0 and of rank 1 both use: each of them holds a copy.
+    std::vector<int> users(box.num_vertices(), 0);
+    for (std::size_t t = 0; t < box.num_tets(); ++t)
+        for (int c = 0; c < 4; ++c)
+            if (owners[t] <= 1) users[box.tets[4 * t + c]] |= 1 << owners[t];
+    const auto shared = static_cast<std::uint32_t>(std::find(users.begin(), users.end(), 3) - users.begin());
+    ASSERT_LT(shared, box.num_vertices());
+    const mpi::MeshPart part = mpi::local_part(box, owners, rank);
+    mpi::Detector detector(MPI_COMM_WORLD, one_thread());
+    const ObjectId id = detector.add_object(part);
+    detector.set_self_collision(id, true);
+    std::vector<double> positions = part.positions;
+    if (rank == 1) {
+        const std::size_t k = static_cast<std::size_t>(
+            std::lower_bound(part.vertex_ids.begin(), part.vertex_ids.end(), shared) - part.vertex_ids.begin());
+        positions[3 * k] += 0.25;
+    }
+    detector.set_positions(id, positions.data(), positions.size() / 3);
+    const std::string message = same_error_everywhere([&] { detector.detect(); });
+    EXPECT_NE(message.find("object 0: vertex " + std::to_string(shared) + " has different positions here and on the rank owning tet"),
+              std::string::npos)
+        << message;
+}
+
 TEST(Mpi, ScatterMeshGivesEachRankItsPart) {
     const TetMesh soup = random_soup(300, 1.0, 1.0, 31);
     const std::vector<std::vector<int>> owners =
@@ -261,19 +309,6 @@ TEST(Mpi, SlabsAreContiguousAlongTheLongestAxis) {
     EXPECT_LE(last_x[1], first_x[2]);
     EXPECT_EQ(count[0], count[1]);
     EXPECT_EQ(count[1], count[2]);
-}
-
-/// The message every rank got from @p action, checked to be the same on all ranks.
-std::string same_error_everywhere(const std::function<void()>& action) {
-    const std::string message = error_message(action);
-    unsigned long length = message.size(), longest = 0;
-    MPI_Allreduce(&length, &longest, 1, MPI_UNSIGNED_LONG, MPI_MAX, MPI_COMM_WORLD);
-    std::string padded = message;
-    padded.resize(longest, '\0');
-    std::string first = padded;
-    MPI_Bcast(first.data(), static_cast<int>(longest), MPI_CHAR, 0, MPI_COMM_WORLD);
-    EXPECT_EQ(padded, first) << "ranks disagree on the error";
-    return message;
 }
 
 TEST(Mpi, BadInputOnOneRankFailsOnEveryRank) {
