@@ -84,8 +84,8 @@ struct FrameResult {
 
 /// @brief Finds every colliding pair among the tets of all ranks of a communicator. The constructor,
 /// add_object(), detect() and gather_pairs() are collective: every rank calls them in the same order.
-/// Bad input on one rank makes the collective call throw the same one-line kdet::Error (prefixed
-/// "rank R: ") on every rank, and leaves every rank's detector as it was.
+/// Bad input on one rank makes the collective call throw the same one-line kdet::Error on every rank
+/// (prefixed "rank R: " with the lowest rank at fault), and leaves every rank's detector as it was.
 class Detector {
 public:
     /// @brief Works on a duplicate of @p comm. DetectorOptions::results_to_host must stay on.
