@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Packs what the GPU checks of the CUDA backend need on the `device` machine, which has the CUDA
 # toolkit and CMake but none of kdet's other dependencies and no network: the CUDA build for sm_90
-# (made here: kdet, the tests and the sort-and-sweep peer), the shared libraries they need beyond the
+# (made here: kdet, the tests, the sort-and-sweep peer and, where ../shared/third_party/cuBQL lies beside
+# the repository, the cuBQL peer), the shared libraries they need beyond the
 # C/C++ runtimes, the models and the prepared meshes of the thesis scenes. The bundle is a git-ignored
 # folder that the device tool carries.
 #
@@ -24,7 +25,11 @@ exclude="$(git -C "$repo" rev-parse --absolute-git-dir)/info/exclude"
 mkdir -p "$(dirname "$exclude")"
 grep -qx '/.gpu-bundle/' "$exclude" 2>/dev/null || echo '/.gpu-bundle/' >>"$exclude"
 (cd "$repo" && cmake --preset cuda -B "$build" >/dev/null)
-cmake --build "$build" -j"$(nproc)" --target kdet_cli kdet_tests kdet_gpu_vs_sweep
+# The cuBQL peer exists where CMake found cuBQL (bench/CMakeLists.txt).
+targets=(kdet_cli kdet_tests kdet_gpu_vs_sweep)
+# (grep reads the whole list: with -q it would stop early, and make would fail on the broken pipe.)
+cmake --build "$build" --target help | grep ' kdet_gpu_vs_cubql$' >/dev/null && targets+=(kdet_gpu_vs_cubql)
+cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
 
 # The thesis scenes read their models and prepared meshes; prepare any that are missing.
 KDET_DATA_DIR="$data_dir" KDET_CACHE_DIR="$cache_dir" "$build/kdet" prepare >/dev/null
@@ -32,6 +37,7 @@ KDET_DATA_DIR="$data_dir" KDET_CACHE_DIR="$cache_dir" "$build/kdet" prepare >/de
 rm -rf "$bundle"
 mkdir -p "$bundle/lib"
 cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bundle/"
+[[ ! " ${targets[*]} " == *" kdet_gpu_vs_cubql "* ]] || cp "$build/bench/kdet_gpu_vs_cubql" "$bundle/"
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"
   # Kept, like the build folder, at the same path every time: the build's CMake cache names its
@@ -54,8 +60,8 @@ done
 # The device tool carries 64 MiB with the working tree: the programs go without their symbols (Nsight
 # Compute names the kernels from the device code) and packed with xz, about a third of their size
 # (scripts/gpu-session.sh unpacks them; by hand there: `xz -dc .gpu-bundle/kdet.xz >/tmp/kdet`). With
-# many older builds, drop what a call does not run (the sort-and-sweep peer, the tests) until `du`
-# below and the tree fit.
+# many older builds, drop what a call does not run (the peers, the tests) until `du` below and the
+# tree fit.
 strip "$bundle"/kdet*
 xz -T0 -6 "$bundle"/kdet*
 git -C "$repo" log -1 --format='built at commit %H %s' >"$bundle/commit.txt"

@@ -7,6 +7,9 @@
 #            brute force on armadillos r4 at the frames where they touch
 #   scaling  the procedural scene from 100k to 4M tets (and 8M), frames around the deepest one (60)
 #   peer     kdet against a CUB sort-and-sweep + sat peer on the same frames (bench/gpu_vs_sweep.cu)
+#   cubql    kdet against a cuBQL BVH + exact test peer (bench/gpu_vs_cubql.cu): the thesis scenes at
+#            resolution 4 and the procedural scene at 1M and 4M tets, self-collision off and on; its
+#            CSV also comes back as $OUT/cubql.csv (for bench/results/gpu-DEVICE/cubql-COMMIT.csv)
 #   profile  each kernel's GPU time in two frames of five cases (Nsight Compute), the heaviest case's
 #            occupancy, divergence and cache hits, and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
@@ -22,11 +25,11 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="${KDET_GPU_BUNDLE:-$repo/.gpu-bundle}"
 out="${OUT:-$repo/exports/gpu-session}"
 deadline="${KDET_GPU_DEADLINE:-500}"
-(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|profile|compare|matrix ..." >&2; exit 2; }
+(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|profile|compare|matrix ..." >&2; exit 2; }
 for part in "$@"; do
   case "$part" in
-  tests | sanitizers | r4 | scaling | peer | profile | compare | matrix) ;;
-  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, profile, compare, matrix)" >&2; exit 2 ;;
+  tests | sanitizers | r4 | scaling | peer | cubql | profile | compare | matrix) ;;
+  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, profile, compare, matrix)" >&2; exit 2 ;;
   esac
 done
 work="$(mktemp -d)"
@@ -109,6 +112,10 @@ for part in "$@"; do
   peer)
     step peer 150 "$bin/kdet_gpu_vs_sweep" --csv "$work/peer.csv"
     ;;
+  cubql)
+    step cubql 400 "$bin/kdet_gpu_vs_cubql" --csv "$work/cubql.csv"
+    [[ ! -f "$work/cubql.csv" ]] || cp "$work/cubql.csv" "$out/cubql.csv"
+    ;;
   profile)
     for case in "armadillos-r4-self-yes armadillos -r 4 -s yes --frames 80:81" \
       "armadillos-r4-self-no armadillos -r 4 -s no --frames 80:81" \
@@ -165,6 +172,7 @@ done
 ls "$work/bench"/*.csv >/dev/null 2>&1 && python3 "$repo/python/kdet_summary.py" "$work/bench" >/dev/null 2>&1
 tar -C "$work" --exclude=models --exclude=cache --exclude=bin -czf "$out/gpu-session.tar.gz" .
 [[ -f "$work/peer.log" ]] && tail -15 "$work/peer.log"
+[[ -f "$work/cubql.log" ]] && tail -15 "$work/cubql.log"
 grep -h "FAILED\|PASSED\|ERROR SUMMARY\|RACECHECK SUMMARY" "$work"/*.log 2>/dev/null | sort | uniq -c | head -40
 cat "$out/steps.txt"
 [[ -f "$work/bench/summary.md" ]] && grep '^|' "$work/bench/summary.md"
