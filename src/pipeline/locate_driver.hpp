@@ -81,7 +81,7 @@ public:
     }
 
     std::size_t memory_bytes() const {
-        return points_.capacity_bytes() + held_.capacity_bytes() + boxes_.capacity_bytes() + keys_.capacity_bytes() +
+        return points_.capacity_bytes() + held_.capacity_bytes() + boxes_.capacity_bytes() + entry_boxes_.capacity_bytes() + keys_.capacity_bytes() +
                slot_begin_.capacity_bytes() + slot_end_.capacity_bytes() + big_.capacity_bytes() + hits_.capacity_bytes() + hits_grown_.capacity_bytes() +
                offsets_.capacity_bytes() + objects_.capacity_bytes() + tets_.capacity_bytes() + barycentrics_.capacity_bytes() +
                closest_points_.capacity_bytes() + distances_.capacity_bytes() + counters_.capacity_bytes();
@@ -182,8 +182,10 @@ private:
         fill(exec, slot_begin_, 0u);
         fill(exec, slot_end_, 0u);
         exec.for_each(entries_, LocateSlotRunsKernel{keys_.data(), entries_, slot_begin_.data(), slot_end_.data()});
+        entry_boxes_.resize_discard(std::max<std::uint64_t>(entries_, 1));
+        exec.for_each(entries_, LocateEntryBoxesKernel{keys_.data(), boxes_.data(), entry_boxes_.data()});
         return LocateGridView{scene.positions, scene.tets, scene.user_id, request.first_tet, boxes_.data(), keys_.data(),
-                              entries_, slot_begin_.data(), slot_end_.data(), big_.data(), big_count_, params, hash,
+                              entry_boxes_.data(), entries_, slot_begin_.data(), slot_end_.data(), big_.data(), big_count_, params, hash,
                               slot_bits, layer_mask_};
     }
 
@@ -237,6 +239,7 @@ private:
     buffer<vec3> points_;
     buffer<std::uint8_t> held_;
     buffer<Aabb> boxes_;
+    buffer<Aabb> entry_boxes_;
     buffer<std::uint64_t> keys_;
     buffer<std::uint32_t> slot_begin_, slot_end_;
     buffer<std::uint32_t> big_;

@@ -118,6 +118,15 @@ struct LocateSlotRunsKernel {
     }
 };
 
+/// @brief After the keys are sorted: each key's tet box beside it, so that a query scanning a slot's
+/// run reads the boxes one after the other instead of each at its tet.
+struct LocateEntryBoxesKernel {
+    const std::uint64_t* keys;
+    const Aabb* boxes;
+    Aabb* entry_boxes;
+    KDET_HD void operator()(std::uint64_t k) const { entry_boxes[k] = boxes[keys[k] & locate_key_low]; }
+};
+
 /// @brief The located tets and their grid, as the queries read them.
 struct LocateGridView {
     const vec3* positions;
@@ -126,6 +135,7 @@ struct LocateGridView {
     std::uint32_t first;          ///< stored id of located tet 0
     const Aabb* boxes;
     const std::uint64_t* keys;
+    const Aabb* entry_boxes; ///< the box of each key's tet
     std::uint64_t key_count;
     const std::uint32_t* begin;
     const std::uint32_t* end;
@@ -144,8 +154,7 @@ struct LocateGridView {
 template <class Visit>
 KDET_HD inline void locate_candidates(const LocateGridView& g, const Aabb& box, Visit& visit) {
     const std::uint64_t slots = std::uint64_t{1} << g.slot_bits;
-    const auto try_tet = [&](std::uint32_t t, int layer) {
-        const Aabb b = g.boxes[t];
+    const auto try_tet = [&](std::uint32_t t, const Aabb& b, int layer) {
         if (boxes_overlap(b, box) && (layer < 0 || layer_of(g.params, box_extent(b)) == layer)) visit(t);
     };
     for (int layer = 0; layer < g.params.layer_count; ++layer) {
@@ -154,7 +163,8 @@ KDET_HD inline void locate_candidates(const LocateGridView& g, const Aabb& box, 
         const std::uint64_t cells = std::uint64_t{r.hi[0] - r.lo[0] + 1} * (r.hi[1] - r.lo[1] + 1) * (r.hi[2] - r.lo[2] + 1);
         if (cells > slots) {
             for (std::uint64_t k = 0; k < g.key_count; ++k)
-                if (k == 0 || g.keys[k] != g.keys[k - 1]) try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), -1);
+                if (k == 0 || g.keys[k] != g.keys[k - 1])
+                    try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), g.entry_boxes[k], -1);
             break;
         }
         for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
@@ -162,11 +172,11 @@ KDET_HD inline void locate_candidates(const LocateGridView& g, const Aabb& box, 
             // A tet in two cells of one slot has two equal keys, side by side once sorted.
             for (std::uint32_t k = g.begin[slot], e = g.end[slot]; k < e; ++k)
                 if (k == g.begin[slot] || g.keys[k] != g.keys[k - 1])
-                    try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), layer);
+                    try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), g.entry_boxes[k], layer);
             return true;
         });
     }
-    for (std::uint32_t k = 0; k < g.big_count; ++k) try_tet(g.big[k], -1);
+    for (std::uint32_t k = 0; k < g.big_count; ++k) try_tet(g.big[k], g.boxes[g.big[k]], -1);
 }
 
 /// @brief A hit's key: the point in the high word, the tet's global id (the caller's) in the low one.
