@@ -51,9 +51,10 @@ public:
         point_count_ = n;
         hit_count_ = 0;
         counters_.resize_discard(1);
-        reset_counters(exec);
+        reset_counters(exec, n);
         stage_points(exec, request);
         const LocateGridView grid = build_grid(exec, scene, request, hash);
+        order_points(exec, n);
         find_hits(exec, grid, request.options.within, n, scene.total_tets);
         describe(exec, scene, static_cast<std::uint32_t>(n));
 
@@ -81,7 +82,7 @@ public:
     }
 
     std::size_t memory_bytes() const {
-        return points_.capacity_bytes() + held_.capacity_bytes() + boxes_.capacity_bytes() + entry_boxes_.capacity_bytes() + keys_.capacity_bytes() +
+        return points_.capacity_bytes() + order_.capacity_bytes() + held_.capacity_bytes() + boxes_.capacity_bytes() + entry_boxes_.capacity_bytes() + keys_.capacity_bytes() +
                slot_begin_.capacity_bytes() + slot_end_.capacity_bytes() + big_.capacity_bytes() + hits_.capacity_bytes() + hits_grown_.capacity_bytes() +
                offsets_.capacity_bytes() + objects_.capacity_bytes() + tets_.capacity_bytes() + barycentrics_.capacity_bytes() +
                closest_points_.capacity_bytes() + distances_.capacity_bytes() + counters_.capacity_bytes();
@@ -93,8 +94,9 @@ private:
         exec.download(&c, counters_.data(), 1);
         return c;
     }
-    void reset_counters(Exec& exec) {
+    void reset_counters(Exec& exec, std::size_t points) {
         LocateCounters c{};
+        c.points = points;
         c.first_non_finite_point = no_vertex;
         for (int a = 0; a < 3; ++a) {
             c.region.lo[a] = float_to_ordered(std::numeric_limits<float>::infinity());
@@ -140,6 +142,7 @@ private:
         GridParams params{};
         std::uint32_t slot_bits = 10;
         while ((std::uint64_t{1} << slot_bits) < 2ull * count && slot_bits < 30) ++slot_bits;
+        order_scale_ = vec3{0.0f, 0.0f, 0.0f};
         if (count > 0) {
             std::uint64_t seen = 0;
             std::uint32_t median = 0, largest = 0;
@@ -156,6 +159,14 @@ private:
             params.layer_count = static_cast<int>(std::min<std::uint32_t>(largest - std::min(largest, median) + 1, max_grid_layers));
             params.origin = vec3{ordered_to_float(sizes.region.lo[0]), ordered_to_float(sizes.region.lo[1]),
                                  ordered_to_float(sizes.region.lo[2])};
+            const float lo[3] = {params.origin.x, params.origin.y, params.origin.z};
+            float scale[3];
+            for (int a = 0; a < 3; ++a) {
+                const float extent = ordered_to_float(sizes.region.hi[a]) - lo[a];
+                scale[a] = extent > 0.0f && extent < std::numeric_limits<float>::infinity() ? 1024.0f / extent : 0.0f;
+            }
+            order_lo_ = params.origin;
+            order_scale_ = vec3{scale[0], scale[1], scale[2]};
         }
         if (keys_.size() < std::size_t{4} * count) keys_.resize_discard(std::size_t{4} * count);
         for (;;) {
@@ -189,6 +200,14 @@ private:
                               slot_bits, layer_mask_};
     }
 
+    /// The order the queries run in: the points sorted along a Morton curve (LocatePointOrderKernel).
+    void order_points(Exec& exec, std::size_t n) {
+        order_.resize_discard(std::max<std::size_t>(n, 1));
+        exec.for_each(n, LocatePointOrderKernel{points_.data(), order_lo_, order_scale_, order_.data()});
+        exec.sort(order_.data(), n, &counters_.data()->points, 62,
+                  high_word_key_bits(std::max<std::uint64_t>(n, 1)) - 32);
+    }
+
     /// The hits' keys, sorted: the tets that hold each point, then, for `within`, the nearest tet of
     /// each point that none holds.
     void find_hits(Exec& exec, const LocateGridView& grid, double within, std::size_t n, std::uint32_t total_tets) {
@@ -196,7 +215,7 @@ private:
         if (hits_.size() < n + 1024) hits_.resize_discard(n + 1024);
         for (;;) {
             const KeyAppender out{hits_.data(), hits_.size(), &c->hits, nullptr};
-            exec.for_each(n, LocateContainingKernel{grid, points_.data(), out, held_.data()});
+            exec.for_each(n, LocateContainingKernel{grid, points_.data(), order_.data(), out, held_.data()});
             const LocateCounters found = read_counters(exec);
             hit_count_ = found.hits;
             if (found.hits <= hits_.size()) break;
@@ -213,7 +232,7 @@ private:
                 hits_.swap(hits_grown_);
             }
             const KeyAppender out{hits_.data(), hits_.size(), &c->hits, nullptr};
-            exec.for_each(n, LocateNearestKernel{grid, points_.data(), held_.data(), within, out});
+            exec.for_each(n, LocateNearestKernel{grid, points_.data(), order_.data(), held_.data(), within, out});
             hit_count_ = read_counters(exec).hits;
         }
         const auto points = static_cast<std::uint32_t>(n);
@@ -237,6 +256,7 @@ private:
     }
 
     buffer<vec3> points_;
+    buffer<std::uint64_t> order_; ///< the points' keys in the order the queries run
     buffer<std::uint8_t> held_;
     buffer<Aabb> boxes_;
     buffer<Aabb> entry_boxes_;
@@ -251,6 +271,7 @@ private:
     std::uint64_t entries_ = 0, hit_count_ = 0;
     std::size_t point_count_ = 0;
     std::uint32_t big_count_ = 0, layer_mask_ = 0;
+    vec3 order_lo_{}, order_scale_{}; ///< LocatePointOrderKernel's grid
 };
 
 } // namespace kdet

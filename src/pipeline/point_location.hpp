@@ -30,6 +30,7 @@ struct LocateCounters {
     alignas(64) unsigned long long entries; ///< grid keys appended (counts past the buffer's end)
     alignas(64) unsigned long long hits;    ///< hit keys appended (counts past the buffer's end)
     alignas(64) std::uint32_t big_count;    ///< tets too large for the top layer's cells
+    unsigned long long points;              ///< the query points (the count the sort of their order reads)
     std::uint32_t layer_mask;
     std::uint32_t first_non_finite_point;
     OrderedBox region; ///< the located tets' boxes
@@ -186,10 +187,33 @@ KDET_HD inline void load_located(const LocateGridView& g, std::uint32_t stored, 
     for (int k = 0; k < 4; ++k) v[k] = g.positions[g.tets[stored].v[k]];
 }
 
+/// @brief Per point: its key in the order the queries run, the Morton code of its place in a grid of
+/// 1024 cells per axis over the located tets' region (high word) and its index (low word): queries in
+/// that order read the cells their neighbours just read, where queries in the caller's order (at
+/// random, say) fetched each cell's keys and boxes from memory anew.
+struct LocatePointOrderKernel {
+    const vec3* points;
+    vec3 lo;
+    vec3 scale; ///< order cells per unit along each axis
+    std::uint64_t* keys;
+    KDET_HD static std::uint32_t cell(float x, float lo, float scale) {
+        const float v = (x - lo) * scale;
+        return v >= 0.0f ? static_cast<std::uint32_t>(v < 1023.0f ? v : 1023.0f) : 0u; // NaN: 0
+    }
+    KDET_HD void operator()(std::uint64_t i) const {
+        const vec3 p = points[i];
+        const std::uint32_t code = hash_detail::spread_bits_3(cell(p.x, lo.x, scale.x)) |
+                                   hash_detail::spread_bits_3(cell(p.y, lo.y, scale.y)) << 1 |
+                                   hash_detail::spread_bits_3(cell(p.z, lo.z, scale.z)) << 2;
+        keys[i] = static_cast<std::uint64_t>(code) << 32 | i;
+    }
+};
+
 /// @brief Per point: a hit for every tet that holds it (exactly), and whether it has one.
 struct LocateContainingKernel {
     LocateGridView grid;
     const vec3* points;
+    const std::uint64_t* order; ///< LocatePointOrderKernel's keys, sorted: item i queries point key_second(order[i])
     KeyAppender out;
     std::uint8_t* held; ///< per point
     struct Visit {
@@ -208,7 +232,8 @@ struct LocateContainingKernel {
             ++hits;
         }
     };
-    KDET_HD void operator()(std::uint64_t i) const {
+    KDET_HD void operator()(std::uint64_t item) const {
+        const std::uint32_t i = key_second(order[item]);
         const vec3 p = points[i];
         KeyBatch batch(&out);
         Visit visit{&grid, p, i, &batch, 0};
@@ -238,6 +263,7 @@ KDET_HD inline float grown_up(float x, double d) {
 struct LocateNearestKernel {
     LocateGridView grid;
     const vec3* points;
+    const std::uint64_t* order; ///< as LocateContainingKernel's
     const std::uint8_t* held;
     double within;
     KeyAppender out;
@@ -258,7 +284,8 @@ struct LocateNearestKernel {
             }
         }
     };
-    KDET_HD void operator()(std::uint64_t i) const {
+    KDET_HD void operator()(std::uint64_t item) const {
+        const std::uint32_t i = key_second(order[item]);
         if (held[i]) return;
         const vec3 p = points[i];
         const Aabb box{{grown_down(p.x, within), grown_down(p.y, within), grown_down(p.z, within)},
