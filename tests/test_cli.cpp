@@ -4,6 +4,7 @@
 
 #include <kdet/detector.hpp>
 #include <kdet/io.hpp>
+#include <kdet/locate.hpp>
 
 #include <gtest/gtest.h>
 
@@ -134,6 +135,54 @@ TEST(Cli, CheckExactReportsFalsePositivesOfTheConservativeTestOnly) {
     ASSERT_EQ(loose.exit_code, 0) << loose.out;
     EXPECT_NE(loose.out.find("false negatives  0"), std::string::npos) << loose.out;
     EXPECT_EQ(loose.out.find("false positives  0"), std::string::npos) << loose.out;
+}
+
+TEST(Cli, LocateWritesTheLibrarysHitsAndNamesBadLines) {
+    const TetMesh mesh = test::load_model("octopus-low.mesh");
+    const auto dir = temp_dir();
+    {
+        std::ofstream points(dir / "points.txt");
+        points.precision(17);
+        points << "# x y z\n";
+        for (std::size_t v = 0; v < mesh.num_vertices(); v += 7)
+            points << mesh.positions[3 * v] << ' ' << mesh.positions[3 * v + 1] << ' ' << mesh.positions[3 * v + 2] + 1e-3 << "\n";
+        std::ofstream(dir / "bad.txt") << "0 0 0\n1 2 x\n";
+    }
+    const std::vector<double> xyz = read_points((dir / "points.txt").string());
+    LocateOptions within;
+    within.within = 0.05;
+    const LocateResult expected = locate(mesh, xyz, within);
+    const auto out = dir / "hits.txt";
+    const Outcome r = kdet_cli("locate " + data_path("octopus-low.mesh") + " " + (dir / "points.txt").string() + " --within 0.05 --out " +
+                               out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    std::ifstream in(out);
+    std::size_t lines = 0, point = 0;
+    std::uint32_t tet = 0;
+    double b[4], distance = 0;
+    while (in >> point >> tet >> b[0] >> b[1] >> b[2] >> b[3] >> distance) {
+        ASSERT_LT(lines, expected.hit_count);
+        EXPECT_GE(lines, expected.offsets[point]);
+        EXPECT_LT(lines, expected.offsets[point + 1]);
+        EXPECT_EQ(tet, expected.tets[lines]);
+        for (int k = 0; k < 4; ++k) EXPECT_EQ(b[k], expected.barycentrics[4 * lines + k]);
+        EXPECT_EQ(distance, expected.distances[lines]);
+        ++lines;
+    }
+    EXPECT_EQ(lines, expected.hit_count);
+    EXPECT_GT(lines, 0u);
+
+    const Outcome bad = kdet_cli("locate " + data_path("octopus-low.mesh") + " " + (dir / "bad.txt").string() + " --out " + out.string());
+    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_NE(bad.out.find("bad.txt:2: expected a coordinate, found 'x'"), std::string::npos) << bad.out;
+    EXPECT_EQ(line_count(bad.out), 1u) << bad.out;
+    for (const char* within_value : {"-1", "nan", "inf", "1x"}) {
+        const Outcome refused = kdet_cli("locate " + data_path("octopus-low.mesh") + " " + (dir / "points.txt").string() +
+                                         " --out " + out.string() + " --within " + within_value);
+        EXPECT_EQ(refused.exit_code, 2) << within_value;
+        EXPECT_NE(refused.out.find("for --within"), std::string::npos) << refused.out;
+        EXPECT_EQ(line_count(refused.out), 1u) << refused.out;
+    }
 }
 
 TEST(Cli, BenchRunsTheBuiltInSceneWithoutData) {

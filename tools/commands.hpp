@@ -15,6 +15,7 @@ enum ExitCode { exit_ok = 0, exit_failure = 1, exit_usage = 2 };
 
 int run_collide(int argc, char** argv);
 int run_bench(int argc, char** argv);
+int run_locate(int argc, char** argv);
 
 /// @brief The help line of one option of the table as @p front_end shows it (flag, placeholder, text).
 std::string option_help_line(const OptionInfo& option, FrontEnd front_end, const DetectorOptions& defaults);

@@ -18,6 +18,8 @@ Finds every colliding pair of tetrahedra between tetrahedral meshes and inside o
 
 commands:
   collide A [B] [options]   colliding pairs between two meshes, or inside one with --self
+  locate MESH POINTS --out FILE [--within D]
+                            the tets holding each point, with barycentric coordinates
   bench [scene] [options]   runs a scene frame by frame (default: the built-in procedural scene)
                             and writes the thesis's CSV files
   view [SCENE | A [B]]      shows a scene or meshes in a window, detecting collisions every frame;
@@ -41,6 +43,7 @@ int main(int argc, char** argv) {
     try {
         if (command == "collide") return run_collide(argc, argv);
         if (command == "bench") return run_bench(argc, argv);
+        if (command == "locate") return run_locate(argc, argv);
         if (command == "prepare") return run_prepare(argc, argv);
         if (command == "plot") return run_plot(argc, argv);
         if (command == "view") return run_view(argc, argv);
@@ -52,7 +55,7 @@ int main(int argc, char** argv) {
             std::cout << "kdet " << kdet::version() << "\n";
             return exit_ok;
         }
-        std::cerr << "kdet: unknown command '" << command << "' (commands: collide, bench, view, plot, prepare; see 'kdet --help')\n";
+        std::cerr << "kdet: unknown command '" << command << "' (commands: collide, locate, bench, view, plot, prepare; see 'kdet --help')\n";
         return exit_usage;
     } catch (const UsageError& e) {
         std::cerr << "kdet " << e.what() << "\n";

@@ -17,6 +17,10 @@ namespace kdet {
 
 using ObjectId = std::uint32_t;
 
+struct LocateOptions;       // locate.hpp
+struct LocateResult;        // locate.hpp
+struct DeviceLocateResults; // locate.hpp
+
 /// @brief Vertex positions as they lie in the caller's memory: coordinate k (0: x, 1: y, 2: z) of
 /// vertex v is element `v * row_stride + k * column_stride` of `data`, float32 or float64 (strides
 /// in elements, not bytes; any sign, zero included, as NumPy's strides divided by the item size).
@@ -114,6 +118,17 @@ public:
     /// @brief The last detection's pairs, flags and contacts in the backend's memory. Throws
     /// kdet::Error while a detect_async() frame is not finished.
     DeviceResults device_results() const;
+    /// @brief Point location (locate.hpp) in `object`'s tets, or every object's (all_objects), at the
+    /// positions as last set: for each point every tet that holds it. The points are host memory;
+    /// with locate_on_device(), memory of the detector's backend (as set_positions_on_device()).
+    /// The result stays valid until the next locate(). Throws kdet::Error on a non-finite point, a bad
+    /// object or option, or positions handed over on the device that no detect() has checked yet.
+    const LocateResult& locate(const PositionsView& points, ObjectId object, const LocateOptions& options);
+    const LocateResult& locate(const PositionsView& points, ObjectId object);
+    const LocateResult& locate_on_device(const PositionsView& points, ObjectId object, const LocateOptions& options);
+    /// @brief The last locate()'s results in the backend's memory.
+    DeviceLocateResults device_locate_results() const;
+
     /// @brief Global id of the first tet of `object` (see DeviceResults).
     std::uint32_t first_tet(ObjectId object) const;
 

@@ -6,6 +6,7 @@
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
+#include <kdet/locate.hpp>
 #include <kdet/mesh.hpp>
 #include <kdet/option_table.hpp>
 #include <kdet/options.hpp>

@@ -3,6 +3,7 @@
 // take meshio meshes and (vertices, tets) pairs as well before calling the library's.
 #include "arrays.hpp"
 #include "fields.hpp"
+#include "locate.hpp"
 #ifdef KDET_HAS_CUDA
 #include <cuda_runtime.h>
 #endif
@@ -613,6 +614,15 @@ void bind_detector(nb::module_& m) {
              "Completes the detection detect_async() started (one wait; a buffer that was too small grows and "
              "the frame runs again) and returns what detect() returns.")
         .def(
+            "locate",
+            [](nb::handle handle, nb::handle points, nb::handle object, nb::handle within, bool device_results) {
+                PyDetector& self = nb::cast<PyDetector&>(handle);
+                return detector_locate(handle, self.detector, self.mutex, points, object, within, device_results);
+            },
+            "points"_a, "object"_a = nb::none(), "within"_a = nb::none(), "device_results"_a = false,
+            "Point location in one object (or all: None) at the positions as last set: kdet.locate()'s LocateResult, "
+            "points (n, 3) host or GPU arrays; device_results=True gives DLPack arrays of the detector's buffers.")
+        .def(
             "first_tet",
             [](PyDetector& self, std::int64_t object) { return self.detector.first_tet(object_id(self, object)); },
             "object"_a, "Global id of the object's first tet (see DeviceFrameResult).")
@@ -675,4 +685,5 @@ NB_MODULE(_kdet, m) {
     bind_results(m);
     bind_detector(m);
     bind_collide(m);
+    bind_locate(m, &options_from_keywords);
 }

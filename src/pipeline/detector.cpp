@@ -3,6 +3,7 @@
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
+#include <kdet/locate.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -26,6 +27,7 @@ struct Detector::Impl {
     // Per object: positions given on the device wait in the pipeline's staging buffer for the next frame.
     std::vector<std::uint8_t> positions_staged;
     FrameResult result;
+    LocateResult located;
     bool frame_pending = false; // detect_async() ran, finish() not yet
 
     std::size_t objects() const { return object_vertex_begin.size() - 1; }
@@ -116,8 +118,13 @@ struct Detector::Impl {
         const std::string name = "object " + std::to_string(object) + ": ";
         if (xyz.vertex_count != expected)
             throw Error(name + "got " + std::to_string(xyz.vertex_count) + " vertices, expected " + std::to_string(expected));
+        check_extent(name + "the positions", xyz);
+    }
+
+    /// Rejects a view with no data or strides reaching further than an address can; `what` names it.
+    static void check_extent(const std::string& what, const PositionsView& xyz) {
         if (xyz.vertex_count == 0) return;
-        if (!xyz.data) throw Error(name + "the positions' data pointer is null");
+        if (!xyz.data) throw Error(what + "' data pointer is null");
         const auto magnitude = [](std::ptrdiff_t stride) {
             return stride < 0 ? 0 - static_cast<std::uint64_t>(stride) : static_cast<std::uint64_t>(stride);
         };
@@ -128,7 +135,7 @@ struct Detector::Impl {
                                __builtin_add_overflow(rows, columns, &extent) || __builtin_mul_overflow(extent, item, &extent) ||
                                extent > static_cast<std::uint64_t>(PTRDIFF_MAX);
         if (overflows)
-            throw Error(name + "the positions' strides (" + std::to_string(xyz.row_stride) + ", " +
+            throw Error(what + "' strides (" + std::to_string(xyz.row_stride) + ", " +
                         std::to_string(xyz.column_stride) + " elements) reach beyond any address for " +
                         std::to_string(xyz.vertex_count) + " vertices");
     }
@@ -142,6 +149,56 @@ struct Detector::Impl {
         topology.to_stored_order(first, xyz, positions.data() + first, host_threads());
         positions_dirty[object] = 1;
         positions_on_device[object] = positions_staged[object] = 0;
+    }
+
+    /// Point location over the current positions (locate.hpp); `points` on the host or, with
+    /// `on_device`, in the backend's memory.
+    const LocateResult& locate(const PositionsView& points, bool on_device, ObjectId object, const LocateOptions& how) {
+        if (!(how.within >= 0.0) || !std::isfinite(how.within))
+            throw Error("locate: within must be finite and not negative, got " + std::to_string(how.within));
+        if (object != all_objects) check_object(object);
+        check_extent("locate: the points", points);
+        if (objects() == 0) { // no tets, no pipeline geometry: nothing holds any point
+            located = LocateResult{};
+            located.point_count = points.vertex_count;
+            located.offsets.assign(points.vertex_count + 1, 0);
+            return located;
+        }
+        if (topology_changed) rebuild_pipeline();
+        for (std::size_t o = 0; o < objects(); ++o)
+            if (positions_staged[o])
+                throw Error("locate: object " + std::to_string(o) +
+                            "'s positions given on the device are not checked yet; call detect() first");
+        std::vector<PositionUpload> uploads;
+        for (std::size_t o = 0; o < objects(); ++o) {
+            const std::uint32_t first = object_vertex_begin[o];
+            if (positions_dirty[o]) uploads.push_back({first, positions.data() + first, object_vertex_begin[o + 1] - first});
+        }
+        pipeline->upload_positions(uploads);
+        std::fill(positions_dirty.begin(), positions_dirty.end(), 0);
+
+        const auto& begin = topology.object_tet_begin;
+        LocateRequest request;
+        request.points = points;
+        request.points_on_device = on_device;
+        request.first_tet = object == all_objects ? 0 : begin[object];
+        request.tet_count = (object == all_objects ? begin.back() : begin[object + 1]) - request.first_tet;
+        request.options = how;
+        std::vector<vec3> converted;
+        if (!on_device) {
+            const std::uint32_t bad = first_non_finite(points);
+            if (bad != no_vertex)
+                throw Error("locate: point " + std::to_string(bad) + " has a non-finite coordinate (or one beyond float range)");
+            converted.resize(points.vertex_count);
+            const auto count = static_cast<std::ptrdiff_t>(points.vertex_count);
+            with_positions(points, [&](const auto& source) {
+#pragma omp parallel for num_threads(host_threads()) schedule(static) if (count > host_parallel_elements)
+                for (std::ptrdiff_t v = 0; v < count; ++v) converted[v] = source(static_cast<std::uint64_t>(v));
+            });
+            request.points = xyz_view(converted.data(), converted.size());
+        }
+        pipeline->locate(request, located);
+        return located;
     }
 
     /// Adds an object; on a bad index or coordinate it throws and leaves the detector as it was.
@@ -304,6 +361,19 @@ DeviceResults Detector::device_results() const {
         throw Error("device_results: the frame started by detect_async() is not finished; call finish() first");
     return impl_->pipeline->device_results();
 }
+
+const LocateResult& Detector::locate(const PositionsView& points, ObjectId object, const LocateOptions& options) {
+    if (impl_->frame_pending) finish();
+    return impl_->locate(points, false, object, options);
+}
+const LocateResult& Detector::locate(const PositionsView& points, ObjectId object) {
+    return locate(points, object, LocateOptions{});
+}
+const LocateResult& Detector::locate_on_device(const PositionsView& points, ObjectId object, const LocateOptions& options) {
+    if (impl_->frame_pending) finish();
+    return impl_->locate(points, true, object, options);
+}
+DeviceLocateResults Detector::device_locate_results() const { return impl_->pipeline->device_locate_results(); }
 
 std::uint32_t Detector::first_tet(ObjectId object) const {
     impl_->check_object(object);

@@ -4,6 +4,7 @@
 /// BaselinePipeline (baselines.hpp) for the thesis's baselines, chosen by make_pipeline.
 
 #include "pipeline/gather_positions.hpp"
+#include "pipeline/locate_driver.hpp"
 #include "pipeline/positions_check.hpp"
 #include "pipeline/scene_view.hpp"
 
@@ -108,6 +109,11 @@ public:
     /// results are empty.
     virtual std::uint32_t finish(FrameResult& result) = 0;
     virtual DeviceResults device_results() = 0;
+    /// @brief Copies in positions that changed on the host, as start() does, outside a frame.
+    virtual void upload_positions(const std::vector<PositionUpload>& uploads) = 0;
+    /// @brief Point location (Locator) over the current positions; waits for its results.
+    virtual void locate(const LocateRequest& request, LocateResult& result) = 0;
+    virtual DeviceLocateResults device_locate_results() const = 0;
     virtual std::size_t memory_bytes() const = 0;
     virtual std::string device_name() const = 0;
 };

@@ -106,6 +106,18 @@ public:
                              options_.contacts ? out_contacts_.data() : nullptr};
     }
 
+    void upload_positions(const std::vector<PositionUpload>& uploads) override {
+        for (const PositionUpload& u : uploads) exec_.upload(positions_.data() + u.first, u.positions, u.count);
+    }
+
+    void locate(const LocateRequest& request, LocateResult& result) override {
+        const LocateScene scene{positions_.data(), tets_.data(), tet_object_.data(), user_id_.data(), stored_id_.data(),
+                                object_tet_begin_.data(), static_cast<std::uint32_t>(tets_.size())};
+        locator_.run(exec_, scene, request, options_.hash, result);
+    }
+
+    DeviceLocateResults device_locate_results() const override { return locator_.device_results(); }
+
     std::size_t memory_bytes() const override {
         return tets_.capacity_bytes() + tet_object_.capacity_bytes() + object_tet_begin_.capacity_bytes() +
                user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() + vertex_user_id_.capacity_bytes() +
@@ -115,7 +127,8 @@ public:
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
                grid_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
-               resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() + exec_.scratch_bytes();
+               resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() + exec_.scratch_bytes() +
+               locator_.memory_bytes();
     }
 
     /// The grid's buffers: the table, the compacted lists and their bounds, the own-layer rows, the claim
@@ -253,6 +266,7 @@ protected:
     bool self_collision_ = false;    ///< some object is checked against itself this frame
     std::size_t colliding_count_ = 0; ///< pairs in out_keys_ after the last detection
     GridView grid_{}; ///< the frame's grid, once populated
+    Locator<Exec> locator_; ///< point location's buffers
 
     // The frame in flight: the staged ranges it adopts, and what it copies back at its end, read by
     // finish(): the counters, and the results where they land (Exec::landed).

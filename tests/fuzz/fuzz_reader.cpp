@@ -1,5 +1,5 @@
 // libFuzzer harness for one reader, chosen at compile time by KDET_FUZZ_EXTENSION (".msh", ".vtk",
-// ".mesh", ".node", ".obj", ".off", ".stl" or ".ply"): each input is written to a scratch file of that
+// ".mesh", ".node", ".obj", ".off", ".stl", ".ply" or ".xyz", the query points of `kdet locate`): each input is written to a scratch file of that
 // extension and read. kdet::Error is the expected answer to bad input; a crash, a sanitizer report or
 // any other exception is a finding. For TetGen the input is the .node file, a NUL byte, the .ele file.
 
@@ -55,6 +55,8 @@ void read_input(std::string_view input) {
     write_file(path, input);
     if (extension == ".obj" || extension == ".off" || extension == ".stl" || extension == ".ply") {
         kdet::read_surface(path);
+    } else if (extension == ".xyz") {
+        kdet::read_points(path);
     } else {
         kdet::read_tet_mesh(path);
     }

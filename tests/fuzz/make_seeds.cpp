@@ -34,7 +34,7 @@ void write_bytes(const fs::path& file, const std::string& content) { std::ofstre
 
 void write_seeds(const fs::path& root) {
     const kdet::TetMesh mesh = seed_mesh();
-    for (const char* format : {"msh", "vtk", "mesh", "node", "obj", "off", "stl", "ply"}) {
+    for (const char* format : {"msh", "vtk", "mesh", "node", "obj", "off", "stl", "ply", "xyz"}) {
         fs::remove_all(root / format);
         fs::create_directories(root / format);
     }
@@ -63,6 +63,8 @@ void write_seeds(const fs::path& root) {
     write_bytes(root / "ply" / "ascii", square_ply_header("ascii") + square_ply_ascii_body);
     write_bytes(root / "ply" / "little", square_ply_header("binary_little_endian") + square_ply_binary_body(false));
     write_bytes(root / "ply" / "big", square_ply_header("binary_big_endian") + square_ply_binary_body(true));
+    // Query points of `kdet locate`: x y z lines, a comment, blank lines, exponents.
+    write_bytes(root / "xyz" / "points", "# x y z\n0 0 0\n\n1.5 -2e-3 4E+2\n0.25 0.5 0.75 # last\n");
 }
 
 } // namespace

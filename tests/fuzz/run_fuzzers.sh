@@ -7,7 +7,7 @@
 # Exit code 77 means skipped (the tests' SKIP_RETURN_CODE); a finding fails with libFuzzer's report.
 set -euo pipefail
 readonly skipped=77
-readonly formats=(msh vtk mesh node obj off stl ply)
+readonly formats=(msh vtk mesh node obj off stl ply xyz)
 
 build() {
   local src=$1 out=$2 cxx=$3

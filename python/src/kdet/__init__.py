@@ -42,6 +42,7 @@ from ._kdet import (
     Error,
     FrameCounts,
     FrameResult,
+    LocateResult,
     StageTimes,
     TetMesh,
     __version__,
@@ -64,6 +65,7 @@ __all__ = [
     "Error",
     "FrameCounts",
     "FrameResult",
+    "LocateResult",
     "StageTimes",
     "TetMesh",
     "__version__",
@@ -72,6 +74,7 @@ __all__ = [
     "cuda_available",
     "cuda_unavailable_reason",
     "from_meshio",
+    "locate",
     "read_tet_mesh",
     "version",
     "write_tet_mesh",
@@ -104,3 +107,13 @@ def collide_self(mesh: MeshLike, **options: Any) -> np.ndarray:
     Tets that share a vertex are adjacent and never reported. options are Detector's keyword arguments."""
     return _kdet.collide_self(_as_tet_mesh(mesh, "mesh"), **options)
 
+
+
+def locate(mesh: MeshLike, points: Any, within: Union[float, None] = None, **options: Any) -> LocateResult:
+    """For each point ((n, 3) float32 or float64), every tet of mesh whose closed set holds it, with its
+    barycentric coordinates, decided exactly for the float32 coordinates; with within=d a point that no
+    tet holds gets the nearest tet at distance <= d. The hits of point p are rows
+    offsets[p]:offsets[p + 1] of the result's arrays (tets, barycentrics, closest_points, distances).
+
+    options are Detector's keyword arguments (backend, threads, ...)."""
+    return _kdet.locate(_as_tet_mesh(mesh, "mesh"), points, within, **options)
