@@ -185,6 +185,17 @@ TEST(Filters, RestContactsAreNeverReportedAgainWhileNewContactsAre) {
     }
 }
 
+TEST(Filters, RestContactsReadPositionsGivenOnTheDeviceAndTheFrameUsesThem) {
+    // On the CPU backend "device" memory is the host's: the positions wait in the staging buffer.
+    const TetMesh rest = jittered_box(6, 5, 4, 0.1, 0.45, 5), moved = jittered_box(6, 5, 4, 0.1, 0.45, 7);
+    Detector detector;
+    detector.set_self_collision(detector.add_object(rest), true);
+    ASSERT_FALSE(detector.detect().pairs.empty());
+    detector.set_positions_on_device(0, PositionsView{moved.positions.data(), true, moved.num_vertices()});
+    EXPECT_GT(detector.exclude_rest_contacts(0), 20u);
+    EXPECT_TRUE(detector.detect().pairs.empty());
+}
+
 TEST(Filters, BadInputIsOneLineAndLeavesTheDetectorAsItWas) {
     const TetMesh mesh = jittered_box(5, 4, 4, 0.1, 0.45, 9);
     Detector detector;

@@ -44,7 +44,8 @@ struct PositionsView {
 /// add objects once, then each frame set_positions() for the objects that moved and detect().
 ///
 /// Semantics: two tets collide when their closed sets share a point. Within one object, tets that
-/// share a vertex index are adjacent and never reported. Positions are stored as float32.
+/// share a vertex index are adjacent and never reported (nor, where asked for, tets within a few
+/// rings of each other and pairs touching at rest: set_self_exclusion_rings, exclude_rest_contacts). Positions are stored as float32.
 /// Every finite float32 coordinate is accepted and answered exactly by NarrowPhase::exact with every
 /// method, from subnormal values to the largest float and far from the origin; a scene scaled by a
 /// power of two (exactly, no coordinate becoming subnormal) gives the same pairs with every method and
