@@ -106,7 +106,7 @@ TEST(Filters, ExclusionRingsMatchTheRingsOfTheMeshOnEveryMethod) {
     // A crumpled bar touches itself between near neighbours and where it is wound over itself; a
     // second copy overlaps it, so rings
     // (which only act within one object) leave the pairs between the two alone.
-    const TetMesh crumpled = test::crumpled_bar(40, 0.45, 3);
+    const TetMesh crumpled = test::crumpled_bar(30, 0.45, 3);
     const TetMesh other = jittered_box(4, 4, 4, 0.1, 0.45, 4, 0.3);
     const std::vector<TetPair> all = brute_force_everything({crumpled, other});
     for (int rings : {1, 2}) {
