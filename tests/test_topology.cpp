@@ -181,9 +181,9 @@ TEST(Topology, RandomRemovalsSplitsAndReaddsMatchBruteForce) {
 TEST(Topology, TinyBuffersGrowAfterEveryChange) {
     DetectorOptions tiny;
     tiny.initial_candidate_capacity = 1;
-    random_changes(tiny, 3, 10);
+    random_changes(tiny, 3, 8);
     tiny.method = Method::brute_force_pairs;
-    random_changes(tiny, 4, 6);
+    random_changes(tiny, 4, 4);
 }
 
 TEST(Topology, CudaMatchesTheCpuThroughEveryChange) {
