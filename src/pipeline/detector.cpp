@@ -158,7 +158,6 @@ struct Detector::Impl {
         positions_on_device[object] = positions_staged[object] = 0;
     }
 
-    /// Adds an object; on a bad index or coordinate it throws and leaves the detector as it was.
     /// Rejects a scene of more tets or vertices than ids can number, were `tets` and `vertices` to
     /// replace `old_tets` and `old_vertices`.
     void check_sizes(std::uint64_t tets, std::uint64_t vertices, std::uint64_t old_tets, std::uint64_t old_vertices) const {
@@ -191,6 +190,7 @@ struct Detector::Impl {
         return converted;
     }
 
+    /// Adds an object; on a bad index or coordinate it throws and leaves the detector as it was.
     ObjectId add(const PositionsView& xyz, const std::uint32_t* tets, std::size_t tet_count) {
         const std::size_t vertex_count = xyz.vertex_count;
         check_sizes(tet_count, vertex_count, 0, 0);
@@ -277,9 +277,9 @@ struct Detector::Impl {
         at_rest.narrow_phase = options.narrow_phase;
         at_rest.threads = options.threads;
         Detector detector(at_rest);
-        const ObjectId objects[2] = {a, b};
-        for (const ObjectId o : objects) {
-            if (o == b && a == b && detector.object_count() == 1) break;
+        const ObjectId both[2] = {a, b};
+        for (std::size_t i = 0; i < (a == b ? 1u : 2u); ++i) {
+            const ObjectId o = both[i];
             const std::uint32_t first_vertex = object_vertex_begin[o], first = topology.object_tet_begin[o];
             const std::uint32_t count = topology.object_tet_begin[o + 1] - first;
             std::vector<std::uint32_t> tets(4 * std::size_t{count});
