@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <set>
+#include <string>
 #include <vector>
 
 namespace kdet {
@@ -194,6 +195,35 @@ TEST(Filters, RestContactsReadPositionsGivenOnTheDeviceAndTheFrameUsesThem) {
     detector.set_positions_on_device(0, PositionsView{moved.positions.data(), true, moved.num_vertices()});
     EXPECT_GT(detector.exclude_rest_contacts(0), 20u);
     EXPECT_TRUE(detector.detect().pairs.empty());
+}
+
+TEST(CudaFilters, GroupsRingsAndRestContactsMatchTheCpu) {
+    std::string reason;
+    if (!cuda_available(&reason)) GTEST_SKIP() << "CUDA backend not tested: " << reason;
+    const TetMesh crumpled = test::crumpled_bar(30, 0.45, 3), moved = test::crumpled_bar(30, 0.45, 4);
+    const TetMesh box = jittered_box(4, 4, 4, 0.1, 0.45, 4, 0.3);
+    const TetMesh soup = random_soup(400, 2.0, 1.0, 5);
+    const auto frames = [&](Backend backend) {
+        DetectorOptions options;
+        options.backend = backend;
+        options.initial_candidate_capacity = 1;
+        Detector detector(options);
+        detector.set_self_collision(detector.add_object(crumpled), true);
+        detector.set_self_collision(detector.add_object(box), true);
+        detector.add_object(soup);
+        detector.set_self_exclusion_rings(0, 1);
+        detector.exclude_rest_contacts(1);
+        detector.exclude_rest_contacts(0, 1);
+        detector.set_collision_filter(1, 3u, ~0u);
+        detector.set_collision_filter(2, 2u, 2u); // against object 1 only
+        std::vector<std::vector<TetPair>> out{detector.detect().pairs};
+        detector.set_positions(0, moved.positions.data(), moved.num_vertices());
+        out.push_back(detector.detect().pairs);
+        return out;
+    };
+    const auto gpu = frames(Backend::cuda);
+    EXPECT_FALSE(gpu.back().empty());
+    EXPECT_EQ(gpu, frames(Backend::cpu));
 }
 
 TEST(Filters, BadInputIsOneLineAndLeavesTheDetectorAsItWas) {

@@ -186,7 +186,7 @@ TEST(Topology, TinyBuffersGrowAfterEveryChange) {
     random_changes(tiny, 4, 4);
 }
 
-TEST(Topology, CudaMatchesTheCpuThroughEveryChange) {
+TEST(CudaTopology, MatchesTheCpuThroughEveryChange) {
     std::string reason;
     if (!cuda_available(&reason)) GTEST_SKIP() << "CUDA backend not tested: " << reason;
     DetectorOptions gpu;
