@@ -6,11 +6,13 @@
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
+#include <kdet/scenes.hpp>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <random>
 #include <string>
@@ -193,6 +195,35 @@ TEST(CudaTopology, MatchesTheCpuThroughEveryChange) {
     gpu.backend = Backend::cuda;
     gpu.initial_candidate_capacity = 1;
     EXPECT_EQ(random_changes(gpu, 5, 12), random_changes(DetectorOptions{}, 5, 12));
+}
+
+TEST(Topology, TearingSceneFramesEqualAFreshDetectorOnTheFramesMeshes) {
+    const std::unique_ptr<Scene> scene = open_scene("tearing");
+    ASSERT_TRUE(scene->changes_tets());
+    Detector detector;
+    add_scene_objects(detector, *scene, true);
+    std::vector<std::vector<std::uint32_t>> current = {scene->rest_mesh(0).tets, scene->rest_mesh(1).tets};
+    std::size_t torn_pairs = 0;
+    for (int frame : {0, 25, 60, 119}) {
+        set_scene_tets(detector, *scene, frame, current);
+        Detector fresh;
+        for (std::size_t o = 0; o < 2; ++o) {
+            TetMesh mesh;
+            scene->positions(o, frame, mesh.positions);
+            mesh.tets = current[o];
+            fresh.set_self_collision(fresh.add_object(mesh), true);
+            std::vector<double> xyz;
+            scene->positions(o, frame, xyz);
+            detector.set_positions(static_cast<ObjectId>(o), xyz.data(), xyz.size() / 3);
+        }
+        EXPECT_EQ(detector.tet_count(0), current[0].size() / 4) << frame;
+        const std::vector<TetPair> expected = fresh.detect().pairs;
+        EXPECT_EQ(detector.detect().pairs, expected) << "frame " << frame;
+        if (frame > 0) torn_pairs += expected.size();
+    }
+    // The cut runs across the slab: two columns of cubes, 24 x 3 of them each, six tets a cube.
+    EXPECT_EQ(scene->rest_mesh(0).tets.size() - current[0].size(), 4u * 2 * 24 * 3 * 6);
+    EXPECT_GT(torn_pairs, 100u) << "the box pressed into the torn slab";
 }
 
 TEST(Topology, ExclusionsFollowTheirObjectsThroughOtherObjectsChanges) {

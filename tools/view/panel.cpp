@@ -97,9 +97,11 @@ void row_ms(const char* name, double ms) {
 }
 
 /// @brief Whether the resolution (1-4) changes the scene: the thesis scenes but the one that is
-/// always at resolution 2, and scene files (their prepared models).
+/// always at resolution 2, and scene files (their prepared models); not the generated ones.
 bool uses_resolution(const ViewSource& source) {
-    if (!source.meshes.empty() || source.scene == "procedural" || source.scene == "pass_through_armadillos") return false;
+    if (!source.meshes.empty() || source.scene == "procedural" || source.scene == "pass_through_armadillos" ||
+        source.scene == "tearing")
+        return false;
     const std::vector<std::string> names = scene_names();
     const std::string& s = source.scene;
     return std::find(names.begin(), names.end(), s) != names.end() ||
