@@ -1,5 +1,6 @@
 // The kdet command as a user runs it: outputs, the pairs file, and one-line errors with exit codes.
 
+#include "filter_support.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -81,6 +82,30 @@ TEST(Cli, SelfCollisionJsonHasCountsTimesAndMemory) {
                             "\"times_ms\": {\"bounding_boxes\": ", "\"narrow_phase\": ", "\"total_ms\": ",
                             "\"memory_bytes\": ", "\"host_waits\": "})
         EXPECT_NE(r.out.find(key), std::string::npos) << key << " missing in " << r.out;
+}
+
+TEST(Cli, ExclusionRingsLeaveOutTheLibrarysPairsAndNeedSelf) {
+    const TetMesh crumpled = test::crumpled_bar(30, 0.45, 3);
+    const std::string mesh = (temp_dir() / "crumpled.mesh").string();
+    write_medit(crumpled, mesh);
+    Detector detector;
+    detector.set_self_collision(detector.add_object(crumpled), true);
+    const std::size_t all = detector.detect().pairs.size();
+    detector.set_self_exclusion_rings(0, 2);
+    const std::size_t expected = detector.detect().pairs.size();
+    ASSERT_GT(expected, 0u);
+    ASSERT_LT(expected, all);
+    const Outcome r = kdet_cli("collide " + mesh + " --self --exclusion-rings 2");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    EXPECT_NE(r.out.find("self-collision, exclusion rings 2\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("colliding pairs   " + std::to_string(expected) + "\n"), std::string::npos) << r.out;
+    const Outcome pair = kdet_cli("collide " + mesh + " " + mesh + " --exclusion-rings 1");
+    EXPECT_EQ(pair.exit_code, 2);
+    EXPECT_EQ(pair.out, "kdet collide: --exclusion-rings acts within one mesh: it needs --self\n");
+    const Outcome range = kdet_cli("collide " + mesh + " --self --exclusion-rings 5");
+    EXPECT_EQ(range.exit_code, 2);
+    EXPECT_NE(range.out.find("invalid value '5' for --exclusion-rings: expected an integer in [0, 4]"), std::string::npos)
+        << range.out;
 }
 
 TEST(Cli, ExactTestReportsThePairsThatReachedItsExactStage) {

@@ -321,7 +321,7 @@ struct SizedTets {
         infos.resize(count);
         planes.resize(count);
         scene = SceneView{positions.data(), tets.data(), objects.data(), infos.data(), planes.data(), nullptr, &self,
-                          &checked, &everywhere_box, count, 1};
+                          &checked, &everywhere_box, count, 1, nullptr, nullptr};
         DetectorOptions options;
         options.threads = threads;
         const CpuExec exec(options);

@@ -94,6 +94,8 @@ BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, const 
     const int last = last_frame_of(config, scene);
     BenchOutcome outcome;
     std::vector<std::vector<float>> xyz(scene.num_objects());
+    std::vector<std::vector<std::uint32_t>> tets(scene.num_objects());
+    for (std::size_t o = 0; o < scene.num_objects(); ++o) tets[o] = scene.rest_mesh(o).tets;
     for (int run = 0; run < config.runs && !outcome.stopped; ++run) {
         std::vector<FrameRow>& rows = outcome.runs.emplace_back();
         for (int frame = config.first_frame; frame <= last; ++frame) {
@@ -101,6 +103,7 @@ BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, const 
                 outcome.stopped = true;
                 break;
             }
+            set_scene_tets(detector, scene, frame, tets);
             for (std::size_t o = 0; o < scene.num_objects(); ++o) {
                 scene.positions(o, frame, xyz[o]);
                 detector.set_positions(static_cast<ObjectId>(o), xyz[o].data(), xyz[o].size() / 3);

@@ -5,6 +5,7 @@
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
+#include <kdet/option_table.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +26,8 @@ Tetrahedra of one mesh that share a vertex are adjacent and never reported.
 
 options:
   --self               self-collision of A (give one mesh)
+  --exclusion-rings K  with --self, also leave out tets with vertices within K mesh edges of
+                       each other (0-4; 0, the default, leaves out only tets sharing a vertex)
   --pairs FILE         write 'i j' per line: 0-based tet indices in file order, sorted
   --contacts FILE      write 'i j depth nx ny nz' per colliding pair: moving B's tet j by depth
                        along (nx, ny, nz) separates it from A's tet i (from the 44-axis SAT)
@@ -83,6 +86,7 @@ int run_collide(int argc, char** argv) {
     bool self = false, json = false, help = false, check = false, mpi = false;
     std::string pairs_path, contacts_path, partition;
     ReadOptions read_options;
+    int rings = 0;
 
     CommandLine parser("collide");
     parser.positionals(2, meshes);
@@ -95,6 +99,9 @@ int run_collide(int argc, char** argv) {
     parser.flag("--check-exact", check);
     parser.flag("--mpi", mpi);
     parser.option("--partition", "slabs|random", [&](const std::string& v) { partition = v; });
+    parser.option("--exclusion-rings", "K", [&](const std::string& v) {
+        rings = static_cast<int>(parse_integer("--exclusion-rings", v, 0, max_exclusion_rings));
+    });
     parser.detector_options(options, front_end_cli);
     parser.parse(argc, argv, 2);
     if (help) {
@@ -104,12 +111,15 @@ int run_collide(int argc, char** argv) {
     if (meshes.empty()) throw UsageError("collide: missing mesh A (see 'kdet collide --help')");
     if (self && meshes.size() == 2) throw UsageError("collide: --self takes one mesh, got two");
     if (!self && meshes.size() == 1) throw UsageError("collide: one mesh given: add mesh B, or --self for self-collision");
+    if (rings > 0 && !self) throw UsageError("collide: --exclusion-rings acts within one mesh: it needs --self");
+    if (rings > 0 && check)
+        throw UsageError("collide: --check-exact judges every pair, so it cannot follow --exclusion-rings");
     if (options.method == Method::kdet_no_pairs && (!pairs_path.empty() || !contacts_path.empty() || check))
         throw UsageError("collide: --pairs, --contacts and --check-exact need a method that builds pairs; "
                          "kdet_no_pairs only flags tets");
     if (!partition.empty() && !mpi) throw UsageError("collide: --partition needs --mpi");
-    if (mpi && (json || check || !contacts_path.empty()))
-        throw UsageError("collide: --json, --contacts and --check-exact do not work with --mpi");
+    if (mpi && (json || check || !contacts_path.empty() || rings > 0))
+        throw UsageError("collide: --json, --contacts, --check-exact and --exclusion-rings do not work with --mpi");
     if (mpi) return run_collide_mpi({meshes, self, pairs_path, partition, read_options, options});
     std::string unavailable;
     if (check && !exact_check_available(&unavailable))
@@ -123,6 +133,7 @@ int run_collide(int argc, char** argv) {
     const ObjectId id_a = detector.add_object(a);
     if (self) {
         detector.set_self_collision(id_a, true);
+        detector.set_self_exclusion_rings(id_a, rings);
     } else {
         detector.add_object(b);
     }
@@ -147,6 +158,7 @@ int run_collide(int argc, char** argv) {
             out["tets_b"] = b.num_tets();
         }
         out["self"] = self;
+        if (self) out["exclusion_rings"] = rings;
         for (const char* name : {"method", "test", "hash", "backend"}) out[name] = find_option(name)->text(options);
         out["candidates"] = c.candidates;
         out["narrow_phase_candidates"] = c.narrow_phase_candidates;
@@ -172,7 +184,9 @@ int run_collide(int argc, char** argv) {
     }
     std::printf("meshes            %s (%zu tets)", meshes[0].c_str(), a.num_tets());
     if (!self) std::printf(" x %s (%zu tets)", meshes[1].c_str(), b.num_tets());
-    std::printf("%s\n", self ? ", self-collision" : "");
+    std::printf("%s", self ? ", self-collision" : "");
+    if (rings > 0) std::printf(", exclusion rings %d", rings);
+    std::printf("\n");
     std::printf("method            %s, test %s, hash %s, backend %s\n", to_string(options.method),
                 to_string(options.narrow_phase), to_string(options.hash), to_string(options.backend));
     std::printf("candidates        %llu (%llu to the narrow phase)\n", static_cast<unsigned long long>(c.candidates),

@@ -21,6 +21,16 @@ struct LocateOptions;       // locate.hpp
 struct LocateResult;        // locate.hpp
 struct DeviceLocateResults; // locate.hpp
 
+/// @brief The most rings Detector::set_self_exclusion_rings() takes: each tet's list of excluded tets
+/// grows with the cube of the rings (a few thousand tets per tet at this bound in a typical mesh).
+constexpr int max_exclusion_rings = 4;
+
+/// @brief An object's collision group and mask (Detector::set_collision_filter).
+struct CollisionFilter {
+    std::uint32_t group = 1;
+    std::uint32_t mask = ~0u;
+};
+
 /// @brief Vertex positions as they lie in the caller's memory: coordinate k (0: x, 1: y, 2: z) of
 /// vertex v is element `v * row_stride + k * column_stride` of `data`, float32 or float64 (strides
 /// in elements, not bytes; any sign, zero included, as NumPy's strides divided by the item size).
@@ -38,7 +48,8 @@ struct PositionsView {
 /// add objects once, then each frame set_positions() for the objects that moved and detect().
 ///
 /// Semantics: two tets collide when their closed sets share a point. Within one object, tets that
-/// share a vertex index are adjacent and never reported. Positions are stored as float32.
+/// share a vertex index are adjacent and never reported (nor, where asked for, tets within a few
+/// rings of each other and pairs touching at rest: set_self_exclusion_rings, exclude_rest_contacts). Positions are stored as float32.
 /// Every finite float32 coordinate is accepted and answered exactly by NarrowPhase::exact with every
 /// method, from subnormal values to the largest float and far from the origin; a scene scaled by a
 /// power of two (exactly, no coordinate becoming subnormal) gives the same pairs with every method and
@@ -93,8 +104,54 @@ public:
 
     /// @brief Switches self-collision of one object (off by default).
     void set_self_collision(ObjectId object, bool enabled);
-    /// @brief Switches collision between two different objects (on by default).
+    /// @brief Switches collision between two different objects (on by default). The switch wins over
+    /// the collision filters: the last set_pair_collision() of a pair decides it, whatever
+    /// set_collision_filter() says before or after.
     void set_pair_collision(ObjectId a, ObjectId b, bool enabled);
+
+    /// @brief Sets an object's collision filter, as PhysX's filter data and MuJoCo's contype and
+    /// conaffinity: two different objects a and b are checked when (group_a & mask_b) != 0 and
+    /// (group_b & mask_a) != 0. Objects start in group 1 with every mask bit set, so by default every
+    /// pair is checked. A pair switched by set_pair_collision() keeps its switch; self-collision is
+    /// set_self_collision()'s alone. Pairs left out are skipped by the search itself, before any test.
+    void set_collision_filter(ObjectId object, std::uint32_t group, std::uint32_t mask);
+    CollisionFilter collision_filter(ObjectId object) const;
+
+    /// @brief Within one object, leaves out tets that have vertices within `rings` mesh edges of each
+    /// other, besides those sharing a vertex (`rings` = 0, the default, leaves out only those), for
+    /// meshes whose neighbouring elements come close by design. The detector keeps, per tet, the sorted
+    /// list of the tets this adds, which the search consults before any test; it grows with the cube of
+    /// `rings`. Throws kdet::Error for `rings` outside [0, max_exclusion_rings]. Kept across set_tets()
+    /// (the lists are made again for the new tets).
+    void set_self_exclusion_rings(ObjectId object, int rings);
+    int self_exclusion_rings(ObjectId object) const;
+
+    /// @brief Records the pairs of tets that collide at the current positions (those given to
+    /// add_object() until set_positions() changes them) inside `object`, or between `object` and
+    /// `other`, and never reports them again (a mesh that touches itself or another by design).
+    /// Recorded whether or not the pair is switched on; calls add up. The pairs are found with this
+    /// detector's narrow-phase test. set_tets() or remove_object() of either object forgets them.
+    /// Returns how many pairs were recorded.
+    std::size_t exclude_rest_contacts(ObjectId object);
+    std::size_t exclude_rest_contacts(ObjectId object, ObjectId other);
+
+    /// @brief Removes an object. Its id is not given again, and any later call naming it throws
+    /// kdet::Error; the other objects keep their ids and everything set for them. Tets stay numbered
+    /// per object in results; the global numbering (first_tet()) closes the gap from the next
+    /// detection on.
+    void remove_object(ObjectId object);
+
+    /// @brief Replaces an object's tets (cutting, tearing, fracture, remeshing), keeping its vertices,
+    /// or with `positions` its vertices too (their count may change). Results use the new numbering
+    /// from the next detection on; the other objects keep their state. The object keeps its switches,
+    /// filter and rings, and forgets its rest contacts. Throws kdet::Error on an out-of-range vertex
+    /// index or a bad coordinate, as add_object() does, and then leaves the detector as it was.
+    void set_tets(ObjectId object, const std::uint32_t* tets, std::size_t tet_count);
+    void set_tets(ObjectId object, const std::uint32_t* tets, std::size_t tet_count, const PositionsView& positions);
+    void set_tets(ObjectId object, const TetMesh& mesh);
+
+    /// @brief Whether `object` names an object that was added and not removed.
+    bool contains(ObjectId object) const;
 
     /// @brief Runs one detection; the result stays valid until the next call. The same as
     /// detect_async() followed by finish(): once a detector's buffers have grown (after its first
@@ -129,9 +186,13 @@ public:
     /// @brief The last locate()'s results in the backend's memory.
     DeviceLocateResults device_locate_results() const;
 
-    /// @brief Global id of the first tet of `object` (see DeviceResults).
+    /// @brief Global id of the first tet of `object` (see DeviceResults): objects are numbered one after
+    /// the other in id order, removed ones holding no tets. After remove_object() or set_tets() it gives
+    /// the numbering of the next detection.
     std::uint32_t first_tet(ObjectId object) const;
 
+    /// @brief The ids given so far (removed objects included: ids index FrameResult::colliding, where a
+    /// removed object has no flags).
     std::size_t object_count() const;
     std::size_t tet_count(ObjectId object) const;
     /// @brief Bytes held by the detector's buffers (device memory on the CUDA backend).

@@ -31,7 +31,8 @@ struct Contact {
 
 /// @brief A detection's results where the backend keeps them: GPU memory for Backend::cuda, host
 /// memory for Backend::cpu. Valid until the next detect(). Tets are numbered globally: object o's
-/// tet i is Detector::first_tet(o) + i.
+/// tet i is Detector::first_tet(o) + i, objects following each other in id order (a removed object
+/// holds none), as they stood when the detection ran.
 struct DeviceResults {
     const std::uint64_t* pair_keys = nullptr; ///< (global_a << 32) | global_b with global_a < global_b, sorted
     std::size_t pair_count = 0;
@@ -52,7 +53,7 @@ struct StageTimes {
 
 /// @brief Sizes of one detection.
 struct FrameCounts {
-    std::uint64_t candidates = 0;        ///< candidate pairs found (boxes overlap, not adjacent), each once
+    std::uint64_t candidates = 0;        ///< candidate pairs found (boxes overlap, not adjacent nor excluded), each once
     /// Of the candidates, those the pre-test (slabs, face planes) could not reject: the narrow phase runs on
     /// these (the thesis's CSV: "unique candidates").
     std::uint64_t narrow_phase_candidates = 0;

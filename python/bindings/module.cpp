@@ -2,6 +2,7 @@
 // part of the package (python/src/kdet/__init__.py) re-exports it, and its collide() and collide_self()
 // take meshio meshes and (vertices, tets) pairs as well before calling the library's.
 #include "arrays.hpp"
+#include "detector.hpp"
 #include "fields.hpp"
 #include "locate.hpp"
 #ifdef KDET_HAS_CUDA
@@ -236,21 +237,6 @@ nb::object device_view(const Scalar* data, std::initializer_list<std::size_t> sh
 // ---------------------------------------------------------------------------------------------
 // The detector
 
-/// A Detector and what the binding keeps beside it. Every call holds `mutex` with the GIL released, so
-/// that detect() can run while other Python threads work, and two threads never use the detector at once.
-struct PyDetector {
-    explicit PyDetector(const DetectorOptions& options) : detector(options) {}
-    Detector detector;
-    std::mutex mutex;
-};
-
-ObjectId object_id(PyDetector& self, std::int64_t object) {
-    if (object < 0 || static_cast<std::uint64_t>(object) >= self.detector.object_count())
-        throw Error("object id " + std::to_string(object) + " out of range (" +
-                    std::to_string(self.detector.object_count()) + " objects)");
-    return static_cast<ObjectId>(object);
-}
-
 ObjectId add_object(PyDetector& self, nb::handle vertices, nb::handle tets) {
     const Coordinates c = coordinates(vertices, "vertices");
     if (c.on_device)
@@ -369,14 +355,6 @@ std::string detector_repr(const Detector& detector) {
         if (o.type == OptionType::choice && o.shown_on(front_end_python))
             out += std::string(o.name) + "='" + o.text(detector.options()) + "', ";
     return out + std::to_string(detector.object_count()) + " objects)";
-}
-
-/// Calls @p f with the lock held and the GIL released.
-template <class F>
-auto locked(PyDetector& self, F&& f) {
-    nb::gil_scoped_release release;
-    std::lock_guard<std::mutex> lock(self.mutex);
-    return f();
 }
 
 /// Pairs as a (k, 2) uint32 array that owns a copy of them.
@@ -558,10 +536,11 @@ void bind_results(nb::module_& m) {
 }
 
 void bind_detector(nb::module_& m) {
-    nb::class_<PyDetector>(m, "Detector",
+    nb::class_<PyDetector> detector(m, "Detector",
                            "Finds colliding tets frame after frame, keeping its buffers between frames: add objects, "
                            "then per frame set_positions() for those that moved and detect(). Pairs of different "
-                           "objects are checked, self-collision is off, until switched.")
+                           "objects are checked, self-collision is off, until switched.");
+    detector
         .def(
             "__init__",
             [](PyDetector* self, const nb::kwargs& keywords) {
@@ -641,6 +620,7 @@ void bind_detector(nb::module_& m) {
             "options", [](PyDetector& self) { return options_dict(self.detector.options()); },
             "The detector's settings, names as the library spells them.")
         .def("__repr__", [](PyDetector& self) { return detector_repr(self.detector); });
+    bind_filters(detector);
 }
 
 void bind_collide(nb::module_& m) {

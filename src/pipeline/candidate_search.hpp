@@ -165,13 +165,16 @@ struct FindCandidatesKernel {
         TetPlanes planes; ///< t's, its vertices included (with FacePlanesInSearch)
         TetSlabs slabs;   ///< t's, where the scene has them
         unsigned long long rejected;
+        ExcludedPartners excluded; ///< t's, left out before any geometry
         KDET_HD void operator()(const GridEntry& e) {
             const std::uint32_t u = e.id();
             // Tets of one object that share a vertex are skipped first: they touch, so the slabs would
             // never separate them, and a self-colliding mesh's box-overlapping pairs hold many (its
             // neighbours); u's indices are loaded only for a pair within one object. Then the slabs,
             // whose 64 bytes separate many of the rest (slabs.hpp), before the costlier face planes.
+            // Excluded pairs (pair_exclusions.hpp) go before any geometry, so filters save the tests.
             if (e.object == object && share_vertex(tet, scene->tets[u])) return;
+            if (excluded.holds(u)) return;
             if (scene->slabs && slabs_separate(slabs, scene->slabs[u])) {
                 ++rejected;
                 return;
@@ -232,7 +235,8 @@ struct FindCandidatesKernel {
     /// @brief Tet t's share of the search, its keys into `batch`; returns the pairs it rejected.
     KDET_HD unsigned long long search(std::uint32_t t, const SearchPart& part, KeyBatch& batch) const {
         Emit emit{&scene, &batch, stop_when_full, t, spread_indices(scene.tets[t]), scene.tet_object[t],
-                  FacePlanesInSearch ? scene.planes[t] : TetPlanes{}, scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
+                  FacePlanesInSearch ? scene.planes[t] : TetPlanes{}, scene.slabs ? scene.slabs[t] : TetSlabs{}, 0,
+                  excluded_partners(scene, t)};
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
         return emit.rejected;

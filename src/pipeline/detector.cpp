@@ -1,4 +1,5 @@
 #include "grid/bucket_table.hpp"
+#include "pipeline/object_filters.hpp"
 #include "pipeline/pipeline_base.hpp"
 
 #include <kdet/detector.hpp>
@@ -29,6 +30,8 @@ struct Detector::Impl {
     FrameResult result;
     LocateResult located;
     bool frame_pending = false; // detect_async() ran, finish() not yet
+    ObjectFilters filters;
+    std::vector<std::uint8_t> removed; // per object id
 
     std::size_t objects() const { return object_vertex_begin.size() - 1; }
 
@@ -36,6 +39,17 @@ struct Detector::Impl {
     /// Staged positions are checked here, as a frame would: bad ones are dropped, and reported once
     /// the rebuild is done.
     void rebuild_pipeline() {
+        const std::string rejected = pull_device_positions();
+        pipeline->set_topology(topology);
+        pipeline->set_exclusions(filters.exclusions(topology.object_tet_begin));
+        std::fill(positions_dirty.begin(), positions_dirty.end(), 1); // the pipeline's buffers are new
+        topology_changed = false;
+        if (!rejected.empty()) throw Error(rejected);
+    }
+
+    /// Copies the positions that only the pipeline holds into the host copy; returns the message
+    /// naming staged positions that were not finite (dropped: the object keeps its previous ones).
+    std::string pull_device_positions() {
         std::string rejected;
         for (std::size_t o = 0; o < objects(); ++o) {
             if (!positions_on_device[o]) continue;
@@ -55,12 +69,11 @@ struct Detector::Impl {
             } else {
                 pipeline->get_positions(first, held, count, false);
             }
+            // Staged positions are not in the pipeline's current ones yet: they go with the next frame.
+            positions_dirty[o] = positions_staged[o];
             positions_on_device[o] = positions_staged[o] = 0;
         }
-        pipeline->set_topology(topology);
-        std::fill(positions_dirty.begin(), positions_dirty.end(), 1); // the pipeline's buffers are new
-        topology_changed = false;
-        if (!rejected.empty()) throw Error(rejected);
+        return rejected;
     }
 
     /// The first i below `count` for which bad(i) holds, or count. Every frame's positions pass here,
@@ -102,6 +115,7 @@ struct Detector::Impl {
         if (object >= objects())
             throw Error("object id " + std::to_string(object) + " out of range (" + std::to_string(objects()) +
                         " objects)");
+        if (removed[object]) throw Error("object id " + std::to_string(object) + " was removed");
     }
 
     /// Rejects coordinates that are not finite as the float32 the pipeline stores.
@@ -201,30 +215,46 @@ struct Detector::Impl {
         return located;
     }
 
-    /// Adds an object; on a bad index or coordinate it throws and leaves the detector as it was.
-    ObjectId add(const PositionsView& xyz, const std::uint32_t* tets, std::size_t tet_count) {
-        const std::size_t vertex_count = xyz.vertex_count;
-        const std::uint64_t total_tets = topology.tets.size() + tet_count;
-        const std::uint64_t total_vertices = std::uint64_t{object_vertex_begin.back()} + vertex_count;
+    /// Rejects a scene of more tets or vertices than ids can number, were `tets` and `vertices` to
+    /// replace `old_tets` and `old_vertices`.
+    void check_sizes(std::uint64_t tets, std::uint64_t vertices, std::uint64_t old_tets, std::uint64_t old_vertices) const {
+        const std::uint64_t total_tets = topology.tets.size() - old_tets + tets;
+        const std::uint64_t total_vertices = std::uint64_t{object_vertex_begin.back()} - old_vertices + vertices;
         if (total_tets > grid_id_mask)
             throw Error("too many tetrahedra: " + std::to_string(total_tets) + " in all, at most " +
                         std::to_string(grid_id_mask));
         if (total_vertices >= 0xffffffffull) throw Error("too many vertices for 32-bit ids");
-        const ObjectId id = static_cast<ObjectId>(objects());
-        check_view(id, xyz, vertex_count);
+    }
+
+    void check_indices(ObjectId id, const std::uint32_t* tets, std::size_t tet_count, std::size_t vertex_count) const {
         const std::size_t bad_index = first_where(4 * tet_count, [&](std::ptrdiff_t i) { return tets[i] >= vertex_count; });
         if (bad_index < 4 * tet_count)
             throw Error("object " + std::to_string(id) + ": tet " + std::to_string(bad_index / 4) + " has vertex index " +
                         std::to_string(tets[bad_index]) + " out of range [0, " + std::to_string(vertex_count) + ")");
-        // Converted on the detector's threads into memory left uninitialised (each element is written
-        // once), then checked as the float32 the pipeline stores, as check_finite checks.
-        const std::unique_ptr<vec3[]> converted(new vec3[vertex_count]);
+    }
+
+    /// The positions as the float32 the pipeline stores, checked finite as check_finite checks.
+    std::unique_ptr<vec3[]> converted_positions(ObjectId id, const PositionsView& xyz) const {
+        // Converted on the detector's threads into memory left uninitialised (each element is written once).
+        const std::size_t vertex_count = xyz.vertex_count;
+        std::unique_ptr<vec3[]> converted(new vec3[vertex_count]);
         const auto vertices = static_cast<std::ptrdiff_t>(vertex_count);
         with_positions(xyz, [&](const auto& source) {
 #pragma omp parallel for num_threads(host_threads()) schedule(static) if (vertices > host_parallel_elements)
             for (std::ptrdiff_t v = 0; v < vertices; ++v) converted[v] = source(static_cast<std::uint64_t>(v));
         });
         check_finite(id, xyz_view(converted.get(), vertex_count));
+        return converted;
+    }
+
+    /// Adds an object; on a bad index or coordinate it throws and leaves the detector as it was.
+    ObjectId add(const PositionsView& xyz, const std::uint32_t* tets, std::size_t tet_count) {
+        const std::size_t vertex_count = xyz.vertex_count;
+        check_sizes(tet_count, vertex_count, 0, 0);
+        const ObjectId id = static_cast<ObjectId>(objects());
+        check_view(id, xyz, vertex_count);
+        check_indices(id, tets, tet_count, vertex_count);
+        const std::unique_ptr<vec3[]> converted = converted_positions(id, xyz);
 
         // The pipeline stores the tets in spatial order and reports them under the caller's numbering.
         const std::uint32_t base = object_vertex_begin.back();
@@ -243,8 +273,82 @@ struct Detector::Impl {
             for (std::size_t b = 0; b < n; ++b)
                 enabled[a * n + b] = (a < n - 1 && b < n - 1) ? pair_enabled[a * (n - 1) + b] : (a != b ? 1 : 0);
         pair_enabled.swap(enabled);
+        filters.add_object(pair_enabled);
+        removed.push_back(0);
         topology_changed = true;
         return id;
+    }
+
+    // Changes of an object's tets (Detector::set_tets, remove_object) and the rest contacts read the
+    // current positions of every object and store a new topology: what can fail comes first.
+
+    /// Completes a pending frame and brings positions held by the pipeline alone into the host copy.
+    void prepare_edit(Detector& detector) {
+        if (frame_pending) detector.finish();
+        const std::string rejected = pull_device_positions();
+        if (!rejected.empty()) throw Error(rejected);
+    }
+
+    /// An object's current positions in the caller's vertex order.
+    std::vector<vec3> caller_positions(ObjectId object) const {
+        const std::uint32_t first = object_vertex_begin[object], end = object_vertex_begin[object + 1];
+        std::vector<vec3> out(end - first);
+        for (std::uint32_t v = first; v < end; ++v) out[topology.vertex_user_id[v] - first] = positions[v];
+        return out;
+    }
+
+    /// The ring lists of `object` in `scene`, its vertices numbered from `first_vertex`.
+    ExclusionLists rings_of(const SceneTopology& scene, ObjectId object, std::uint32_t first_vertex,
+                            std::uint32_t vertex_count, int rings) const {
+        if (rings == 0) return {};
+        const std::uint32_t first = scene.object_tet_begin[object];
+        return ring_exclusions(scene.tets.data() + first, scene.object_tet_begin[object + 1] - first, first_vertex,
+                               vertex_count, rings, object, host_threads());
+    }
+
+    /// Replaces an object's vertices and tets by checked ones (prepare_edit() done).
+    void replace(ObjectId object, const vec3* xyz, std::uint32_t vertex_count, const std::uint32_t* tets, std::size_t tet_count) {
+        const std::uint32_t first = object_vertex_begin[object], old_count = object_vertex_begin[object + 1] - first;
+        SceneTopology next =
+            topology.with_object_replaced(object, first, old_count, xyz, vertex_count, tets, tet_count, host_threads());
+        ExclusionLists rings = rings_of(next, object, first, vertex_count, filters.rings(object));
+        filters.check_room(rings.partners.size(), filters.ring_ids(object));
+        std::vector<vec3> next_positions(next.vertex_count);
+        std::copy(positions.begin(), positions.begin() + first, next_positions.begin());
+        next.to_stored_order(first, vertex_count, xyz, next_positions.data() + first, host_threads());
+        std::copy(positions.begin() + first + old_count, positions.end(), next_positions.begin() + first + vertex_count);
+
+        topology = std::move(next);
+        positions.swap(next_positions);
+        for (std::size_t o = object + 1; o < object_vertex_begin.size(); ++o) object_vertex_begin[o] += vertex_count - old_count;
+        positions_dirty[object] = 1;
+        filters.forget_tets(object);
+        filters.set_rings(object, filters.rings(object), std::move(rings));
+        topology_changed = true;
+    }
+
+    /// The pairs of stored tets (local ids) colliding now inside object a (a == b) or between a < b,
+    /// found by a detector of their own with this one's test.
+    std::vector<std::uint64_t> colliding_now(ObjectId a, ObjectId b) const {
+        DetectorOptions at_rest;
+        at_rest.narrow_phase = options.narrow_phase;
+        at_rest.threads = options.threads;
+        Detector detector(at_rest);
+        const ObjectId both[2] = {a, b};
+        for (std::size_t i = 0; i < (a == b ? 1u : 2u); ++i) {
+            const ObjectId o = both[i];
+            const std::uint32_t first_vertex = object_vertex_begin[o], first = topology.object_tet_begin[o];
+            const std::uint32_t count = topology.object_tet_begin[o + 1] - first;
+            std::vector<std::uint32_t> tets(4 * std::size_t{count});
+            for (std::uint32_t t = 0; t < count; ++t)
+                for (int k = 0; k < 4; ++k) tets[4 * std::size_t{t} + k] = topology.tets[first + t].v[k] - first_vertex;
+            detector.add_object(xyz_view(positions.data() + first_vertex, object_vertex_begin[o + 1] - first_vertex),
+                                tets.data(), count);
+        }
+        detector.set_self_collision(0, a == b);
+        std::vector<std::uint64_t> keys;
+        for (const TetPair& p : detector.detect().pairs) keys.push_back(std::uint64_t{p.tet_a} << 32 | p.tet_b);
+        return keys;
     }
 };
 
@@ -315,7 +419,89 @@ void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
     impl_->check_object(b);
     if (a == b) throw Error("set_pair_collision needs two different objects; use set_self_collision");
     impl_->pair_enabled[a * impl_->objects() + b] = impl_->pair_enabled[b * impl_->objects() + a] = enabled ? 1 : 0;
+    impl_->filters.set_explicit(a, b);
 }
+
+void Detector::set_collision_filter(ObjectId object, std::uint32_t group, std::uint32_t mask) {
+    impl_->check_object(object);
+    impl_->filters.set_filter(object, group, mask, impl_->pair_enabled);
+}
+
+CollisionFilter Detector::collision_filter(ObjectId object) const {
+    impl_->check_object(object);
+    return CollisionFilter{impl_->filters.group(object), impl_->filters.mask(object)};
+}
+
+void Detector::set_self_exclusion_rings(ObjectId object, int rings) {
+    Impl& d = *impl_;
+    d.check_object(object);
+    if (rings < 0 || rings > max_exclusion_rings)
+        throw Error("object " + std::to_string(object) + ": exclusion rings " + std::to_string(rings) + " out of range [0, " +
+                    std::to_string(max_exclusion_rings) + "]");
+    if (rings == d.filters.rings(object)) return;
+    const std::uint32_t first = d.object_vertex_begin[object];
+    ExclusionLists lists = d.rings_of(d.topology, object, first, d.object_vertex_begin[object + 1] - first, rings);
+    d.filters.check_room(lists.partners.size(), d.filters.ring_ids(object));
+    d.filters.set_rings(object, rings, std::move(lists));
+}
+
+int Detector::self_exclusion_rings(ObjectId object) const {
+    impl_->check_object(object);
+    return impl_->filters.rings(object);
+}
+
+std::size_t Detector::exclude_rest_contacts(ObjectId object) { return exclude_rest_contacts(object, object); }
+
+std::size_t Detector::exclude_rest_contacts(ObjectId object, ObjectId other) {
+    Impl& d = *impl_;
+    d.check_object(object);
+    d.check_object(other);
+    d.prepare_edit(*this);
+    const ObjectId a = std::min(object, other), b = std::max(object, other);
+    const std::vector<std::uint64_t> keys = d.colliding_now(a, b);
+    d.filters.check_room(2 * keys.size());
+    d.filters.add_rest_pairs(a, b, keys);
+    return keys.size();
+}
+
+void Detector::remove_object(ObjectId object) {
+    Impl& d = *impl_;
+    d.check_object(object);
+    d.prepare_edit(*this);
+    d.replace(object, nullptr, 0, nullptr, 0);
+    d.filters.set_rings(object, 0, ExclusionLists{});
+    d.pair_enabled[object * d.objects() + object] = 0;
+    d.removed[object] = 1;
+}
+
+void Detector::set_tets(ObjectId object, const std::uint32_t* tets, std::size_t tet_count) {
+    Impl& d = *impl_;
+    d.check_object(object);
+    const std::uint32_t vertices = d.object_vertex_begin[object + 1] - d.object_vertex_begin[object];
+    d.check_sizes(tet_count, 0, d.topology.object_tet_begin[object + 1] - d.topology.object_tet_begin[object], 0);
+    d.check_indices(object, tets, tet_count, vertices);
+    d.prepare_edit(*this);
+    const std::vector<vec3> xyz = d.caller_positions(object);
+    d.replace(object, xyz.data(), vertices, tets, tet_count);
+}
+
+void Detector::set_tets(ObjectId object, const std::uint32_t* tets, std::size_t tet_count, const PositionsView& positions) {
+    Impl& d = *impl_;
+    d.check_object(object);
+    const std::uint32_t old_vertices = d.object_vertex_begin[object + 1] - d.object_vertex_begin[object];
+    d.check_sizes(tet_count, positions.vertex_count, d.topology.object_tet_begin[object + 1] - d.topology.object_tet_begin[object], old_vertices);
+    Impl::check_view(object, positions, positions.vertex_count);
+    d.check_indices(object, tets, tet_count, positions.vertex_count);
+    const std::unique_ptr<vec3[]> xyz = d.converted_positions(object, positions);
+    d.prepare_edit(*this);
+    d.replace(object, xyz.get(), static_cast<std::uint32_t>(positions.vertex_count), tets, tet_count);
+}
+
+void Detector::set_tets(ObjectId object, const TetMesh& mesh) {
+    set_tets(object, mesh.tets.data(), mesh.num_tets(), xyz_view(mesh.positions.data(), mesh.num_vertices()));
+}
+
+bool Detector::contains(ObjectId object) const { return object < impl_->objects() && !impl_->removed[object]; }
 
 const FrameResult& Detector::detect() {
     detect_async();
@@ -326,6 +512,7 @@ void Detector::detect_async() {
     Impl& d = *impl_;
     if (d.frame_pending) finish(); // its counters are checked before the next frame overwrites them
     if (d.topology_changed) d.rebuild_pipeline();
+    if (d.filters.exclusions_changed()) d.pipeline->set_exclusions(d.filters.exclusions(d.topology.object_tet_begin));
     if (d.objects() == 0) {
         d.result = FrameResult{};
         return;

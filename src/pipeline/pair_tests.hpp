@@ -6,6 +6,7 @@
 #include "geometry/face_planes.hpp"
 #include "geometry/slabs.hpp"
 #include "geometry/tet_intersect.hpp"
+#include "pipeline/pair_exclusions.hpp"
 #include "pipeline/scene_view.hpp"
 
 #include <kdet/options.hpp>
@@ -52,10 +53,11 @@ KDET_HD inline bool candidate_collides(const SceneView& s, std::uint32_t first, 
     return planes_or_test_collide<Test>(s, first, second, exact_stage, planes_separate);
 }
 
-/// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, and
-/// their boxes overlap.
+/// @brief Whether a pair of stored tets first < second needs a decision at all: not adjacent, not
+/// excluded (pair_exclusions.hpp), and their boxes overlap.
 KDET_HD inline bool may_collide(const SceneView& s, std::uint32_t first, std::uint32_t second) {
     if (s.tet_object[first] == s.tet_object[second] && share_vertex(s.tets[first], s.tets[second])) return false;
+    if (excluded_pair(s, first, second)) return false;
     return boxes_overlap(s.info[first].box, s.info[second].box);
 }
 

@@ -55,6 +55,22 @@ struct SceneTopology {
     void to_stored_order(std::uint32_t first, std::uint32_t count, const vec3* caller_order, vec3* stored, int threads = 1) const {
         to_stored_order(first, xyz_view(caller_order, count), stored, threads);
     }
+
+    /// @brief This topology with object `object`'s vertices (from global id `first_vertex`,
+    /// `old_vertex_count` of them) and tets replaced by `vertex_count` vertices at `positions` and
+    /// `tet_count` tets, stored as add_object() stores them; the other objects keep their stored order,
+    /// their ids shifted past it (topology_edit.cpp).
+    SceneTopology with_object_replaced(std::uint32_t object, std::uint32_t first_vertex, std::uint32_t old_vertex_count,
+                                       const vec3* positions, std::uint32_t vertex_count, const std::uint32_t* tets,
+                                       std::size_t tet_count, int threads = 1) const;
+};
+
+/// @brief Per stored tet, the sorted stored ids of the tets it is never paired with beyond shared
+/// vertices (pair_exclusions.hpp): a compressed row array, begin[t] to begin[t + 1] indexing
+/// partners; empty when nothing is excluded.
+struct ExclusionLists {
+    std::vector<std::uint32_t> begin;
+    std::vector<std::uint32_t> partners;
 };
 
 /// @brief Each of `count` colliding pairs' keys (two global tet ids in the caller's numbering) as the
@@ -87,6 +103,9 @@ public:
     virtual ~PipelineBase() = default;
     /// @brief Replaces all geometry; positions must be set again afterwards.
     virtual void set_topology(const SceneTopology& topology) = 0;
+    /// @brief Replaces the pairs excluded beyond shared vertices (pair_exclusions.hpp), in stored ids
+    /// of the current topology; set again after every set_topology(), which clears them.
+    virtual void set_exclusions(const ExclusionLists& lists) = 0;
     /// @brief Copies positions already in the backend's memory (in stream order), in any layout, as
     /// float32 into a staging buffer from global vertex `first` on, waiting for nothing; a frame
     /// adopts them (start()'s `staged`) once it has checked that they are finite, so rejected

@@ -75,12 +75,22 @@ public:
         pair_enabled_.resize_discard(objects * objects);
         pair_active_.resize_discard(objects * objects);
         checked_objects_.resize_discard(objects);
+        // Exclusions name stored tets: the detector sets them again for the new topology.
+        exclusion_begin_.resize_discard(0);
+        excluded_.resize_discard(0);
         counters_.resize_discard(1);
         // New geometry: the first frame plans the grid and sizes the pairs from what it finds; the bucket
         // size is chosen again from that plan (and only grows with later ones).
         grid_planned_ = pairs_sized_ = false;
         bucket_capacity_ = 0;
         colliding_count_ = 0;
+    }
+
+    void set_exclusions(const ExclusionLists& lists) override {
+        exclusion_begin_.resize_discard(lists.partners.empty() ? 0 : lists.begin.size());
+        exec_.upload(exclusion_begin_.data(), lists.begin.data(), exclusion_begin_.size());
+        excluded_.resize_discard(lists.partners.size());
+        exec_.upload(excluded_.data(), lists.partners.data(), lists.partners.size());
     }
 
     void stage_positions(std::uint32_t first, const PositionsView& positions) override {
@@ -125,7 +135,7 @@ public:
                info_.capacity_bytes() + planes_.capacity_bytes() + slabs_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
-               grid_bytes() + counters_.capacity_bytes() +
+               exclusion_begin_.capacity_bytes() + excluded_.capacity_bytes() + grid_bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
                resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() + exec_.scratch_bytes() +
                locator_.memory_bytes();
@@ -169,7 +179,8 @@ protected:
         TetSlabs* slabs = options_.narrow_phase == NarrowPhase::sat_no_edges ? nullptr : slabs_.data();
         return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), slabs, pair_active_.data(),
                          checked_objects_.data(), object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
-                         static_cast<std::uint32_t>(object_boxes_.size())};
+                         static_cast<std::uint32_t>(object_boxes_.size()),
+                         exclusion_begin_.size() ? exclusion_begin_.data() : nullptr, excluded_.data()};
     }
     template <class T>
     void fill(buffer<T>& b, const T& value) {
@@ -240,6 +251,8 @@ protected:
     buffer<std::uint8_t> pair_enabled_; ///< the caller's switches, [objects * objects]
     buffer<std::uint8_t> pair_active_;  ///< enabled and the boxes overlap, this frame
     buffer<std::uint32_t> checked_objects_; ///< per object, the bits of the objects it is checked against this frame
+    buffer<std::uint32_t> exclusion_begin_; ///< SceneView::exclusion_begin; empty when nothing is excluded
+    buffer<std::uint32_t> excluded_;
     buffer<BucketHeader> headers_;
     buffer<std::uint32_t> ids_;
     buffer<EntryBlock> entry_blocks_; ///< the compacted cells' lists

@@ -42,6 +42,10 @@ struct SceneView {
     const Aabb* object_boxes;
     std::uint32_t tet_count;
     std::uint32_t object_count;
+    /// [tet_count + 1] where each tet's excluded partners start in `excluded` (pair_exclusions.hpp), or
+    /// null when no pair is excluded beyond shared vertices.
+    const std::uint32_t* exclusion_begin;
+    const std::uint32_t* excluded;
 };
 
 KDET_HD inline void load_vertices(const SceneView& s, const TetIndices& tet, vec3 out[4]) {

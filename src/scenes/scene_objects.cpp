@@ -1,5 +1,6 @@
 /// @file scene_objects.cpp
-/// @brief add_scene_objects: a scene's objects and the collisions it checks, set up in a Detector.
+/// @brief add_scene_objects: a scene's objects and the collisions it checks, set up in a Detector;
+/// set_scene_tets: the tets of a scene whose tets change, frame by frame.
 
 #include <kdet/scenes.hpp>
 
@@ -13,6 +14,18 @@ void add_scene_objects(Detector& detector, const Scene& scene, bool self) {
         for (std::size_t b = a + 1; b < scene.num_objects(); ++b)
             if (!scene.checks_pair(a, b))
                 detector.set_pair_collision(first + static_cast<ObjectId>(a), first + static_cast<ObjectId>(b), false);
+}
+
+void set_scene_tets(Detector& detector, const Scene& scene, int frame, std::vector<std::vector<std::uint32_t>>& current,
+                    ObjectId first_id) {
+    if (!scene.changes_tets()) return;
+    std::vector<std::uint32_t> tets;
+    for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+        scene.tets(o, frame, tets);
+        if (tets == current[o]) continue;
+        detector.set_tets(first_id + static_cast<ObjectId>(o), tets.data(), tets.size() / 4);
+        current[o].swap(tets);
+    }
 }
 
 } // namespace kdet

@@ -2,6 +2,7 @@
 /// @brief open_scene: the built-in scenes by name, and scene files, recordings and frame folders by path.
 
 #include "scenes/scripted_scene.hpp"
+#include "scenes/tearing_scene.hpp"
 
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
@@ -29,6 +30,7 @@ std::unique_ptr<Scene> play(scenes::SceneSpec spec, const std::string& default_n
 std::vector<std::string> scene_names() {
     std::vector<std::string> names = {"procedural"};
     for (const auto& [name, text] : scenes::builtin_scene_files()) names.push_back(name);
+    names.push_back("tearing");
     return names;
 }
 
@@ -43,6 +45,7 @@ std::unique_ptr<Scene> read_scene_file(const std::string& path, const SceneReque
 
 std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& request) {
     if (name == "procedural") return std::make_unique<ProceduralScene>(request.procedural);
+    if (name == "tearing") return std::make_unique<scenes::TearingScene>(120);
     for (const auto& [builtin, text] : scenes::builtin_scene_files())
         if (name == builtin) return play(scenes::parse_scene(text, "scenes/" + builtin + ".scene"), builtin, request, ".");
     std::error_code ignored;

@@ -97,9 +97,11 @@ void row_ms(const char* name, double ms) {
 }
 
 /// @brief Whether the resolution (1-4) changes the scene: the thesis scenes but the one that is
-/// always at resolution 2, and scene files (their prepared models).
+/// always at resolution 2, and scene files (their prepared models); not the generated ones.
 bool uses_resolution(const ViewSource& source) {
-    if (!source.meshes.empty() || source.scene == "procedural" || source.scene == "pass_through_armadillos") return false;
+    if (!source.meshes.empty() || source.scene == "procedural" || source.scene == "pass_through_armadillos" ||
+        source.scene == "tearing")
+        return false;
     const std::vector<std::string> names = scene_names();
     const std::string& s = source.scene;
     return std::find(names.begin(), names.end(), s) != names.end() ||
@@ -181,6 +183,13 @@ void Viewer::panel_scene() {
     }
     bool self = session_.self();
     if (ImGui::Checkbox("self-collision", &self)) session_.set_self(self);
+    ImGui::BeginDisabled(!self);
+    int rings = session_.exclusion_rings();
+    ImGui::SliderInt("exclusion rings", &rings, 0, max_exclusion_rings);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("also leave out tets within this many mesh edges of each other (0: sharing a vertex)");
+    if (ImGui::IsItemDeactivatedAfterEdit()) session_.set_exclusion_rings(rings);
+    ImGui::EndDisabled();
     ImGui::EndDisabled();
     const Scene& scene = session_.scene();
     for (std::size_t o = 0; o < scene.num_objects(); ++o) {
@@ -190,6 +199,11 @@ void Viewer::panel_scene() {
         ImGui::SameLine();
         ImGui::Text("object %zu: %zu tets, %zu surface triangles", o, scene.rest_mesh(o).num_tets(),
                     session_.faces()[o].boundary.size() / 3);
+        const CollisionFilter filter = session_.collision_filter(o);
+        if (filter.group != CollisionFilter{}.group || filter.mask != CollisionFilter{}.mask) {
+            ImGui::SameLine();
+            ImGui::Text("(group 0x%x, mask 0x%x)", filter.group, filter.mask);
+        }
         ImGui::PopID();
     }
 }

@@ -101,11 +101,25 @@ void ViewSession::set_self(bool self) {
     results_stale_ = true;
 }
 
+void ViewSession::set_exclusion_rings(int rings) {
+    if (rings == exclusion_rings_) return;
+    exclusion_rings_ = rings;
+    detector_.reset();
+    results_stale_ = true;
+}
+
+CollisionFilter ViewSession::collision_filter(std::size_t object) const {
+    return detector_ ? detector_->collision_filter(static_cast<ObjectId>(object)) : CollisionFilter{};
+}
+
 void ViewSession::set_frame(int frame) { frame_ = std::clamp(frame, 0, scene_->num_frames() - 1); }
 
 void ViewSession::build_detector() {
     auto detector = std::make_unique<Detector>(options_);
     add_scene_objects(*detector, *scene_, self_);
+    if (self_)
+        for (std::size_t o = 0; o < scene_->num_objects(); ++o)
+            detector->set_self_exclusion_rings(static_cast<ObjectId>(o), exclusion_rings_);
     detector_ = std::move(detector);
 }
 

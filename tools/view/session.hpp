@@ -50,6 +50,9 @@ public:
     void set_options(const DetectorOptions& options);
     /// @brief Self-collision of every object (as `kdet bench -s`).
     void set_self(bool self);
+    /// @brief Self-exclusion rings of every object while self-collision is on
+    /// (Detector::set_self_exclusion_rings).
+    void set_exclusion_rings(int rings);
     /// @brief Selects a frame; clamped to the scene's frames.
     void set_frame(int frame);
 
@@ -61,6 +64,9 @@ public:
     const Scene& scene() const { return *scene_; }
     const DetectorOptions& options() const { return options_; }
     bool self() const { return self_; }
+    int exclusion_rings() const { return exclusion_rings_; }
+    /// @brief An object's collision filter in the current detector (the default before there is one).
+    CollisionFilter collision_filter(std::size_t object) const;
     int frame() const { return frame_; }
     int num_frames() const { return scene_->num_frames(); }
 
@@ -96,6 +102,7 @@ private:
     std::vector<MeshFaces> faces_;
     DetectorOptions options_;
     bool self_ = false;
+    int exclusion_rings_ = 0;
     int frame_ = 0;
     int positions_frame_ = -1; ///< frame whose positions are in positions_, -1 for none
     bool results_stale_ = true;

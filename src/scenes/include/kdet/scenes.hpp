@@ -41,7 +41,8 @@ public:
     virtual std::string name() const = 0;
     virtual std::size_t num_objects() const = 0;
     virtual int num_frames() const = 0;
-    /// @brief The tets (and rest positions) of `object`; the tets never change between frames.
+    /// @brief The tets (and rest positions) of `object`; the tets change between frames only in a
+    /// scene whose changes_tets() says so.
     virtual const TetMesh& rest_mesh(std::size_t object) const = 0;
     /// @brief Vertex positions of `object` at `frame` (0-based) as x y z; `out` is resized.
     virtual void positions(std::size_t object, int frame, std::vector<float>& out) const = 0;
@@ -50,7 +51,18 @@ public:
     virtual bool checks_pair(std::size_t a, std::size_t b) const { return a != b; }
     /// @brief Whether the scene asks for self-collisions of @p object (default: none).
     virtual bool checks_self(std::size_t /*object*/) const { return false; }
+    /// @brief Whether the tets of some object change between frames (cutting, tearing): then a
+    /// frame's tets are tets()', set with Detector::set_tets (default: they never change).
+    virtual bool changes_tets() const { return false; }
+    /// @brief The tets of `object` at `frame` (4 indices each, into rest_mesh(object)'s vertices).
+    virtual void tets(std::size_t object, int /*frame*/, std::vector<std::uint32_t>& out) const { out = rest_mesh(object).tets; }
 };
+
+/// @brief Sets the tets of `scene`'s objects at `frame` in `detector` (ids in scene order from
+/// `first_id`) where they differ from `current` (each object's tets as last set, updated), for a scene
+/// whose tets change (Scene::changes_tets); does nothing for any other.
+void set_scene_tets(Detector& detector, const Scene& scene, int frame, std::vector<std::vector<std::uint32_t>>& current,
+                    ObjectId first_id = 0);
 
 /// @brief Adds every object of @p scene to @p detector (ids in scene order, from the detector's next
 /// id on), with self-collision of each object as @p self says (the thesis's `-s`, whatever the
