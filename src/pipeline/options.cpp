@@ -4,6 +4,7 @@
 
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 
@@ -200,7 +201,19 @@ std::string join_names(const std::vector<std::string>& names) {
 }
 
 std::string invalid_value_message(const std::string& shown, const std::string& text, const std::string& expected) {
-    return "invalid value '" + text + "' for " + shown + ": expected " + expected;
+    // Control characters are written as \xNN, so that the message stays one line whatever was given.
+    std::string echoed;
+    for (const char c : text) {
+        const auto byte = static_cast<unsigned char>(c);
+        if (byte >= 0x20 && byte != 0x7f) {
+            echoed += c;
+            continue;
+        }
+        char escaped[8];
+        std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+        echoed += escaped;
+    }
+    return "invalid value '" + echoed + "' for " + shown + ": expected " + expected;
 }
 
 long long parse_integer(const std::string& shown, const std::string& text, long long lo, long long hi) {
