@@ -120,19 +120,37 @@ struct LimitedBuffer {
 };
 
 TEST(GrowForRerun, TakesRerunCapacitysRoomWhereItFitsElseTheNeed) {
+    constexpr std::size_t unlimited = std::numeric_limits<std::size_t>::max();
     LimitedBuffer ample{100000, 1000};
-    grow_for_rerun(ample, 1001);
+    EXPECT_TRUE(grow_for_rerun(ample, 1001, unlimited));
     EXPECT_EQ(ample.size(), rerun_capacity(1000, 1001)); // twice as much
     EXPECT_EQ(ample.allocations, 1u);
     LimitedBuffer tight{1500, 1000};
-    grow_for_rerun(tight, 1001); // twice as much does not fit, the need does
+    EXPECT_TRUE(grow_for_rerun(tight, 1001, unlimited)); // twice as much does not fit, the need does
     EXPECT_EQ(tight.size(), 1001u);
-    grow_for_rerun(tight, 900); // enough room: nothing allocated
+    EXPECT_TRUE(grow_for_rerun(tight, 900, unlimited)); // enough room: nothing allocated
     EXPECT_EQ(tight.size(), 1001u);
     EXPECT_EQ(tight.allocations, 2u);
     LimitedBuffer full{1000, 1000};
-    EXPECT_THROW(grow_for_rerun(full, 1001), std::bad_alloc); // not even the need
+    EXPECT_FALSE(grow_for_rerun(full, 1001, unlimited)); // not even the need
     EXPECT_EQ(full.size(), 0u);
+}
+
+TEST(GrowForRerun, StaysWithinTheRoomOfTheMemoryLimitAndAsksNothingBeyondIt) {
+    LimitedBuffer headroom{100000, 1000};
+    EXPECT_TRUE(grow_for_rerun(headroom, 1001, 1500)); // twice as much is beyond the room: as much as it allows
+    EXPECT_EQ(headroom.size(), 1500u);
+    LimitedBuffer over{100000, 1000};
+    EXPECT_FALSE(grow_for_rerun(over, 1600, 1500)); // the need itself is beyond: no allocation tried
+    EXPECT_EQ(over.allocations, 0u);
+    EXPECT_EQ(over.size(), 1000u);
+}
+
+TEST(RoomFor, CountsTheElementsTheLimitLeavesBesideTheRest) {
+    EXPECT_EQ(room_for(0, 123456, 8), std::numeric_limits<std::size_t>::max()); // no limit
+    EXPECT_EQ(room_for(1000, 200, 8), 100u);
+    EXPECT_EQ(room_for(1000, 1000, 8), 0u);
+    EXPECT_EQ(room_for(1000, 5000, 8), 0u); // the rest alone is over it
 }
 
 TEST(PairsWindowForCandidates, GrowsByTheCandidatesFactor) {

@@ -277,6 +277,20 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
     }
 }
 
+TEST(Cli, AFrameTheMemoryLimitCannotHoldFailsAtOnceNamingItsPairsAndBytes) {
+    const auto pile = (temp_dir() / "pile").string();
+    write_tetgen(test::identical_tets(200), pile); // 19,900 colliding pairs
+    const Outcome refused = kdet_cli("collide " + pile + " --self --memory-limit 100000");
+    EXPECT_EQ(refused.exit_code, 1) << refused.out;
+    EXPECT_EQ(line_count(refused.out), 1u) << refused.out;
+    EXPECT_EQ(refused.out.rfind("kdet: error: the frame has 19900 candidate pairs", 0), 0u) << refused.out;
+    EXPECT_NE(refused.out.find(" bytes ("), std::string::npos) << refused.out;
+    EXPECT_NE(refused.out.find("memory_limit 100000"), std::string::npos) << refused.out;
+    const Outcome answered = kdet_cli("collide " + pile + " --self");
+    EXPECT_EQ(answered.exit_code, 0) << answered.out;
+    EXPECT_NE(answered.out.find("colliding pairs   19900"), std::string::npos) << answered.out;
+}
+
 TEST(Cli, VersionNamesTheCommitTheProgramWasBuiltFrom) {
     // The commit used to be read when CMake configured the build folder, so rebuilt programs
     // reported an older one.

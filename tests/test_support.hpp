@@ -43,6 +43,19 @@ inline TetMesh load_model(const std::string& file) {
 }
 
 /// @brief Disjoint random tets whose sizes span `decades` orders of magnitude, inside a cube of side `extent`.
+/// @brief `count` copies of one tet, each with vertices of its own: every pair of them collides and
+/// none is adjacent, so self-collision gives count * (count - 1) / 2 pairs, all of them candidates.
+inline TetMesh identical_tets(std::uint32_t count) {
+    TetMesh mesh;
+    const double corners[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (std::uint32_t t = 0; t < count; ++t)
+        for (std::uint32_t k = 0; k < 4; ++k) {
+            mesh.positions.insert(mesh.positions.end(), corners[k], corners[k] + 3);
+            mesh.tets.push_back(4 * t + k);
+        }
+    return mesh;
+}
+
 inline TetMesh random_soup(std::size_t count, double extent, double decades, unsigned seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> unit(0.0, 1.0);

@@ -87,6 +87,10 @@ struct DetectorOptions {
     /// Initial capacity of the candidate buffer in pairs; 0 sizes it from the tet count.
     /// It grows (and the stage reruns) whenever a frame needs more, so any value is safe.
     std::size_t initial_candidate_capacity = 0;
+    /// Bytes the detector's memory may reach by growing a frame's candidate and colliding-pair
+    /// buffers; 0: as much as the memory holds. A frame that needs more (counted before anything
+    /// grows) throws kdet::Error at once, naming its pairs and their bytes, and leaves the detector usable.
+    std::size_t memory_limit = 0;
     /// Return depth and direction per colliding pair, whatever the narrow-phase test: a stage after
     /// the test computes them with the 44-axis SAT's minimum translation vector.
     bool contacts = false;

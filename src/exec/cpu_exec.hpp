@@ -165,6 +165,14 @@ public:
     /// 2^low_word_bits, which shortens the radix sort (one pass per 12 bits used here, per 8 bits
     /// below 2^bits in CUB's).
     void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits, int low_word_bits = 32) const;
+    /// @brief Holds the spare keys sort() needs for `capacity` keys now, so that a window of colliding
+    /// pairs is refused before a frame's narrow phase rather than when it sorts; false when the memory
+    /// cannot hold them.
+    bool reserve_sort(std::size_t capacity) const {
+        return sort_scratch_.size() >= capacity || sort_scratch_.try_resize_discard(capacity);
+    }
+    std::size_t sort_spare_bytes() const { return sort_scratch_.capacity_bytes(); }
+    void release_sort() const { HostBuffer<std::uint64_t>().swap(sort_scratch_); }
 
     /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
     /// sorted ascending (the grid's lists by id); the lists are disjoint and lie within the first

@@ -443,6 +443,14 @@ public:
         return properties.name;
     }
 
+    /// @brief Holds the spare keys sort() needs for `capacity` keys now (as CpuExec::reserve_sort); false
+    /// when the device cannot hold them.
+    bool reserve_sort(std::size_t capacity) const {
+        return spare_keys_.size() >= capacity || spare_keys_.try_resize_discard(capacity);
+    }
+    std::size_t sort_spare_bytes() const { return spare_keys_.capacity_bytes(); }
+    void release_sort() const { DeviceBuffer<std::uint64_t>().swap(spare_keys_); }
+
     /// @brief Bytes of the scratch buffers CUB needs, for memory reports (device memory only).
     std::size_t scratch_bytes() const {
         return temp_.capacity_bytes() + spare_keys_.capacity_bytes() + prefixed_keys_.capacity_bytes() +

@@ -6,6 +6,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include <kdet/error.hpp>
 
 namespace kdet {
 
@@ -30,22 +34,50 @@ constexpr std::uint64_t rerun_capacity(std::uint64_t current, std::uint64_t want
     return std::max(wanted + wanted / 4, 2 * current);
 }
 
-/// @brief Makes `buffer` (an execution layer's buffer) hold `wanted` elements where the memory allows,
-/// else `fallback` (fewer), and returns how many it holds: near the memory's limit room with headroom
-/// can fail where the need itself still fits. Throws only when `fallback` does not fit either (the
-/// buffer is then empty).
+/// @brief Makes `buffer` (an execution layer's buffer) hold `wanted` elements where the memory and
+/// `room` (DetectorOptions::memory_limit's share for it, room_for) allow, else `needed` (fewer), and
+/// says whether it could: near the memory's limit room with headroom can fail where the need itself
+/// still fits. When not even `needed` fits the buffer may be left empty (a failed allocation frees
+/// the old one), which the next frame grows again.
 template <class Buffer>
-std::size_t resize_within_memory(Buffer& buffer, std::size_t wanted, std::size_t fallback) {
-    if (buffer.try_resize_discard(wanted)) return wanted;
-    buffer.resize_discard(fallback);
-    return fallback;
+bool resize_within_memory(Buffer& buffer, std::size_t wanted, std::size_t needed, std::size_t room) {
+    if (needed > room) return false;
+    const std::size_t headroom = std::min(wanted, room);
+    if (headroom > needed && buffer.try_resize_discard(headroom)) return true;
+    return buffer.try_resize_discard(needed);
 }
 
 /// @brief Makes `buffer` hold at least `wanted` elements for a frame that outgrew it: rerun_capacity's
-/// room where the memory allows, else `wanted` exactly (resize_within_memory).
+/// room where the memory allows, else `wanted` exactly (resize_within_memory); false when not even that.
 template <class Buffer>
-void grow_for_rerun(Buffer& buffer, std::uint64_t wanted) {
-    if (wanted > buffer.size()) resize_within_memory(buffer, rerun_capacity(buffer.size(), wanted), wanted);
+bool grow_for_rerun(Buffer& buffer, std::uint64_t wanted, std::size_t room) {
+    return wanted <= buffer.size() || resize_within_memory(buffer, rerun_capacity(buffer.size(), wanted), wanted, room);
+}
+
+/// @brief How many elements of `bytes_each` bytes fit under `limit` (DetectorOptions::memory_limit;
+/// 0: none) beside `held` bytes of the detector's other buffers.
+constexpr std::size_t room_for(std::size_t limit, std::size_t held, std::size_t bytes_each) {
+    if (limit == 0) return static_cast<std::size_t>(-1);
+    return held >= limit ? 0 : (limit - held) / bytes_each;
+}
+
+/// @brief "N bytes (X.Y GB)", or MB below a gigabyte: a size for messages.
+inline std::string bytes_text(std::uint64_t bytes) {
+    char scaled[32];
+    const bool gb = bytes >= 1000000000u;
+    std::snprintf(scaled, sizeof scaled, gb ? "%.1f GB" : "%.1f MB", static_cast<double>(bytes) / (gb ? 1e9 : 1e6));
+    return std::to_string(bytes) + " bytes (" + scaled + ")";
+}
+
+/// @brief The one-line error of a frame whose pairs the memory cannot hold: "`need` B bytes, more than
+/// ...": `need` names the pairs ("the frame has N candidate pairs, which take"), `held` what the
+/// detector holds besides, `limit` DetectorOptions::memory_limit (0: none).
+[[noreturn]] inline void throw_frame_too_large(const std::string& need, std::uint64_t bytes, std::uint64_t held,
+                                               std::uint64_t limit) {
+    const std::string over = limit ? "more than memory_limit " + std::to_string(limit) + " leaves"
+                                   : "more than the memory holds";
+    throw Error(need + " " + bytes_text(bytes) + ", " + over + " beside the detector's " + bytes_text(held) +
+                "; nothing was detected");
 }
 
 /// @brief The colliding pairs' window when the candidates outgrew their buffer of

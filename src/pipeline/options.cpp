@@ -4,6 +4,7 @@
 
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 
@@ -169,6 +170,10 @@ const std::vector<OptionInfo>& option_table() {
             "initial_candidate_capacity", "", "", "initial candidate capacity",
             "pairs the candidate buffer holds at first (0: sized from the tets); it grows as needed",
             OptionType::integer, 0, no_limit, "sized from the tets", front_end_python),
+        number<std::size_t, &O::memory_limit>(
+            "memory_limit", "--memory-limit", "--memory-limit", "memory limit",
+            "bytes the detector may take for a frame's candidates and pairs; a frame that needs more fails at once",
+            OptionType::integer, 0, no_limit, "as much as the memory holds", text_front_ends | front_end_python),
         number<bool, &O::contacts>("contacts", "", "", "contacts", "depth and direction per colliding pair",
                                    OptionType::boolean, 0, 1, nullptr, front_end_python),
         number<bool, &O::results_to_host>("results_to_host", "", "", "results to host",
@@ -196,7 +201,19 @@ std::string join_names(const std::vector<std::string>& names) {
 }
 
 std::string invalid_value_message(const std::string& shown, const std::string& text, const std::string& expected) {
-    return "invalid value '" + text + "' for " + shown + ": expected " + expected;
+    // Control characters are written as \xNN, so that the message stays one line whatever was given.
+    std::string echoed;
+    for (const char c : text) {
+        const auto byte = static_cast<unsigned char>(c);
+        if (byte >= 0x20 && byte != 0x7f) {
+            echoed += c;
+            continue;
+        }
+        char escaped[8];
+        std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+        echoed += escaped;
+    }
+    return "invalid value '" + echoed + "' for " + shown + ": expected " + expected;
 }
 
 long long parse_integer(const std::string& shown, const std::string& text, long long lo, long long hi) {

@@ -9,6 +9,7 @@
 #include <kdet/error.hpp>
 
 #include <algorithm>
+#include <new>
 #include <optional>
 
 namespace kdet {
@@ -31,9 +32,10 @@ void Pipeline<Exec>::enqueue_frame() {
         const std::size_t estimate = options_.initial_candidate_capacity
                                          ? options_.initial_candidate_capacity
                                          : std::max<std::size_t>(4096, 16 * plan.involved_tets);
-        // A guess: where the memory does not hold it, the search starts from less and grows as it
-        // goes (stop and resume: find_candidates).
-        if (candidates_.size() < estimate) resize_within_memory(candidates_, estimate, std::min<std::size_t>(estimate, 4096));
+        // A guess: where the memory (or memory_limit) does not hold it, the search starts from less,
+        // down to nothing, and the buffer grows to what the search counts (find_candidates).
+        if (candidates_.size() < estimate)
+            resize_within_memory(candidates_, estimate, 0, room(candidates_.capacity_bytes(), sizeof(std::uint64_t)));
         grid_planned_ = true;
     }
     enqueue_from(Rerun::grid);
@@ -52,10 +54,13 @@ void Pipeline<Exec>::enqueue_from(Rerun stage) {
         std::optional<FrameCounters> found = candidate_stage();
         clock_.mark(candidates_done);
         if (makes_pairs() && !pairs_sized_) {
-            // The colliding pairs are at most the candidates.
             if (!found) found = read_counters_now();
-            pairs_window_ = std::max<std::size_t>(pairs_window_, std::min<std::size_t>(found->candidates, candidates_.size()));
-            pairs_sized_ = true;
+            // A grid that did not fill has left candidates to find again: its rerun counts them as a
+            // first frame does, so that a need the memory cannot hold still fails before it is stored.
+            if (!found->grid_failure) {
+                reserve_pairs_window(std::min<std::size_t>(found->candidates - found->candidate_padding, candidates_.size()));
+                pairs_sized_ = true;
+            }
         }
     }
     enqueue_results();
@@ -137,7 +142,10 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
     }
     const std::size_t candidates_fitted = candidates_.size();
     if (c.candidates > candidates_fitted) {
-        grow_for_rerun(candidates_, c.candidates);
+        // The search counted every key, past the buffer's end: the need is known before anything grows.
+        if (!grow_for_rerun(candidates_, c.candidates, room(candidates_.capacity_bytes(), sizeof(std::uint64_t))))
+            refuse_frame("the frame has " + std::to_string(c.candidates - c.candidate_padding) + " candidate pairs, which take",
+                         c.candidates * sizeof(std::uint64_t));
         candidates_again = true;
     }
     bool pairs_again = false;
@@ -145,10 +153,13 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
         if (candidates_again) {
             // The rerun decides every candidate again: the window grows with them, in it (where the
             // memory allows; else a rerun of its own grows it to what it needs).
-            pairs_window_ = pairs_window_within_memory(
-                pairs_window_for_candidates(pairs_window_, candidates_fitted, candidates_.size()), pairs_window_);
+            const std::size_t held = pairs_window_;
+            if (!pairs_window_within_memory(pairs_window_for_candidates(held, candidates_fitted, candidates_.size()), held))
+                refuse_frame("the frame's window of " + std::to_string(held) + " colliding pairs takes", held * pair_bytes());
         } else if (c.colliding_pairs > pairs_window_) {
-            pairs_window_ = pairs_window_within_memory(rerun_capacity(pairs_window_, c.colliding_pairs), c.colliding_pairs);
+            if (!pairs_window_within_memory(rerun_capacity(pairs_window_, c.colliding_pairs), c.colliding_pairs))
+                refuse_frame("the frame has " + std::to_string(c.colliding_pairs) + " colliding pairs, which take",
+                             c.colliding_pairs * pair_bytes());
             pairs_again = true;
         } else if (c.colliding_pairs * 4 < pairs_window_ && pairs_window_ > 4096) {
             // Far fewer pairs than room: the GPU sorts the whole window, so it shrinks (memory stays).
@@ -163,13 +174,59 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
     return pairs_again ? Rerun::results : Rerun::none;
 }
 
-/// @brief Allocates the buffers of a pairs' window of `wanted` pairs and returns `wanted`, or, where the
-/// memory does not allow it, of the `needed` pairs alone (resize_within_memory for both buffers that
-/// hold the window); throws only when the need does not fit either.
+/// @brief Makes the pairs' window hold `wanted` pairs, or, where the memory (or memory_limit) does not
+/// allow it, the `needed` pairs alone (resize_within_memory for both buffers that hold it), and sets
+/// pairs_window_; false when not even the need fits. The sort's spare keys for the window are held
+/// with it (Exec::reserve_sort), so that a window the memory cannot sort fails here too.
 template <class Exec>
-std::size_t Pipeline<Exec>::pairs_window_within_memory(std::size_t wanted, std::size_t needed) {
-    const std::size_t keys = resize_within_memory(out_keys_, wanted, needed);
-    return options_.contacts ? resize_within_memory(out_contacts_, keys, needed) : keys;
+bool Pipeline<Exec>::pairs_window_within_memory(std::size_t wanted, std::size_t needed) {
+    const std::size_t own = out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() + exec_.sort_spare_bytes();
+    const std::size_t pairs_room = room(own, pair_bytes());
+    if (!resize_within_memory(out_keys_, wanted, needed, pairs_room)) return false;
+    if (options_.contacts && !resize_within_memory(out_contacts_, out_keys_.size(), needed, pairs_room)) return false;
+    std::size_t window = options_.contacts ? out_contacts_.size() : out_keys_.size();
+    if (!exec_.reserve_sort(window)) {
+        window = needed; // the headroom goes first
+        if (!exec_.reserve_sort(window)) return false;
+    }
+    pairs_window_ = window;
+    return true;
+}
+
+/// @brief A first frame's window for its colliding pairs, which are at most its `candidates`: room for
+/// all of them, filled once (every byte of it is copied out), or the frame is refused before the
+/// narrow phase runs. find_candidates reserves it as soon as it has counted a candidate buffer's
+/// overflow, before the search stores them.
+template <class Exec>
+void Pipeline<Exec>::reserve_pairs_window(std::uint64_t candidates) {
+    if (candidates <= pairs_window_) return;
+    if (!pairs_window_within_memory(candidates, candidates)) refuse_first_frame(candidates);
+    fill(out_keys_, no_pair_key);
+    if (options_.contacts) fill(out_contacts_, Contact{});
+}
+
+/// @brief Ends a frame whose pairs the memory (or memory_limit) cannot hold, before anything grows for
+/// them: frees the buffers that grow with the pairs (the detector keeps no room for a frame it
+/// refused; the next frame grows them again) and throws kdet::Error naming `need` and its `bytes`.
+template <class Exec>
+void Pipeline<Exec>::refuse_frame(const std::string& need, std::uint64_t bytes) {
+    buffer<std::uint64_t>().swap(candidates_);
+    buffer<std::uint64_t>().swap(candidates_grown_);
+    buffer<std::uint64_t>().swap(out_keys_);
+    buffer<Contact>().swap(out_contacts_);
+    exec_.release_sort();
+    pairs_window_ = 0;
+    colliding_count_ = 0;
+    throw_frame_too_large(need, bytes, memory_bytes(), options_.memory_limit);
+}
+
+/// @brief refuse_frame for a first frame of `candidates` candidate pairs, which needs room for them and
+/// for as many colliding pairs.
+template <class Exec>
+void Pipeline<Exec>::refuse_first_frame(std::uint64_t candidates) {
+    refuse_frame("the frame has " + std::to_string(candidates) +
+                     " candidate pairs; with room for all of them to collide, as a first frame keeps, they take",
+                 candidates * (sizeof(std::uint64_t) + pair_bytes()));
 }
 
 template <class Exec>
@@ -231,7 +288,12 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
         const std::uint32_t* flags = exec_.template landed<std::uint32_t>(flags_view_);
         const Contact* contacts = exec_.template landed<Contact>(contacts_view_);
         const auto& begin = topology_.object_tet_begin;
-        result.pairs.resize(colliding_count_);
+        try {
+            result.pairs.resize(colliding_count_);
+        } catch (const std::bad_alloc&) {
+            refuse_frame("the frame has " + std::to_string(colliding_count_) + " colliding pairs, whose copy for the caller takes",
+                         colliding_count_ * sizeof(TetPair));
+        }
         pairs_from_keys(begin, keys, colliding_count_, result.pairs.data(), options_.threads);
         if (options_.contacts) result.contacts.assign(contacts, contacts + colliding_count_);
         flags_by_object(begin, flags, result.colliding, options_.threads);

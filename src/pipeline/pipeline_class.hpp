@@ -11,6 +11,7 @@
 /// control in pipeline.hpp, and each stage's kernels in a header of its own.
 
 #include "pipeline/bounding_boxes.hpp"
+#include "pipeline/capacity.hpp"
 #include "pipeline/candidate_search.hpp"
 #include "pipeline/frame_counters.hpp"
 #include "pipeline/grid_populate.hpp"
@@ -78,7 +79,7 @@ public:
         // Exclusions name stored tets: the detector sets them again for the new topology.
         exclusion_begin_.resize_discard(0);
         excluded_.resize_discard(0);
-        counters_.resize_discard(1);
+        counters_.resize_discard(2); // the frame's, and find_candidates' count of what its buffer lacked
         // New geometry: the first frame plans the grid and sizes the pairs from what it finds; the bucket
         // size is chosen again from that plan (and only grows with later ones).
         grid_planned_ = pairs_sized_ = false;
@@ -218,7 +219,17 @@ protected:
     /// when everything fitted).
     enum class Rerun { none, results, candidates, grid };
     Rerun grow_for(const FrameCounters& c);
-    std::size_t pairs_window_within_memory(std::size_t wanted, std::size_t needed);
+    bool pairs_window_within_memory(std::size_t wanted, std::size_t needed);
+    void reserve_pairs_window(std::uint64_t candidates);
+    [[noreturn]] void refuse_frame(const std::string& need, std::uint64_t bytes);
+    [[noreturn]] void refuse_first_frame(std::uint64_t candidates);
+    /// Bytes of the pairs' window per pair: its key, its sort's spare key, its contact where asked for.
+    std::size_t pair_bytes() const { return 2 * sizeof(std::uint64_t) + (options_.contacts ? sizeof(Contact) : 0); }
+    /// Elements of `bytes_each` bytes that buffers now holding `own_bytes` may grow to under
+    /// DetectorOptions::memory_limit (room_for).
+    std::size_t room(std::size_t own_bytes, std::size_t bytes_each) const {
+        return room_for(options_.memory_limit, memory_bytes() - own_bytes, bytes_each);
+    }
     void enqueue_from(Rerun stage);
     void enqueue_results();
     void enqueue_again(const FrameCounters& c, Rerun stage);

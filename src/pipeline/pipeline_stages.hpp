@@ -137,13 +137,16 @@ GridView Pipeline<Exec>::populate() {
 }
 
 /// @brief Stage 3 (kdet): candidate pairs, each written once. A frame that reads its counters back
-/// here (a first frame, to size the pairs' window) does not rerun when the buffer overflows: the
-/// buffer grows keeping what was stored and only the search items (tets, or parts of their searches:
-/// SearchPart) that did not fit search again, each resuming after the keys it had
-/// stored (they stopped searching when they did not fit). There is room to resume one item per tet;
-/// when more stop (a first buffer far too small for a split search), every item searches again into
-/// the grown buffer. Later frames read nothing here; an overflow shows in the frame's counters and the
-/// frame reruns (grow_for). Returns the counters when it read them.
+/// here (a first frame, to size the pairs' window) does not rerun when the buffer overflows: the search
+/// items (tets, or parts of their searches: SearchPart) that did not fit stopped when they did not, so
+/// they search once more storing nothing, only counting the keys they still need; then the buffer
+/// grows once to that need, keeping what was stored, and only they search again, each resuming after
+/// the keys it had stored. There is room to resume one item per tet; when more stop (a first buffer
+/// far too small for a split search), every item counts and then searches again into the grown
+/// buffer. A need that the memory (or memory_limit) cannot hold, with room for as many colliding
+/// pairs, throws at once, before the search stores it. Later frames read nothing here; an overflow
+/// shows in the frame's counters, which count past the buffer's end, and the frame reruns (grow_for).
+/// Returns the counters when it read them.
 template <class Exec>
 std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
     // Items are numbered in 32 bits (ResumePoint): a scene too large for that searches its tets whole.
@@ -158,44 +161,55 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
     const std::size_t runs = TetRuns<tets_per_item>::count(static_cast<std::uint32_t>(tets_.size()));
     const std::size_t all_items = runs * parts, resume_room = tets_.size();
     for (auto& points : resume_points_) points.resize_discard(resume_room);
+    // `items` items (resuming where `from` says, or from their start) append to `out`, counting into
+    // `into`; those that do not fit are recorded in `stopped`, while there is `stopped_room`.
+    const auto search = [&](std::size_t items, const ResumePoint* from, const KeyAppender& out, FrameCounters* into,
+                            ResumePoint* stopped, std::size_t stopped_room, bool stop_when_full) {
+        FrameCounters* c = counters_.data();
+        exec_.for_each(items, Search{scene_view(), grid, &c->params, &c->layer_mask, out, &into->rejected, from, stopped,
+                                     &into->stopped_items, static_cast<std::uint32_t>(stopped_room), layer_parts,
+                                     block_parts, stop_when_full},
+                       tets_per_item);
+    };
     std::size_t items = all_items;
-    std::size_t first_slot = 0; ///< where this run's keys start in the buffer
     const ResumePoint* resume_from = nullptr;
     for (int run = 0;; ++run) {
         FrameCounters* c = counters_.data();
         ResumePoint* stopped = resume_points_[run % 2].data();
-        const KeyAppender out{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding};
-        exec_.for_each(items, Search{scene_view(), grid, &c->params, &c->layer_mask, out, &c->rejected, resume_from, stopped,
-                                     &c->stopped_items, static_cast<std::uint32_t>(resume_room), layer_parts, block_parts,
-                                     !pairs_sized_},
-                       tets_per_item);
+        search(items, resume_from, KeyAppender{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding},
+               c, stopped, resume_room, !pairs_sized_);
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
         if (!after.stopped_items) return after;
-        // The items that stopped quit searching when they did not fit, so their need is estimated from
-        // the keys per item of the ones that finished in this run, with a quarter more (room for the
-        // next frames, whose overflow would rerun the whole frame); the buffer grows by half at
-        // least, so a poor estimate costs few rounds; where the memory does not hold that much beside
-        // the kept keys, half as much, and so on down to a batch more (each round stores some).
-        const std::size_t kept = candidates_.size();
-        const double finished = static_cast<double>(items - after.stopped_items);
-        const double stored_now = static_cast<double>(kept - std::min(kept, first_slot));
-        const double estimate = finished > 0.0 ? 1.25 * stored_now / finished * after.stopped_items : 0.0;
-        std::size_t more = std::max(static_cast<std::size_t>(estimate), kept / 2);
+        // The count: the items to search again, into a buffer of no room, on counters of their own.
         const bool resume = after.stopped_items <= resume_room;
-        while (more > 0 && !candidates_grown_.try_resize_discard(kept + more + KeyBatch::size)) more /= 2;
-        if (more == 0) candidates_grown_.resize_discard(kept + KeyBatch::size); // throws if not even that fits
-        if (resume) exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
+        items = resume ? after.stopped_items : all_items;
+        resume_from = resume ? stopped : nullptr;
+        FrameCounters* count = counters_.data() + 1;
+        const FrameCounters zero{};
+        exec_.upload(count, &zero, 1);
+        search(items, resume_from, KeyAppender{candidates_.data(), 0, &count->candidates, nullptr}, count, nullptr, 0, false);
+        FrameCounters counted;
+        exec_.download(&counted, count, 1);
+        const std::size_t kept = candidates_.size();
+        const std::uint64_t keys = (resume ? kept - after.candidate_padding : 0) + counted.candidates;
+        reserve_pairs_window(keys);
+        // Room for the next frames too where the memory allows (their overflow would rerun the whole
+        // frame); where it does not hold the kept keys and the grown buffer at once, every item
+        // searches again into a buffer of the keys alone.
+        const std::size_t slots = (resume ? kept : 0) + counted.candidates;
+        const bool copied = resume && resize_within_memory(candidates_grown_, rerun_capacity(kept, slots), slots,
+                                                           room(candidates_grown_.capacity_bytes(), sizeof(std::uint64_t)));
+        if (copied) exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
         candidates_.swap(candidates_grown_);
+        buffer<std::uint64_t>().swap(candidates_grown_); // frees the old buffer
+        if (!copied && !resize_within_memory(candidates_, keys + keys / 4, keys, room(candidates_.capacity_bytes(), sizeof(std::uint64_t))))
+            refuse_first_frame(keys);
         ++regrows_;
-        if (resume) {
+        if (copied) {
             after.candidates = kept;
-            first_slot = kept;
-            items = after.stopped_items;
-            resume_from = stopped;
         } else {
             after.candidates = after.candidate_padding = after.rejected = 0;
-            first_slot = 0;
             items = all_items;
             resume_from = nullptr;
         }
