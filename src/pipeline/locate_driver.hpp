@@ -179,7 +179,7 @@ private:
                 layer_mask_ = inserted.layer_mask;
                 break;
             }
-            grow_for_rerun(keys_, inserted.entries);
+            grow_or_refuse(keys_, inserted.entries, "grid entries");
             LocateCounters again = inserted;
             again.entries = again.big_count = again.layer_mask = 0;
             exec.upload(c, &again, 1);
@@ -198,6 +198,13 @@ private:
         return LocateGridView{scene.positions, scene.tets, scene.user_id, request.first_tet, boxes_.data(), keys_.data(),
                               entry_boxes_.data(), entries_, slot_begin_.data(), slot_end_.data(), big_.data(), big_count_, params, hash,
                               slot_bits, layer_mask_};
+    }
+
+    /// Grows a key buffer for a rerun; a need the memory cannot hold is a one-line error naming it.
+    static void grow_or_refuse(buffer<std::uint64_t>& keys, std::uint64_t wanted, const char* what) {
+        if (!grow_for_rerun(keys, wanted, std::numeric_limits<std::size_t>::max()))
+            throw Error("locate: out of memory: " + std::to_string(wanted) + " " + what + " take " +
+                        bytes_text(wanted * sizeof(std::uint64_t)));
     }
 
     /// The order the queries run in: the points sorted along a Morton curve (LocatePointOrderKernel).
@@ -219,7 +226,7 @@ private:
             const LocateCounters found = read_counters(exec);
             hit_count_ = found.hits;
             if (found.hits <= hits_.size()) break;
-            grow_for_rerun(hits_, found.hits);
+            grow_or_refuse(hits_, found.hits, "hits");
             LocateCounters again = found;
             again.hits = 0;
             exec.upload(c, &again, 1);
