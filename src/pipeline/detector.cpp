@@ -253,6 +253,19 @@ void Detector::set_self_collision(ObjectId object, bool enabled) {
     impl_->pair_enabled[object * impl_->objects() + object] = enabled ? 1 : 0;
 }
 
+void Detector::set_static(ObjectId object, bool is_static) {
+    impl_->check_object(object);
+    std::uint8_t& flag = impl_->topology.object_static[object];
+    if ((flag != 0) == is_static) return;
+    flag = is_static ? 1 : 0;
+    impl_->topology_changed = true;
+}
+
+bool Detector::is_static(ObjectId object) const {
+    impl_->check_object(object);
+    return impl_->topology.object_static[object] != 0;
+}
+
 void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
     impl_->check_object(a);
     impl_->check_object(b);
@@ -279,6 +292,7 @@ void Detector::detect_async() {
         const std::uint32_t first = d.object_vertex_begin[o], count = d.object_vertex_begin[o + 1] - first;
         if (d.positions_dirty[o]) uploads.push_back({first, d.positions.data() + first, count});
         if (d.positions_staged[o]) staged.push_back({first, count});
+        if (d.topology.object_static[o] && (d.positions_dirty[o] || d.positions_staged[o])) d.pipeline->static_moved();
     }
     d.pipeline->start(uploads, staged, d.pair_enabled);
     std::fill(d.positions_dirty.begin(), d.positions_dirty.end(), 0);
