@@ -6,12 +6,13 @@
 /// this grid.
 ///
 /// A moving tet m and a static tet s must meet whichever of them is larger. The static grid therefore
-/// holds each static tet on its own layer and on every layer above it, up to a top layer whose cells
-/// span the whole static region. m searches the static grid from the layer its own size gives it
-/// (`L`, at most the top) upwards: on L it takes the static tets whose own layer is L or below (the
-/// smaller ones, held there as copies), on each higher layer those whose own layer it is (the larger
-/// ones). Each pair is so found on one layer only, and on that layer in one cell only, by the rule of
-/// for_each_larger_neighbour (the cell of the lower corner of the boxes' intersection). m's box is cut
+/// holds each static tet in the cells of its own layer and, as a copy, in the copy cells of every
+/// layer above it (keys of their own: layer + max_grid_layers), up to a top layer whose cells span
+/// the whole static region. m searches the static grid from the layer its own size gives it (`L`, at
+/// most the top) upwards: the own cells of L and of every layer above (the tets of its size and
+/// larger), and the copy cells of L alone (the smaller tets). Each pair is so found on one layer only,
+/// and on that layer in one cell only, by the rule of for_each_larger_neighbour (the cell of the lower
+/// corner of the boxes' intersection); no search reads a copy it must skip. m's box is cut
 /// to the static region first, so that a moving tet larger than the region still visits at most two
 /// cells per axis of the top layer.
 ///
@@ -123,8 +124,13 @@ struct StaticPlanKernel {
     }
 };
 
-/// @brief Placing static tets, per tet: inserts it into the cells of its box on its own layer and on
-/// every layer above (start bits relative to its range on each). Once an insert has failed, the rest
+/// @brief The key of a copy cell (see the file's comment): apart from every layer's own cells.
+KDET_HD inline CellCoord copy_cell(std::uint32_t x, std::uint32_t y, std::uint32_t z, int layer) {
+    return make_cell(x, y, z, layer + max_grid_layers);
+}
+
+/// @brief Placing static tets, per tet: inserts it into the cells of its box on its own layer and the
+/// copy cells of every layer above (start bits relative to its range on each). Once an insert has failed, the rest
 /// give up: the pass runs again with more room.
 struct StaticPopulateKernel {
     SceneView scene;
@@ -139,7 +145,8 @@ struct StaticPopulateKernel {
             if (atomic_load_acquire(grid.failure)) return;
             const CellRange r = cell_range(*params, info.box, l);
             for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-                return grid_insert(grid, make_cell(x, y, z, l), t, first_cell_axes(r, x, y, z)) != no_bucket;
+                const CellCoord cell = l == info.layer ? make_cell(x, y, z, l) : copy_cell(x, y, z, l);
+                return grid_insert(grid, cell, t, first_cell_axes(r, x, y, z)) != no_bucket;
             });
         }
     }
@@ -153,21 +160,14 @@ struct StaticGridSearch {
     bool active;
 };
 
-/// @brief Passes on the static entries that moving tet t must test on `layer` (see the file's
-/// comment): of an object t is checked against, and held there as the layer's own tet, or, on t's
-/// layer L, as a copy of a smaller one.
+/// @brief Passes on the static entries of an object that t's object is checked against.
 template <class Visitor>
-struct StaticLayerFilter {
-    const SceneView* scene;
+struct StaticObjectFilter {
     const std::uint8_t* checked_against;
-    int layer;
-    bool from_below; ///< layer is L: the copies of smaller tets count too
     Visitor* visit;
 
     KDET_HD void operator()(const GridEntry& e) const {
-        if (!checked_against[e.object]) return;
-        const int own = scene->info[e.id()].layer;
-        if (own == layer || (from_below && own < layer)) (*visit)(e);
+        if (checked_against[e.object]) (*visit)(e);
     }
 };
 
@@ -190,15 +190,15 @@ KDET_HD inline void for_each_static_neighbour(const SceneView& scene, const Stat
     const Aabb cut{max_v(self.box.lo, region_lo), min_v(self.box.hi, region_hi)};
     if (!(cut.lo.x <= cut.hi.x && cut.lo.y <= cut.hi.y && cut.lo.z <= cut.hi.z)) return;
     const int from = tet_layer(scene, params, t, self.diameter);
-    StaticLayerFilter<Visitor> filter{&scene, scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count,
-                                      from, true, &visit};
+    StaticObjectFilter<Visitor> filter{scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count, &visit};
     for (int layer = from; layer < params.layer_count; ++layer) {
-        filter.layer = layer;
-        filter.from_below = layer == from;
         const CellRange r = cell_range(params, cut, layer);
         const bool searched_all = for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-            grid_for_each_in_cell(statics.grid, make_cell(x, y, z, layer), 0u, checked_objects, self.box,
-                                  ~first_cell_axes(r, x, y, z) & 7u, filter);
+            const std::uint32_t required_starts = ~first_cell_axes(r, x, y, z) & 7u;
+            grid_for_each_in_cell(statics.grid, make_cell(x, y, z, layer), 0u, checked_objects, self.box, required_starts, filter);
+            if (layer == from)
+                grid_for_each_in_cell(statics.grid, copy_cell(x, y, z, layer), 0u, checked_objects, self.box, required_starts,
+                                      filter);
             return !visit.finished();
         });
         if (!searched_all) return;
