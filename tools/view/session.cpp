@@ -121,9 +121,12 @@ bool ViewSession::update() {
         changed = true;
     }
     if (results_stale_) {
-        if (!detector_) build_detector();
+        const bool fresh = !detector_;
+        if (fresh) build_detector();
+        // A static object's positions are the same in every frame: given once, it stays placed.
         for (std::size_t o = 0; o < scene_->num_objects(); ++o)
-            detector_->set_positions(static_cast<ObjectId>(o), positions_[o].data(), positions_[o].size() / 3);
+            if (fresh || !scene_->is_static(o))
+                detector_->set_positions(static_cast<ObjectId>(o), positions_[o].data(), positions_[o].size() / 3);
         const auto start = std::chrono::steady_clock::now();
         const double cpu_start = process_cpu_ms();
         result_ = detector_->detect();
