@@ -24,7 +24,7 @@ exclude="$(git -C "$repo" rev-parse --absolute-git-dir)/info/exclude"
 mkdir -p "$(dirname "$exclude")"
 grep -qx '/.gpu-bundle/' "$exclude" 2>/dev/null || echo '/.gpu-bundle/' >>"$exclude"
 (cd "$repo" && cmake --preset cuda -B "$build" >/dev/null)
-cmake --build "$build" -j"$(nproc)" --target kdet_cli kdet_tests kdet_gpu_vs_sweep
+cmake --build "$build" -j"$(nproc)" --target kdet_cli kdet_tests kdet_gpu_vs_sweep static_environment
 
 # The thesis scenes read their models and prepared meshes; prepare any that are missing.
 KDET_DATA_DIR="$data_dir" KDET_CACHE_DIR="$cache_dir" "$build/kdet" prepare >/dev/null
@@ -32,6 +32,7 @@ KDET_DATA_DIR="$data_dir" KDET_CACHE_DIR="$cache_dir" "$build/kdet" prepare >/de
 rm -rf "$bundle"
 mkdir -p "$bundle/lib"
 cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bundle/"
+cp "$build/bench/static_environment" "$bundle/kdet_static_environment"
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"
   # Kept, like the build folder, at the same path every time: the build's CMake cache names its
