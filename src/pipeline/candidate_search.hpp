@@ -238,7 +238,10 @@ struct FindCandidatesKernel {
                   FacePlanesInSearch ? scene.planes[t] : TetPlanes{}, scene.slabs ? scene.slabs[t] : TetSlabs{}, 0};
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
-        if (part.layer == 0 && part.block == 0 && !emit.finished()) for_each_static_neighbour(scene, statics, t, emit);
+        if (part.layer == 0 && part.block == 0 && !emit.finished()) {
+            const ObjectFilter<Emit> filter{scene.pair_active + static_cast<std::uint64_t>(emit.object) * scene.object_count, &emit};
+            for_each_static_neighbour(scene, statics, t, filter, emit);
+        }
         return emit.rejected;
     }
 

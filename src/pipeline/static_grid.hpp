@@ -160,23 +160,13 @@ struct StaticGridSearch {
     bool active;
 };
 
-/// @brief Passes on the static entries of an object that t's object is checked against.
-template <class Visitor>
-struct StaticObjectFilter {
-    const std::uint8_t* checked_against;
-    Visitor* visit;
-
-    KDET_HD void operator()(const GridEntry& e) const {
-        if (checked_against[e.object]) (*visit)(e);
-    }
-};
-
-/// @brief Calls visit(entry) once for every static tet u that moving tet t must test: u's object is
-/// checked against t's and the boxes overlap (adjacency cannot occur: they are different objects).
-/// Ends early, after a cell, once visit.finished().
-template <class Visitor>
+/// @brief Calls filter(entry) once for every static tet u that moving tet t must test and whose box
+/// overlaps t's, in a cell holding one of the objects t is checked against; the filter checks u's
+/// object (ObjectFilter) and passes it on to `visit` (adjacency cannot occur: they are different
+/// objects). Ends early, after a cell, once visit.finished().
+template <class Filter, class Visitor>
 KDET_HD inline void for_each_static_neighbour(const SceneView& scene, const StaticGridSearch& statics, std::uint32_t t,
-                                              Visitor& visit) {
+                                              const Filter& filter, const Visitor& visit) {
     if (!statics.active || *statics.grid.failure) return;
     const GridParams params = *statics.params;
     if (params.layer_count == 0) return;
@@ -190,7 +180,6 @@ KDET_HD inline void for_each_static_neighbour(const SceneView& scene, const Stat
     const Aabb cut{max_v(self.box.lo, region_lo), min_v(self.box.hi, region_hi)};
     if (!(cut.lo.x <= cut.hi.x && cut.lo.y <= cut.hi.y && cut.lo.z <= cut.hi.z)) return;
     const int from = tet_layer(scene, params, t, self.diameter);
-    StaticObjectFilter<Visitor> filter{scene.pair_active + static_cast<std::uint64_t>(object) * scene.object_count, &visit};
     for (int layer = from; layer < params.layer_count; ++layer) {
         const CellRange r = cell_range(params, cut, layer);
         const bool searched_all = for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
