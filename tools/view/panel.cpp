@@ -190,6 +190,11 @@ void Viewer::panel_scene() {
         ImGui::SameLine();
         ImGui::Text("object %zu: %zu tets, %zu surface triangles", o, scene.rest_mesh(o).num_tets(),
                     session_.faces()[o].boundary.size() / 3);
+        if (scene.is_static(o)) {
+            ImGui::SameLine();
+            bool is_static = session_.is_static(o);
+            if (ImGui::Checkbox("static", &is_static)) session_.set_static(o, is_static);
+        }
         ImGui::PopID();
     }
 }
