@@ -1,4 +1,4 @@
-// The scenes of issue 46 built in code (heap, drape) and the scene file's `static` statement: the
+// The scenes of issue 46 built in code (heap, drape, graded) and the scene file's `static` statement: the
 // scenes are deterministic, their static objects never move, and a frame's pairs with the static
 // objects placed once equal those with every object moving (which tests/test_pipeline.cpp holds to
 // brute force), minus the pairs of two static objects.
@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -106,8 +108,33 @@ TEST(GeneratedScenes, DrapeWrapsAStaticBallAndFoldsOnItself) {
     EXPECT_EQ(detector.detect().pairs.size(), 0u) << "the sheet lying on the ball does not";
 }
 
+TEST(GeneratedScenes, GradedSizesSpanThreeDecades) {
+    const auto graded = open_scene("graded");
+    ASSERT_EQ(graded->num_objects(), 2u);
+    EXPECT_TRUE(graded->is_static(0));
+    const TetMesh& block = graded->rest_mesh(0);
+    double smallest = 1e300, largest = 0;
+    for (std::size_t t = 0; t < block.num_tets(); ++t) {
+        double longest = 0;
+        for (int i = 0; i < 4; ++i)
+            for (int j = i + 1; j < 4; ++j) {
+                double d2 = 0;
+                for (int a = 0; a < 3; ++a) {
+                    const double d = block.positions[3 * block.tets[4 * t + i] + a] - block.positions[3 * block.tets[4 * t + j] + a];
+                    d2 += d * d;
+                }
+                longest = std::max(longest, std::sqrt(d2));
+            }
+        smallest = std::min(smallest, longest);
+        largest = std::max(largest, longest);
+    }
+    EXPECT_GE(largest / smallest, 1000.0);
+    expect_static_objects_still(*graded);
+    expect_static_placement_changes_nothing(*graded, {50, 59, 70}, true);
+}
+
 TEST(GeneratedScenes, SameFramesEveryTime) {
-    for (const char* name : {"heap", "drape"}) {
+    for (const char* name : {"heap", "drape", "graded"}) {
         const auto a = open_scene(name), b = open_scene(name);
         std::vector<float> pa, pb;
         for (std::size_t o : {std::size_t{0}, a->num_objects() - 1}) {

@@ -126,6 +126,13 @@ std::unique_ptr<Scene> make_heap_scene(int resolution);
 /// resolution outside 1-4.
 std::unique_ptr<Scene> make_drape_scene(int resolution);
 
+/// @brief `graded`: a static unit block whose cubes halve in size toward a point inside it, from a
+/// quarter of the block down 10 to 13 times at resolution 1-4 (tet sizes over 3 to 3.9 decades; not
+/// conforming where cube sizes change),
+/// and an upright torus of 10k-40k tets of one size rolling along x through that point. Throws
+/// kdet::Error for a resolution outside 1-4.
+std::unique_ptr<Scene> make_graded_scene(int resolution);
+
 /// @brief What open_scene needs besides the name.
 struct SceneRequest {
     int resolution = 1;                     ///< 1-4, for the thesis scenes
