@@ -7,7 +7,7 @@
 #            brute force on armadillos r4 at the frames where they touch
 #   scaling  the procedural scene from 100k to 4M tets (and 8M), frames around the deepest one (60)
 #   peer     kdet against a CUB sort-and-sweep + sat peer on the same frames (bench/gpu_vs_sweep.cu)
-#   scenes   issue 46's scenes (heap, drape at resolution 1-4, pass_through_deep), self-collision off
+#   scenes   issue 46's scenes (heap, drape, graded at resolution 1 and 4, pass_through_deep), self-collision off
 #            and on, and a body on a 1M-tet static floor against a 20k-tet one (bench/static_environment.cpp)
 #   profile  each kernel's GPU time in two frames of five cases (Nsight Compute), the heaviest case's
 #            occupancy, divergence and cache hits, and the bucket
@@ -109,7 +109,7 @@ for part in "$@"; do
     done
     ;;
   scenes)
-    for scene in heap drape; do
+    for scene in heap drape graded; do
       for r in 1 4; do
         for self in no yes; do
           bench "scenes-$scene-r$r-self-$self" 90 "$scene" -r "$r" -s "$self" -n 3
