@@ -379,7 +379,7 @@ void Viewer::profile(int width, int height) {
     reset_camera(static_cast<float>(width) / static_cast<float>(height));
     std::size_t tets = 0, triangles = 0;
     for (std::size_t o = 0; o < session_.scene().num_objects(); ++o) {
-        tets += session_.scene().rest_mesh(o).num_tets();
+        tets += session_.mesh(o).num_tets();
         triangles += session_.faces()[o].boundary.size() / 3;
     }
     std::printf("profile: scene %s, %zu objects, %zu tets, %zu surface triangles, %d frames; method %s, test %s, "
