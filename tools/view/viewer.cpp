@@ -224,6 +224,7 @@ void Viewer::handle_click(int scene_x, int scene_width, int scene_height) {
     selected_ = pick_tet(session_, camera_, io.MousePos.x - static_cast<float>(scene_x), io.MousePos.y, scene_width,
                          scene_height, config_.display, scene_box_);
     selection_version_ = 0;
+    selection_topology_ = session_.topology_version();
 }
 
 void Viewer::handle_input(int scene_height) {
@@ -297,8 +298,11 @@ void Viewer::run() {
         const bool computed = !bench_job_ && session_.update();
         renderer_->update(session_);
         if (selection_version_ != session_.result_version()) {
-            // The selection follows its tet through the frames; a new scene drops it.
-            if (selected_ && selected_->object >= session_.scene().num_objects()) selected_.reset();
+            // The selection follows its tet through the frames; a new scene drops it, and so do new tets
+            // (a tear numbers them anew).
+            if (selected_ && (selected_->object >= session_.scene().num_objects() ||
+                              session_.topology_version() != selection_topology_))
+                selected_.reset();
             partners_ = selected_ ? partners_of(session_.result(), *selected_) : std::vector<Partner>{};
             std::vector<TetRef> shown;
             if (selected_) shown.push_back(*selected_);
