@@ -15,6 +15,7 @@
 /// steps.
 
 #include "exec/atomic.hpp"
+#include "pipeline/pair_exclusions.hpp"
 #include "pipeline/pipeline_base.hpp"
 #include "pipeline/scene_view.hpp"
 
@@ -116,23 +117,9 @@ struct UniqueKernel {
     }
 };
 
-/// Whether x is in the sorted items [first, last).
-KDET_HD inline bool sorted_holds(const std::uint32_t* first, const std::uint32_t* last, std::uint32_t x) {
-    std::uint32_t n = static_cast<std::uint32_t>(last - first);
-    while (n > 0) {
-        const std::uint32_t half = n / 2;
-        if (first[half] < x) {
-            first += half + 1;
-            n -= half + 1;
-        } else {
-            n = half;
-        }
-    }
-    return first != last && *first == x;
-}
-
-/// Per row of sorted `rows`, the items y of the adjacency rows of its items x, each once: from the x that comes first in y's own row of `back` (which holds x whenever x's adjacency
-/// row holds y). Counts them (Write == false) or writes them from out_begin[r] on, unsorted.
+/// Per row of sorted `rows`, the items y of the adjacency rows of its items x, each once: from the x
+/// that comes first in y's own row of `back` (which holds x whenever x's adjacency row holds y).
+/// Counts them (Write == false) or writes them from out_begin[r] on, unsorted.
 template <bool Write>
 struct ExpandOnceKernel {
     RowsView rows, adjacency, back;
@@ -232,17 +219,7 @@ struct MergeTetsKernel {
             const std::uint32_t v = tet_vertices[4 * i + k];
             head[k] = vertex_tets.items + vertex_tets.begin[v];
             last[k] = vertex_tets.items + vertex_tets.begin[v + 1];
-            // Only later tets are listed: start past t.
-            std::uint32_t n = static_cast<std::uint32_t>(last[k] - head[k]);
-            while (n > 0) {
-                const std::uint32_t half = n / 2;
-                if (head[k][half] <= t) {
-                    head[k] += half + 1;
-                    n -= half + 1;
-                } else {
-                    n = half;
-                }
-            }
+            head[k] = first_not_below(head[k], last[k], t + 1); // only later tets are listed
         }
         std::uint32_t n = 0;
         for (;;) {

@@ -13,6 +13,27 @@
 
 namespace kdet {
 
+/// @brief The first of the sorted ids [first, last) that is not below x (last when none is).
+KDET_HD inline const std::uint32_t* first_not_below(const std::uint32_t* first, const std::uint32_t* last, std::uint32_t x) {
+    std::uint32_t n = static_cast<std::uint32_t>(last - first);
+    while (n > 0) {
+        const std::uint32_t half = n / 2;
+        if (first[half] < x) {
+            first += half + 1;
+            n -= half + 1;
+        } else {
+            n = half;
+        }
+    }
+    return first;
+}
+
+/// @brief Whether the sorted ids [first, last) hold x.
+KDET_HD inline bool sorted_holds(const std::uint32_t* first, const std::uint32_t* last, std::uint32_t x) {
+    const std::uint32_t* found = first_not_below(first, last, x);
+    return found != last && *found == x;
+}
+
 /// @brief The exclusions as one tet meets its partners: holds(u) says whether (t, u) is excluded.
 struct ExcludedPartners {
     const std::uint32_t* begin = nullptr; ///< SceneView::exclusion_begin; null when nothing is excluded
@@ -24,19 +45,7 @@ struct ExcludedPartners {
     KDET_HD bool holds(std::uint32_t u) const {
         if (!begin) return false;
         const std::uint32_t low = u < t ? u : t, high = u < t ? t : u;
-        const std::uint32_t* lo = excluded + begin[low];
-        const std::uint32_t* const last = excluded + begin[low + 1];
-        std::uint32_t n = static_cast<std::uint32_t>(last - lo);
-        while (n > 0) {
-            const std::uint32_t half = n / 2;
-            if (lo[half] < high) {
-                lo += half + 1;
-                n -= half + 1;
-            } else {
-                n = half;
-            }
-        }
-        return lo != last && *lo == high;
+        return sorted_holds(excluded + begin[low], excluded + begin[low + 1], high);
     }
 };
 
