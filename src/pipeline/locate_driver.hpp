@@ -171,7 +171,7 @@ private:
         if (keys_.size() < std::size_t{4} * count) keys_.resize_discard(std::size_t{4} * count);
         for (;;) {
             const KeyAppender out{keys_.data(), keys_.size(), &c->entries, nullptr};
-            exec.for_each(count, LocateInsertKernel{boxes_.data(), params, hash, slot_bits, out, big_.data(), c});
+            exec.for_each(count, PopulateKernel<LocateCells>{LocateCells{boxes_.data(), params, hash, slot_bits, out, big_.data(), c}});
             const LocateCounters inserted = read_counters(exec);
             if (inserted.entries <= keys_.size()) {
                 entries_ = inserted.entries;

@@ -6,7 +6,8 @@
 ///
 /// The grid is the hierarchical one of the collision pipeline (grid_math.hpp: layer l has cell size
 /// c0 * 2^l, a tet goes to the layer whose cells its box's extent fits, so it spans at most two cells
-/// per axis), stored for queries by points instead of tets: each (cell slot, tet) is one 64-bit key,
+/// per axis), filled by the pipeline's populate step (PopulateKernel) and stored for queries by points
+/// instead of tets: each (cell slot, tet) is one 64-bit key,
 /// sorted, and a table gives each slot's run of keys. A point visits one cell per occupied layer;
 /// a box (a point grown by `within`) the cells it overlaps. Cells whose hashes share a slot only add
 /// candidates: every candidate passes a box test and the exact test.
@@ -15,6 +16,7 @@
 #include "geometry/point_tet.hpp"
 #include "grid/grid_math.hpp"
 #include "pipeline/bounding_boxes.hpp"
+#include "pipeline/grid_populate.hpp"
 #include "pipeline/pair_keys.hpp"
 #include "pipeline/scene_view.hpp"
 
@@ -74,35 +76,48 @@ KDET_HD inline std::uint32_t locate_slot(HashFunction hash, std::uint32_t x, std
     return table_slot(hash_cell(hash, make_cell(x, y, z, layer), 0u), slot_bits);
 }
 
-/// @brief Per located tet: a key (slot << 32 | tet) per cell its box overlaps on its layer, or, when it
-/// spans more than two cells along an axis there (larger than the top layer's cells), its index in
-/// the list that every query scans.
-struct LocateInsertKernel {
+/// @brief What point location's grid stores (run by the populate step, PopulateKernel): per located
+/// tet, on the layer its box's extent picks, a key (slot << 32 | tet) per cell its box overlaps, or,
+/// when it spans more than two cells along an axis there (larger than the top layer's cells), its
+/// index in the list that every query scans.
+struct LocateCells {
     const Aabb* boxes;
-    GridParams params;
+    GridParams grid;
     HashFunction hash;
     std::uint32_t slot_bits;
     KeyAppender out;
     std::uint32_t* big; ///< [located tets]
     LocateCounters* counters;
-    KDET_HD void operator()(std::uint64_t i) const {
-        const Aabb box = boxes[i];
-        const int layer = layer_of(params, box_extent(box));
-        const CellRange r = cell_range(params, box, layer);
+
+    struct Tet {
+        std::uint64_t keys[8];
+        std::uint32_t count;
+        std::uint32_t id;
+        int layer;
+    };
+    KDET_HD const GridParams& params() const { return grid; }
+    KDET_HD bool place(std::uint64_t i, Aabb& box, int& layer) const {
+        box = boxes[i];
+        layer = layer_of(grid, box_extent(box));
+        return true;
+    }
+    KDET_HD bool open(std::uint64_t i, const CellRange& r, int layer, Tet& tet) const {
         if (r.hi[0] - r.lo[0] > 1u || r.hi[1] - r.lo[1] > 1u || r.hi[2] - r.lo[2] > 1u) {
             big[atomic_fetch_add(&counters->big_count, 1u)] = static_cast<std::uint32_t>(i);
-            return;
+            return false;
         }
         const std::uint32_t bit = 1u << layer;
         if (!(atomic_load_acquire(&counters->layer_mask) & bit)) atomic_fetch_or(&counters->layer_mask, bit);
-        std::uint64_t keys[8];
-        std::uint32_t n = 0;
-        for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-            keys[n++] = static_cast<std::uint64_t>(locate_slot(hash, x, y, z, layer, slot_bits)) << 32 | i;
-            return true;
-        });
-        out.write(keys, n);
+        tet.count = 0;
+        tet.id = static_cast<std::uint32_t>(i);
+        tet.layer = layer;
+        return true;
     }
+    KDET_HD bool add(Tet& tet, std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
+        tet.keys[tet.count++] = static_cast<std::uint64_t>(locate_slot(hash, x, y, z, tet.layer, slot_bits)) << 32 | tet.id;
+        return true;
+    }
+    KDET_HD void close(Tet& tet) const { out.write(tet.keys, tet.count); }
 };
 
 /// @brief After the keys are sorted: the run of keys of each slot, [begin, end) (both 0 for a slot
