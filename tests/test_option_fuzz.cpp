@@ -4,6 +4,8 @@
 // the flag (control characters in it escaped); never a crash, an exception of another kind, or a
 // value out of range.
 
+#include "random_text.hpp"
+
 #include <kdet/error.hpp>
 #include <kdet/option_table.hpp>
 
@@ -15,31 +17,13 @@
 namespace kdet {
 namespace {
 
-/// A string drawn from pieces that parsers trip over, or from any bytes.
-std::string random_text(std::mt19937& rng) {
-    static const char* const pieces[] = {"0", "1", "9", "-", "+", " ", "\t", "\n", ".", "e", "x", "0x", "1e3",
-                                         "9223372036854775807", "9223372036854775808", "-9223372036854775808",
-                                         "18446744073709551616", "1024", "4096", "true", "FALSE", "Yes", "sat-MTV",
-                                         "fnv_1a", "gpu", "cuda", "nan", "inf", "_", "\xff", "\0"};
-    std::uniform_int_distribution<int> length(0, 6), kind(0, 3), byte(0, 255);
-    std::uniform_int_distribution<std::size_t> piece(0, std::size(pieces) - 1);
-    std::string text;
-    for (int n = length(rng); n > 0; --n) {
-        if (kind(rng) == 0)
-            text += static_cast<char>(byte(rng));
-        else
-            text += std::string(pieces[piece(rng)]);
-    }
-    return text;
-}
-
 TEST(OptionFuzz, EveryOptionReadsRandomTextIntoItsRangeOrRefusesItInOneLine) {
     std::mt19937 rng(48);
     for (const OptionInfo& option : option_table()) {
         const std::string shown = option.flag[0] ? option.flag : option.name;
         std::size_t accepted = 0;
         for (int draw = 0; draw < 4000; ++draw) {
-            const std::string text = random_text(rng);
+            const std::string text = test::random_text(rng);
             DetectorOptions options;
             try {
                 option.parse(text, options, shown);

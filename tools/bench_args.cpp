@@ -90,7 +90,9 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     parser.flag("--help", config.help);
     parser.flag("--quiet", config.quiet);
     parser.flag("--mpi", config.mpi);
-    parser.option("--partition", "slabs|random", [&](const std::string& v) { config.partition = v; });
+    parser.option("--partition", "slabs|random", [&](const std::string& v) {
+        config.partition = parse_choice("--partition", v, {"slabs", "random"});
+    });
     parser.option("-r", "resolution", [&](const std::string& v) {
         config.request.resolution = static_cast<int>(parse_integer("-r", v, 1, 4));
     });
@@ -121,8 +123,8 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
             config.first_frame = static_cast<int>(parse_integer("--frames", v.substr(0, colon), 0, 1000000));
             config.last_frame = static_cast<int>(parse_integer("--frames", v.substr(colon + 1), config.first_frame, 1000000));
         } catch (const Error&) {
-            throw UsageError("invalid value '" + v + "' for --frames: expected A:B with 0 <= A <= B (0-based frames), " +
-                             "or N (length of the procedural scene)");
+            throw UsageError(invalid_value_message("--frames", v,
+                                                   "A:B with 0 <= A <= B (0-based frames), or N (length of the procedural scene)"));
         }
     });
     parser.option("--scene-frames", "N", [&](const std::string& v) { scene_length("--scene-frames", v); });

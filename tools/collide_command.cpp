@@ -98,7 +98,9 @@ int run_collide(int argc, char** argv) {
     parser.option("--contacts", "FILE", [&](const std::string& v) { contacts_path = v; });
     parser.flag("--check-exact", check);
     parser.flag("--mpi", mpi);
-    parser.option("--partition", "slabs|random", [&](const std::string& v) { partition = v; });
+    parser.option("--partition", "slabs|random", [&](const std::string& v) {
+        partition = parse_choice("--partition", v, {"slabs", "random"});
+    });
     parser.option("--exclusion-rings", "K", [&](const std::string& v) {
         rings = static_cast<int>(parse_integer("--exclusion-rings", v, 0, max_exclusion_rings));
     });

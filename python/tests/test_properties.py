@@ -224,3 +224,107 @@ def test_frame_sequences_give_what_a_fresh_detector_gives(meshes, steps, chosen)
             r = detector.detect()
             answer = ({tuple(map(int, p)) for p in r.pairs}, [np.asarray(c).copy() for c in r.colliding])
             assert_same(chosen["method"], answer, detect(current, self_collision=sorted(selves), pairs_off=sorted(off)))
+
+
+# What has landed since the sequences above: collision filters, self-exclusion rings, rest contacts,
+# static objects, removal and new tets, and a memory limit. Masks and groups are drawn from 2 bits, so
+# that filters both pass and block pairs.
+filtered_steps = st.lists(
+    st.one_of(
+        st.tuples(st.just("move"), st.integers(0, 2), st.floats(-1.5, 1.5), st.sampled_from([2.0**-80, 1.0, 2.0**80])),
+        st.tuples(st.just("self"), st.integers(0, 2), st.booleans()),
+        st.tuples(st.just("pair"), st.integers(0, 2), st.integers(0, 2), st.booleans()),
+        st.tuples(st.just("filter"), st.integers(0, 2), st.integers(0, 3), st.integers(0, 3)),
+        st.tuples(st.just("rings"), st.integers(0, 2), st.integers(0, 2)),
+        st.tuples(st.just("rest"), st.integers(0, 2), st.one_of(st.none(), st.integers(0, 2))),
+        st.tuples(st.just("static"), st.integers(0, 2), st.booleans()),
+        st.tuples(st.just("remove"), st.integers(0, 2)),
+        st.tuples(st.just("tets"), st.integers(0, 2), soups(max_tets=6)),
+        st.tuples(st.just("detect")),
+    ),
+    min_size=1,
+    max_size=14,
+)
+
+
+def replay(meshes, log, **options):
+    """A fresh detector given the same objects and the same calls, in the same order."""
+    detector = kdet.Detector(**options)
+    for mesh in meshes:
+        detector.add_object(mesh)
+    for name, args in log:
+        getattr(detector, name)(*args)
+    return detector
+
+
+def answer_of(detector):
+    r = detector.detect()
+    return {tuple(map(int, p)) for p in r.pairs}, [np.asarray(c).copy() for c in r.colliding]
+
+
+@PROPERTY
+@given(meshes=st.lists(soups(max_tets=6), min_size=3, max_size=3), steps=filtered_steps, chosen=options,
+       memory_limit=st.sampled_from([0, 0, 3000, 100000]))
+def test_filtered_sequences_give_what_brute_force_gives_the_same_calls(meshes, steps, chosen, memory_limit):
+    """Filters, rings, rest contacts, static objects, removals and new tets switched in any order on one
+    detector, also under a memory limit: every frame equals a fresh brute-force detector given the same
+    calls (rest contacts are recorded where the positions were when they were asked for, so the calls
+    are replayed in order), or, where the limit cannot hold the frame, it fails naming memory_limit and
+    the detector goes on as it was."""
+    detector = kdet.Detector(test="exact", memory_limit=memory_limit, **chosen)
+    ids = [detector.add_object(m) for m in meshes]
+    live = set(ids)
+    current = [m.vertices.astype(np.float32) for m in meshes]  # each object's positions as set last
+    log = []
+    for step in steps + [("detect",)]:
+        kind, args = step[0], step[1:]
+        if kind != "detect" and args[0] not in live:
+            continue
+        if kind == "move":
+            k, shift, scale = args
+            moved = (current[k].astype(np.float64) + shift) * scale
+            if not np.all(np.abs(moved) <= np.finfo(np.float32).max):
+                continue  # beyond float: refused, as test_inputs.py checks
+            current[k] = moved.astype(np.float32)
+            call = ("set_positions", (k, current[k]))
+        elif kind == "self":
+            call = ("set_self_collision", args)
+        elif kind == "pair":
+            if args[0] == args[1] or args[1] not in live:
+                continue
+            call = ("set_pair_collision", args)
+        elif kind == "filter":
+            call = ("set_collision_filter", args)
+        elif kind == "rings":
+            call = ("set_self_exclusion_rings", args)
+        elif kind == "rest":
+            k, other = args
+            if other is not None and (other == k or other not in live):
+                continue
+            call = ("exclude_rest_contacts", (k,) if other is None else (k, other))
+        elif kind == "static":
+            call = ("set_static", args)
+        elif kind == "remove":
+            if len(live) == 1:
+                continue
+            live.discard(args[0])
+            call = ("remove_object", args)
+        elif kind == "tets":
+            k, mesh = args
+            current[k] = mesh.vertices.astype(np.float32)
+            call = ("set_tets", (k, mesh))
+        else:
+            try:
+                answer = answer_of(detector)
+            except kdet.Error as error:
+                assert memory_limit and "memory_limit" in str(error), str(error)
+                continue
+            reference = answer_of(replay(meshes, log, method="brute_force_pairs", test="exact"))
+            assert_same(chosen["method"], answer, reference)
+            continue
+        try:
+            getattr(detector, call[0])(*call[1])
+        except kdet.Error as error:  # only recording rest contacts detects, and may meet the limit
+            assert call[0] == "exclude_rest_contacts" and memory_limit and "memory_limit" in str(error), str(error)
+            continue
+        log.append(call)

@@ -1,11 +1,13 @@
 // Writes the seed corpus of the fuzzers: small valid files of every format and variant, made by the
-// writers (tetrahedral formats) or built in code (surfaces). Usage: kdet_fuzz_seeds OUTPUT_DIR; it
+// writers (tetrahedral formats) or built in code (surfaces, points), and the scene files (the built-in
+// scenes' and one with every statement). Usage: kdet_fuzz_seeds OUTPUT_DIR; it
 // creates OUTPUT_DIR/<format>/ with a few files each.
 
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 
 #include "sample_files.hpp"
+#include "scene_checks.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -34,7 +36,7 @@ void write_bytes(const fs::path& file, const std::string& content) { std::ofstre
 
 void write_seeds(const fs::path& root) {
     const kdet::TetMesh mesh = seed_mesh();
-    for (const char* format : {"msh", "vtk", "mesh", "node", "obj", "off", "stl", "ply", "xyz"}) {
+    for (const char* format : {"msh", "vtk", "mesh", "node", "obj", "off", "stl", "ply", "xyz", "scene"}) {
         fs::remove_all(root / format);
         fs::create_directories(root / format);
     }
@@ -65,6 +67,8 @@ void write_seeds(const fs::path& root) {
     write_bytes(root / "ply" / "big", square_ply_header("binary_big_endian") + square_ply_binary_body(true));
     // Query points of `kdet locate`: x y z lines, a comment, blank lines, exponents.
     write_bytes(root / "xyz" / "points", "# x y z\n0 0 0\n\n1.5 -2e-3 4E+2\n0.25 0.5 0.75 # last\n");
+    for (const auto& [name, text] : kdet::scenes::builtin_scene_files()) write_bytes(root / "scene" / name, text);
+    write_bytes(root / "scene" / "every_statement", every_statement_scene);
 }
 
 } // namespace
