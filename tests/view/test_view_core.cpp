@@ -737,6 +737,7 @@ TEST(ViewPoints, PointsFlags) {
     EXPECT_EQ(config.points, "p.txt");
     EXPECT_EQ(config.within, 0.25);
     for (const std::vector<std::string>& bad : {std::vector<std::string>{"--within", "0.5"},
+                                                std::vector<std::string>{"--within", "0"},
                                                 std::vector<std::string>{"--points", "p.txt", "--within", "-1"},
                                                 std::vector<std::string>{"--points", "p.txt", "--within", "x"}}) {
         std::vector<std::string> line = {"kdet", "view", "box.mesh"};

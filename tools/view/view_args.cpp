@@ -150,6 +150,7 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     ViewConfig config;
     std::vector<std::string> positionals;
     std::string procedural_flag;
+    bool within_given = false;
     cli::CommandLine parser("view");
     parser.positionals(2, positionals);
     parser.flag("--help", config.help);
@@ -183,6 +184,7 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     parser.option("--within", "D", [&](const std::string& v) {
         char* end = nullptr;
         config.within = std::strtod(v.c_str(), &end);
+        within_given = true;
         if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(config.within) || config.within < 0)
             throw cli::UsageError(invalid_value_message("--within", v, "a finite distance >= 0"));
     });
@@ -225,7 +227,7 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
         throw cli::UsageError("view: " + procedural_flag + " applies to the procedural scene only");
     if (!config.screenshot.empty() && config.profile)
         throw cli::UsageError("view: --screenshot and --profile are two different runs; give one");
-    if (config.within > 0 && config.points.empty()) throw cli::UsageError("view: --within applies to --points only");
+    if (within_given && config.points.empty()) throw cli::UsageError("view: --within applies to --points only");
     if (config.panel && config.screenshot.empty()) throw cli::UsageError("view: --panel applies to --screenshot only");
     return config;
 }
