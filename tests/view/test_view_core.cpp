@@ -690,3 +690,63 @@ TEST(ViewBenchmark, ReportsAnErrorInOneLine) {
 
 } // namespace
 } // namespace kdet::view
+
+namespace kdet::view {
+namespace {
+
+// ---- query points ----
+
+TEST(ViewPoints, TheSessionLocatesAsKdetLocate) {
+    const test::BoxAndPoints b = test::box_and_points();
+    ViewSession session(b.source, DetectorOptions{}, false);
+    session.set_points(b.points, 0.5);
+    session.update();
+    const LocateResult expected = locate(b.box, b.points, LocateOptions{0.5, true});
+    const LocateResult& got = session.located();
+    EXPECT_EQ(got.offsets, expected.offsets);
+    EXPECT_EQ(got.tets, expected.tets);
+    EXPECT_EQ(got.distances, expected.distances);
+    const PointCounts counts = count_points(got), want = count_points(expected);
+    EXPECT_EQ(counts.held, want.held);
+    EXPECT_EQ(counts.near, want.near);
+    EXPECT_EQ(counts.missed, want.missed);
+    EXPECT_GT(counts.held, b.box.num_vertices()); // every vertex, and random points inside
+    EXPECT_GT(counts.near, 0u);
+    EXPECT_GT(counts.missed, 0u);
+    EXPECT_EQ(counts.held + counts.near + counts.missed, b.points.size() / 3);
+
+    // Without a distance the near points have no tet; without points nothing is located.
+    const std::uint64_t version = session.result_version();
+    session.set_points(b.points, 0.0);
+    EXPECT_TRUE(session.update());
+    EXPECT_GT(session.result_version(), version);
+    const PointCounts exact = count_points(session.located());
+    EXPECT_EQ(exact.held, counts.held);
+    EXPECT_EQ(exact.near, 0u);
+    EXPECT_EQ(exact.missed, counts.near + counts.missed);
+    session.set_points({}, 0.0);
+    session.update();
+    EXPECT_EQ(session.located().point_count, 0u);
+}
+
+TEST(ViewPoints, PointsFlags) {
+    std::vector<std::string> args = {"kdet", "view", "box.mesh", "--points", "p.txt", "--within", "0.25"};
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    const ViewConfig config = parse_view_args(static_cast<int>(argv.size()), argv.data(), 2);
+    EXPECT_EQ(config.points, "p.txt");
+    EXPECT_EQ(config.within, 0.25);
+    for (const std::vector<std::string>& bad : {std::vector<std::string>{"--within", "0.5"},
+                                                std::vector<std::string>{"--within", "0"},
+                                                std::vector<std::string>{"--points", "p.txt", "--within", "-1"},
+                                                std::vector<std::string>{"--points", "p.txt", "--within", "x"}}) {
+        std::vector<std::string> line = {"kdet", "view", "box.mesh"};
+        line.insert(line.end(), bad.begin(), bad.end());
+        std::vector<char*> v;
+        for (std::string& a : line) v.push_back(a.data());
+        EXPECT_THROW(parse_view_args(static_cast<int>(v.size()), v.data(), 2), cli::UsageError) << bad.front();
+    }
+}
+
+} // namespace
+} // namespace kdet::view

@@ -525,5 +525,94 @@ TEST(ViewRenderer, FiftySwitchesKeepBuffersAndMemoryBounded) {
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
+// ---- query points ----
+
+/// @brief Pixels of @p rgb within a few levels of @p color, which is drawn unlit.
+std::size_t count_color(const std::vector<std::uint8_t>& rgb, Color color) {
+    const float want[3] = {color.r * 255.0f, color.g * 255.0f, color.b * 255.0f};
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < rgb.size(); i += 3) {
+        bool close = true;
+        for (std::size_t k = 0; k < 3; ++k) close = close && std::abs(static_cast<float>(rgb[i + k]) - want[k]) < 4.0f;
+        n += close;
+    }
+    return n;
+}
+
+/// @brief Pixels of the tets that hold points: green well above red and blue.
+std::size_t count_located(const std::vector<std::uint8_t>& rgb) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < rgb.size(); i += 3) n += rgb[i + 1] > rgb[i] + 40 && rgb[i + 1] > rgb[i + 2] + 60;
+    return n;
+}
+
+TEST(ViewRenderer, QueryPointsAndTheirTetsAreDrawn) {
+    REQUIRE_GL();
+    const test::BoxAndPoints b = test::box_and_points();
+    ViewSession session(b.source, DetectorOptions{}, false);
+    session.update();
+    Renderer renderer;
+    renderer.update(session);
+    OffscreenTarget target(240, 180, 1);
+    const auto picture = [&] {
+        target.bind();
+        renderer.draw(camera_for(session.positions(), 240, 180), 0, 0, 240, 180, DisplaySettings{}, Bounds{});
+        return target.read_rgb();
+    };
+    const std::vector<std::uint8_t> before = picture();
+    session.set_points(b.points, 0.5);
+    session.update();
+    renderer.update(session);
+    const PointCounts counts = count_points(session.located());
+    EXPECT_EQ(renderer.point_counts()[0], counts.held);
+    EXPECT_EQ(renderer.point_counts()[1], counts.near);
+    EXPECT_EQ(renderer.point_counts()[2], counts.missed);
+    const std::vector<std::uint8_t> after = picture();
+    for (int status = 0; status < 3; ++status) {
+        EXPECT_EQ(count_color(before, point_color(status)), 0u) << status;
+        EXPECT_GT(count_color(after, point_color(status)), 100u) << status;
+    }
+    EXPECT_EQ(count_located(before), 0u);
+    EXPECT_GT(count_located(after), 1000u) << "the tets that hold points";
+    session.set_points({}, 0.0);
+    session.update();
+    renderer.update(session);
+    EXPECT_EQ(picture(), before);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+TEST(ViewCommand, PointsInAScreenshotAndBadPointsFiles) {
+    REQUIRE_GL();
+    const test::BoxAndPoints b = test::box_and_points();
+    const auto dir = test::temp_dir("points_command");
+    const std::string points = (dir / "points.txt").string(), bad = (dir / "bad.txt").string();
+    {
+        std::FILE* file = std::fopen(points.c_str(), "w");
+        for (std::size_t i = 0; i < b.points.size(); i += 3)
+            std::fprintf(file, "%.17g %.17g %.17g\n", b.points[i], b.points[i + 1], b.points[i + 2]);
+        std::fclose(file);
+        file = std::fopen(bad.c_str(), "w");
+        std::fprintf(file, "1 2 3\n1 2\n");
+        std::fclose(file);
+    }
+    const PointCounts want = count_points(locate(b.box, b.points, LocateOptions{0.5, true}));
+    const std::string png = (picture_dir() / "points.png").string();
+    const std::string view = std::string(KDET_CLI_PATH) + " view " + b.source.meshes[0];
+    const Outcome shot = run_command(view + " --points " + points + " --within 0.5 --size 320x240 --screenshot " + png);
+    ASSERT_EQ(shot.exit_code, 0) << shot.out;
+    EXPECT_NE(shot.out.find("points: " + std::to_string(want.held) + " in a tet, " + std::to_string(want.near) +
+                            " near one, " + std::to_string(want.missed) + " without"),
+              std::string::npos)
+        << shot.out;
+    const Picture picture = test::read_png(png);
+    EXPECT_GT(count_color(picture.rgb, point_color(2)), 0u) << "points without a tet";
+    EXPECT_GT(count_located(picture.rgb), 0u);
+
+    const Outcome malformed = run_command(view + " --points " + bad + " --screenshot " + png);
+    EXPECT_EQ(malformed.exit_code, 2) << malformed.out;
+    EXPECT_NE(malformed.out.find("bad.txt:2"), std::string::npos) << malformed.out;
+    EXPECT_EQ(std::count(malformed.out.begin(), malformed.out.end(), '\n'), 1) << malformed.out;
+}
+
 } // namespace
 } // namespace kdet::view

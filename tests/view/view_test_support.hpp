@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <random>
 #include <string>
 
 namespace kdet::view::test {
@@ -54,6 +55,26 @@ inline ViewSource nested_boxes() {
     ViewSource source;
     source.meshes = {(dir / "big").string(), (dir / "small").string()};
     return source;
+}
+
+/// @brief A 4x4x4 box of unit cubes as a mesh file, and points in and around it: its vertices (each
+/// held by several tets) and random points in the box grown by one unit on every side.
+struct BoxAndPoints {
+    TetMesh box;
+    ViewSource source;
+    std::vector<double> points;
+};
+
+inline BoxAndPoints box_and_points() {
+    BoxAndPoints b{make_box_mesh(4, 4, 4, 1.0), {}, {}};
+    const auto dir = temp_dir("points");
+    write_tetgen(b.box, (dir / "box").string());
+    b.source.meshes = {(dir / "box").string()};
+    b.points = b.box.positions;
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> coordinate(-1.0, 5.0);
+    for (int i = 0; i < 1500; ++i) b.points.push_back(coordinate(random));
+    return b;
 }
 
 } // namespace kdet::view::test

@@ -297,6 +297,12 @@ void Viewer::panel_results() {
         row("colliding tets", c.colliding_tets);
         row("buffer regrows", c.buffer_regrows);
         row("host waits", c.host_waits);
+        if (!session_.points().empty()) {
+            const PointCounts points = count_points(session_.located());
+            row("points in a tet (white)", points.held);
+            row("points near one (orange)", points.near);
+            row("points without (magenta)", points.missed);
+        }
         row_ms("boxes", t.bounding_boxes);
         row_ms("populate grid", t.populate_grid);
         row_ms("candidates", t.find_candidates);

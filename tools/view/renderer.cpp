@@ -124,17 +124,26 @@ Color object_color(std::size_t object) {
 
 Color highlight_color() { return {0.96f, 0.20f, 0.12f}; }
 
+Color point_color(int status) {
+    // None of them red or of the objects' cool colours.
+    static constexpr Color colors[] = {{1.0f, 1.0f, 1.0f}, {1.0f, 0.62f, 0.05f}, {0.95f, 0.15f, 0.95f}};
+    return colors[status];
+}
+
+Color located_color() { return {0.45f, 0.90f, 0.15f}; }
+
 Renderer::Renderer() {
     mesh_program_ = link(mesh_vertex_shader, mesh_fragment_shader);
     background_program_ = link(background_vertex_shader, background_fragment_shader);
     glGenVertexArrays(1, &empty_array_);
     glGenVertexArrays(1, &contacts_.array);
     glGenVertexArrays(1, &selection_.array);
+    glGenVertexArrays(1, &points_.array);
 }
 
 Renderer::~Renderer() {
     release_scene();
-    for (Stream* stream : {&contacts_, &selection_}) {
+    for (Stream* stream : {&contacts_, &selection_, &points_}) {
         release_buffer(stream->buffer, stream->capacity * sizeof(float));
         glDeleteVertexArrays(1, &stream->array);
     }
@@ -166,9 +175,11 @@ void Renderer::release_scene() {
     for (ObjectBuffers& o : objects_) {
         release_buffer(o.positions, o.vertex_bytes);
         release_buffer(o.surface_indices, o.surface_capacity * sizeof(std::uint32_t));
-        release_buffer(o.highlight_indices, o.highlight_capacity * sizeof(std::uint32_t));
         glDeleteVertexArrays(1, &o.surface_array);
-        glDeleteVertexArrays(1, &o.highlight_array);
+        for (Region* region : {&o.highlight, &o.located}) {
+            release_buffer(region->indices, region->capacity * sizeof(std::uint32_t));
+            glDeleteVertexArrays(1, &region->array);
+        }
     }
     objects_.clear();
 }
@@ -190,11 +201,13 @@ void Renderer::load_scene(const ViewSession& session) {
         glEnableVertexAttribArray(0);
         b.surface_indices = make_buffer(GL_ELEMENT_ARRAY_BUFFER, surface.size() * sizeof(std::uint32_t),
                                         surface.data(), GL_STATIC_DRAW);
-        glGenVertexArrays(1, &b.highlight_array);
-        glBindVertexArray(b.highlight_array);
-        glBindBuffer(GL_ARRAY_BUFFER, b.positions);
-        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
-        glEnableVertexAttribArray(0);
+        for (Region* region : {&b.highlight, &b.located}) {
+            glGenVertexArrays(1, &region->array);
+            glBindVertexArray(region->array);
+            glBindBuffer(GL_ARRAY_BUFFER, b.positions);
+            glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+            glEnableVertexAttribArray(0);
+        }
         objects_.push_back(b);
         for (std::size_t i = 0; i < mesh.positions.size(); i += 3)
             box.add(Vec3{static_cast<float>(mesh.positions[i]), static_cast<float>(mesh.positions[i + 1]),
@@ -205,7 +218,8 @@ void Renderer::load_scene(const ViewSession& session) {
     scene_version_ = session.scene_version();
     topology_version_ = session.topology_version();
     positions_version_ = result_version_ = 0;
-    contacts_.vertices = selection_.vertices = 0;
+    contacts_.vertices = selection_.vertices = points_.vertices = 0;
+    point_counts_ = {};
 }
 
 void Renderer::update(const ViewSession& session) {
@@ -223,6 +237,7 @@ void Renderer::update(const ViewSession& session) {
     if (session.has_result() && session.result_version() != result_version_) {
         upload_highlights(session);
         upload_contacts(session);
+        upload_points(session);
         result_version_ = session.result_version();
     }
 }
@@ -251,28 +266,52 @@ void Renderer::upload_surfaces(const ViewSession& session) {
 
 void Renderer::upload_highlights(const ViewSession& session) {
     const FrameResult& result = session.result();
-    for (std::size_t o = 0; o < objects_.size(); ++o) {
-        ObjectBuffers& b = objects_[o];
-        scratch_indices_.clear();
-        // Faces between two colliding tets are hidden inside the region: only its surface is drawn.
-        if (o < result.colliding.size())
-            append_flagged_region(session.mesh(o), session.faces()[o], result.colliding[o], scratch_indices_);
-        b.highlight_count = scratch_indices_.size();
-        if (b.highlight_count == 0) continue;
-        if (b.highlight_count > b.highlight_capacity) {
-            // Grown geometrically, so that an animation allocates a few times at most.
-            release_buffer(b.highlight_indices, b.highlight_capacity * sizeof(std::uint32_t));
-            b.highlight_capacity = std::max(b.highlight_count, 2 * b.highlight_capacity);
-            glBindVertexArray(b.highlight_array);
-            b.highlight_indices = make_buffer(GL_ELEMENT_ARRAY_BUFFER, b.highlight_capacity * sizeof(std::uint32_t),
-                                              nullptr, GL_DYNAMIC_DRAW);
-            glBindVertexArray(0);
-        }
-        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b.highlight_indices);
-        glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(b.highlight_count * sizeof(std::uint32_t)),
-                        scratch_indices_.data());
+    for (std::size_t o = 0; o < objects_.size(); ++o)
+        upload_region(session, o, objects_[o].highlight, o < result.colliding.size() ? result.colliding[o] : std::vector<std::uint8_t>{});
+}
+
+void Renderer::upload_region(const ViewSession& session, std::size_t object, Region& region,
+                             const std::vector<std::uint8_t>& flags) {
+    scratch_indices_.clear();
+    // Faces between two flagged tets are hidden inside the region: only its surface is drawn.
+    if (!flags.empty()) append_flagged_region(session.mesh(object), session.faces()[object], flags, scratch_indices_);
+    region.count = scratch_indices_.size();
+    if (region.count == 0) return;
+    if (region.count > region.capacity) {
+        // Grown geometrically, so that an animation allocates a few times at most.
+        release_buffer(region.indices, region.capacity * sizeof(std::uint32_t));
+        region.capacity = std::max(region.count, 2 * region.capacity);
+        glBindVertexArray(region.array);
+        region.indices = make_buffer(GL_ELEMENT_ARRAY_BUFFER, region.capacity * sizeof(std::uint32_t), nullptr, GL_DYNAMIC_DRAW);
+        glBindVertexArray(0);
     }
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, region.indices);
+    glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(region.count * sizeof(std::uint32_t)),
+                    scratch_indices_.data());
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
+}
+
+void Renderer::upload_points(const ViewSession& session) {
+    const LocateResult& located = session.located();
+    std::vector<std::vector<std::uint8_t>> holding(objects_.size());
+    for (std::size_t o = 0; o < objects_.size(); ++o)
+        if (located.point_count > 0) holding[o].assign(session.mesh(o).num_tets(), 0);
+    for (std::size_t h = 0; h < located.hit_count; ++h)
+        if (located.distances[h] == 0) holding[located.objects[h]][located.tets[h]] = 1;
+    for (std::size_t o = 0; o < objects_.size(); ++o) upload_region(session, o, objects_[o].located, holding[o]);
+    // Grouped by status, so that each group is one draw call in its colour; the held points last,
+    // over the others.
+    scratch_vertices_.clear();
+    const std::vector<double>& xyz = session.points();
+    for (int status = 2; status >= 0; --status) {
+        const std::size_t before = scratch_vertices_.size();
+        for (std::size_t p = 0; p < located.point_count; ++p)
+            if (point_status(located, p) == status)
+                scratch_vertices_.insert(scratch_vertices_.end(), {static_cast<float>(xyz[3 * p]), static_cast<float>(xyz[3 * p + 1]),
+                                                                   static_cast<float>(xyz[3 * p + 2]), 0, 0, 0});
+        point_counts_[static_cast<std::size_t>(status)] = (scratch_vertices_.size() - before) / 6;
+    }
+    upload_stream(points_, scratch_vertices_);
 }
 
 void Renderer::upload_contacts(const ViewSession& session) {
@@ -335,16 +374,16 @@ void Renderer::select(const ViewSession& session, const std::vector<TetRef>& tet
     upload_stream(selection_, scratch_vertices_);
 }
 
-void Renderer::draw_objects(bool surfaces, bool highlights) const {
+void Renderer::draw_objects(bool surfaces, Region ObjectBuffers::*region) const {
     for (std::size_t o = 0; o < objects_.size(); ++o) {
         const ObjectBuffers& b = objects_[o];
         if (surfaces && b.surface_count) {
             glBindVertexArray(b.surface_array);
             glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(b.surface_count), GL_UNSIGNED_INT, nullptr);
         }
-        if (highlights && b.highlight_count) {
-            glBindVertexArray(b.highlight_array);
-            glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(b.highlight_count), GL_UNSIGNED_INT, nullptr);
+        if (region && (b.*region).count) {
+            glBindVertexArray((b.*region).array);
+            glDrawElements(GL_TRIANGLES, static_cast<GLsizei>((b.*region).count), GL_UNSIGNED_INT, nullptr);
         }
     }
     glBindVertexArray(0);
@@ -420,7 +459,9 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(display.wireframe ? 0.0f : -1.0f, display.wireframe ? 0.0f : -2.0f);
     set_color(mesh_program_, highlight_color(), 1.0f);
-    draw_objects(false, true);
+    draw_objects(false, &ObjectBuffers::highlight);
+    set_color(mesh_program_, located_color(), 1.0f);
+    draw_objects(false, &ObjectBuffers::located);
     glDisable(GL_POLYGON_OFFSET_FILL);
 
     if (display.wireframe) {
@@ -434,11 +475,11 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
                 glCullFace(GL_BACK);
             }
             set_color(mesh_program_, Color{0.05f, 0.06f, 0.08f}, 0.55f);
-            draw_objects(true, false);
+            draw_objects(true, nullptr);
             glDisable(GL_CULL_FACE);
         }
         set_color(mesh_program_, scaled(highlight_color(), 0.4f), 1.0f);
-        draw_objects(false, true);
+        draw_objects(false, &ObjectBuffers::highlight);
         glDisable(GL_BLEND);
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
         glUniform1i(lit, 1);
@@ -467,6 +508,22 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
         glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(contacts_.vertices));
         glBindVertexArray(0);
         glEnable(GL_DEPTH_TEST);
+    }
+
+    if (points_.vertices > 0) {
+        // Query points over everything, where they lie inside the meshes too.
+        glDisable(GL_DEPTH_TEST);
+        glUniform1i(lit, 0);
+        glPointSize(5.0f);
+        glBindVertexArray(points_.array);
+        std::size_t first = 0;
+        for (int status = 2; status >= 0; --status) {
+            const std::size_t n = point_counts_[static_cast<std::size_t>(status)];
+            set_color(mesh_program_, point_color(status), 1.0f);
+            if (n) glDrawArrays(GL_POINTS, static_cast<GLint>(first), static_cast<GLsizei>(n));
+            first += n;
+        }
+        glBindVertexArray(0);
     }
 
     glDisable(GL_CLIP_DISTANCE0);

@@ -8,6 +8,7 @@
 #include "session.hpp"
 #include "view_args.hpp"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -23,6 +24,11 @@ struct Color {
 Color object_color(std::size_t object);
 /// @brief The colour of colliding tets: the only red in the picture.
 Color highlight_color();
+
+/// @brief Query points: held by a tet, given the nearest tet within the distance, or without a tet.
+Color point_color(int status);
+/// @brief The tets that hold query points.
+Color located_color();
 
 /// @brief At most this many contact normals are drawn (an even sample of the colliding pairs).
 constexpr std::size_t max_contact_lines = 1500;
@@ -63,16 +69,24 @@ public:
     std::size_t surface_triangles(std::size_t object) const { return objects_.at(object).surface_count / 3; }
     /// @brief Contact normals the last update() prepared (0 without contacts).
     std::size_t contact_lines() const { return contacts_.vertices / 2; }
+    /// @brief Query points the last update() prepared, per status of point_status().
+    const std::array<std::size_t, 3>& point_counts() const { return point_counts_; }
 
 private:
+    /// @brief The surface of a region of flagged tets: indices into the object's vertex buffer.
+    struct Region {
+        unsigned array = 0, indices = 0;
+        std::size_t count = 0; ///< indices drawn
+        std::size_t capacity = 0;
+    };
+
     struct ObjectBuffers {
         unsigned positions = 0;       ///< vertex buffer, x y z float per vertex
         unsigned surface_array = 0, surface_indices = 0;
-        unsigned highlight_array = 0, highlight_indices = 0;
         std::size_t surface_count = 0;   ///< indices drawn
         std::size_t surface_capacity = 0;
-        std::size_t highlight_count = 0; ///< indices drawn
-        std::size_t highlight_capacity = 0;
+        Region highlight; ///< the colliding tets
+        Region located;   ///< the tets that hold query points
         std::size_t vertex_bytes = 0;
     };
 
@@ -92,11 +106,15 @@ private:
     /// @brief Refills the surface index buffers after the session's tets changed.
     void upload_surfaces(const ViewSession& session);
     void upload_highlights(const ViewSession& session);
+    /// @brief Refills @p region from @p flags (one per tet; empty flags clear it).
+    void upload_region(const ViewSession& session, std::size_t object, Region& region, const std::vector<std::uint8_t>& flags);
+    void upload_points(const ViewSession& session);
     void upload_contacts(const ViewSession& session);
-    void draw_objects(bool surfaces, bool highlights) const;
+    void draw_objects(bool surfaces, Region ObjectBuffers::*region) const;
 
     unsigned mesh_program_ = 0, background_program_ = 0, empty_array_ = 0;
-    Stream contacts_, selection_;
+    Stream contacts_, selection_, points_;
+    std::array<std::size_t, 3> point_counts_{}; ///< points_ holds the missed, then the near, then the held
     std::vector<ObjectBuffers> objects_;
     std::uint64_t scene_version_ = 0, positions_version_ = 0, result_version_ = 0, topology_version_ = 0;
     float scene_radius_ = 1.0f;

@@ -65,6 +65,23 @@ double process_cpu_ms() {
     return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
+int point_status(const LocateResult& located, std::size_t p) {
+    const std::uint64_t first = located.offsets[p];
+    if (first == located.offsets[p + 1]) return 2;
+    return located.distances[first] > 0 ? 1 : 0;
+}
+
+PointCounts count_points(const LocateResult& located) {
+    PointCounts counts;
+    for (std::size_t p = 0; p < located.point_count; ++p) {
+        const int status = point_status(located, p);
+        counts.held += status == 0;
+        counts.near += status == 1;
+        counts.missed += status == 2;
+    }
+    return counts;
+}
+
 ViewSession::ViewSession(const ViewSource& source, const DetectorOptions& options, bool self)
     : options_(options), self_(self) {
     open(source);
@@ -127,6 +144,12 @@ CollisionFilter ViewSession::collision_filter(std::size_t object) const {
     return detector_ ? detector_->collision_filter(static_cast<ObjectId>(object)) : CollisionFilter{};
 }
 
+void ViewSession::set_points(std::vector<double> xyz, double within) {
+    points_ = std::move(xyz);
+    locate_options_.within = within;
+    points_stale_ = true;
+}
+
 void ViewSession::set_frame(int frame) { frame_ = std::clamp(frame, 0, scene_->num_frames() - 1); }
 
 void ViewSession::build_detector() {
@@ -182,6 +205,18 @@ bool ViewSession::update() {
         detect_ms_ = milliseconds_since(start);
         has_result_ = true;
         results_stale_ = false;
+        points_stale_ = !points_.empty();
+        ++result_version_;
+        changed = true;
+    }
+    if (points_stale_ && detector_) {
+        // Located at this frame's positions, which the detection just placed.
+        if (points_.empty()) {
+            located_ = LocateResult{};
+        } else {
+            located_ = detector_->locate(PositionsView{points_.data(), true, points_.size() / 3}, all_objects, locate_options_);
+        }
+        points_stale_ = false;
         ++result_version_;
         changed = true;
     }

@@ -7,6 +7,7 @@
 
 #include <kdet/detector.hpp>
 #include <kdet/io.hpp>
+#include <kdet/locate.hpp>
 #include <kdet/scenes.hpp>
 
 #include <cstddef>
@@ -36,6 +37,16 @@ std::size_t resident_bytes();
 /// time it hardly changes when other programs share the processors.
 double process_cpu_ms();
 
+/// @brief How many query points a point location found in a tet (held), gave the nearest tet
+/// within `within` (near), or left without a tet (missed).
+struct PointCounts {
+    std::size_t held = 0, near = 0, missed = 0;
+};
+
+/// @brief What @p located says of point @p p: 0 held, 1 near, 2 missed.
+int point_status(const LocateResult& located, std::size_t p);
+PointCounts count_points(const LocateResult& located);
+
 /// @brief The scene, detector and current results of one viewer. Every setting may change at any
 /// time, before or after the first detection: the detector is rebuilt with the new settings the next
 /// time results are needed, and the old one is released.
@@ -57,6 +68,9 @@ public:
     /// (Detector::set_static: placed once), or moving, given its positions every frame.
     void set_static(std::size_t object, bool is_static);
     bool is_static(std::size_t object) const { return static_[object] != 0; }
+    /// @brief Query points (x y z each) located in every object's tets after each detection, with
+    /// LocateOptions::within = @p within (`kdet view --points FILE --within D`).
+    void set_points(std::vector<double> xyz, double within);
     /// @brief Selects a frame; clamped to the scene's frames.
     void set_frame(int frame);
 
@@ -85,6 +99,10 @@ public:
     /// @brief The last detection; empty before the first update().
     const FrameResult& result() const { return result_; }
     bool has_result() const { return has_result_; }
+    const std::vector<double>& points() const { return points_; }
+    /// @brief Where the points lie at frame() as of the last update() (empty without points); it
+    /// changes with result_version().
+    const LocateResult& located() const { return located_; }
     /// @brief Bytes held by the current detector (0 before the first detection).
     std::size_t detector_memory() const;
     /// @brief Name of the device the detector runs on (empty before the first detection).
@@ -125,6 +143,10 @@ private:
     std::vector<std::vector<float>> positions_;
     FrameResult result_;
     bool has_result_ = false;
+    std::vector<double> points_;
+    LocateOptions locate_options_;
+    LocateResult located_;
+    bool points_stale_ = false;
     double positions_ms_ = 0, detect_ms_ = 0, detect_cpu_ms_ = 0;
     std::uint64_t positions_version_ = 0, result_version_ = 0, scene_version_ = 0, topology_version_ = 0;
 };

@@ -32,6 +32,10 @@ scene options:
   --scene-frames N     frames of the procedural scene (default 120)
   --frame N            first frame shown (0-based, default 0)
   --allow-degenerate   accept zero-volume tetrahedra in mesh files
+  --points FILE        query points (`x y z` lines, or a mesh file's vertices) located in every
+                       frame as `kdet locate` does: points in a tet white, the tets holding them
+                       green, points given the nearest tet by --within orange, the rest magenta
+  --within D           with --points: a point no tet holds gets the nearest tet within D
 
 detector options:
 )";
@@ -146,6 +150,7 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     ViewConfig config;
     std::vector<std::string> positionals;
     std::string procedural_flag;
+    bool within_given = false;
     cli::CommandLine parser("view");
     parser.positionals(2, positionals);
     parser.flag("--help", config.help);
@@ -171,6 +176,17 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     parser.option("--screenshot", "FILE", [&](const std::string& v) {
         if (v.empty()) throw cli::UsageError("invalid value '' for --screenshot: expected a file name");
         config.screenshot = v;
+    });
+    parser.option("--points", "FILE", [&](const std::string& v) {
+        if (v.empty()) throw cli::UsageError("invalid value '' for --points: expected a file name");
+        config.points = v;
+    });
+    parser.option("--within", "D", [&](const std::string& v) {
+        char* end = nullptr;
+        config.within = std::strtod(v.c_str(), &end);
+        within_given = true;
+        if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(config.within) || config.within < 0)
+            throw cli::UsageError(invalid_value_message("--within", v, "a finite distance >= 0"));
     });
     parser.flag("--profile", config.profile);
     parser.option("--size", "WxH", [&](const std::string& v) { parse_size(v, config); });
@@ -211,6 +227,7 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
         throw cli::UsageError("view: " + procedural_flag + " applies to the procedural scene only");
     if (!config.screenshot.empty() && config.profile)
         throw cli::UsageError("view: --screenshot and --profile are two different runs; give one");
+    if (within_given && config.points.empty()) throw cli::UsageError("view: --within applies to --points only");
     if (config.panel && config.screenshot.empty()) throw cli::UsageError("view: --panel applies to --screenshot only");
     return config;
 }

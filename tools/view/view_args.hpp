@@ -47,6 +47,8 @@ struct ViewConfig {
     int width = 1280, height = 800;
     bool panel = false;            ///< draw the side panel into the screenshot too
     int samples = 4;               ///< multisampling per pixel (1 turns it off)
+    std::string points;            ///< query points file (read_points), located after each detection
+    double within = 0;             ///< LocateOptions::within for the points
     DisplaySettings display;
     CameraRequest camera;
     bool help = false;

@@ -8,6 +8,7 @@
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
+#include <kdet/io.hpp>
 
 #include <cstdio>
 #include <iostream>
@@ -25,6 +26,16 @@ int run_view(int argc, char** argv) {
         throw Error("view: --backend cuda is not available here: " + reason);
     config.options.contacts = view::wants_contacts(config.display, false);
     view::ViewSession session(config.source, config.options, config.self);
+    if (!config.points.empty()) {
+        std::vector<double> points;
+        try {
+            points = read_points(config.points);
+        } catch (const Error& e) {
+            // A points file is an argument of this command: a bad one is a usage error.
+            throw UsageError(std::string("view: ") + e.what());
+        }
+        session.set_points(std::move(points), config.within);
+    }
     if (config.frame >= session.num_frames())
         throw UsageError("invalid value '" + std::to_string(config.frame) + "' for --frame: scene '" +
                          session.scene().name() + "' has frames 0 to " + std::to_string(session.num_frames() - 1));
@@ -36,6 +47,10 @@ int run_view(int argc, char** argv) {
         std::printf("wrote %s: frame %d of %s, %llu colliding pairs, %llu colliding tets\n", config.screenshot.c_str(),
                     session.frame(), session.scene().name().c_str(), static_cast<unsigned long long>(r.counts.colliding_pairs),
                     static_cast<unsigned long long>(r.counts.colliding_tets));
+        if (!config.points.empty()) {
+            const view::PointCounts points = view::count_points(session.located());
+            std::printf("points: %zu in a tet, %zu near one, %zu without\n", points.held, points.near, points.missed);
+        }
         return exit_ok;
     }
     if (config.profile) {
