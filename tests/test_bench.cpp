@@ -11,6 +11,8 @@
 #include "bench_csv.hpp"
 #include "bench_runner.hpp"
 
+#include "run_command.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -432,12 +434,8 @@ TEST(BenchRunner, FilesHoldAveragesAndRuns) {
 /// @brief Runs the kdet command; stdout only (stderr goes to `stderr_file` when given).
 std::pair<int, std::string> kdet_command(const std::string& arguments, const std::string& stderr_file = "/dev/null") {
     const std::string command = std::string(KDET_CLI_PATH) + " " + arguments + " 2>" + stderr_file;
-    FILE* pipe = popen(command.c_str(), "r");
-    std::string out;
-    std::array<char, 4096> chunk{};
-    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe)) out += chunk.data();
-    const int status = pclose(pipe);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+    const test::CommandOutcome r = test::run_command(command);
+    return {r.exit_code, r.out};
 }
 
 std::uint64_t colliding_pairs_of(const std::string& json) {

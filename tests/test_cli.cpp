@@ -1,6 +1,7 @@
 // The kdet command as a user runs it: outputs, the pairs file, and one-line errors with exit codes.
 
 #include "filter_support.hpp"
+#include "run_command.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -22,20 +23,9 @@ namespace {
 
 #ifdef KDET_CLI_PATH
 
-struct Outcome {
-    int exit_code;
-    std::string out; // stdout and stderr together
-};
+using Outcome = test::CommandOutcome; // stdout and stderr together
 
-Outcome run_command(const std::string& command_line) {
-    const std::string command = command_line + " 2>&1";
-    FILE* pipe = popen(command.c_str(), "r");
-    std::string out;
-    std::array<char, 4096> chunk{};
-    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe)) out += chunk.data();
-    const int status = pclose(pipe);
-    return Outcome{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+Outcome run_command(const std::string& command_line) { return test::run_command(command_line + " 2>&1"); }
 
 Outcome kdet_cli(const std::string& arguments) { return run_command(std::string(KDET_CLI_PATH) + " " + arguments); }
 

@@ -4,6 +4,7 @@
 // and exit 2, as the program runs.
 
 #include "random_text.hpp"
+#include "run_command.hpp"
 
 #include <kdet/option_table.hpp>
 
@@ -59,10 +60,7 @@ TEST(CliFuzz, EveryBenchValueFlagReadsRandomTextOrRefusesItInOneLineNamingIt) {
 
 #ifdef KDET_CLI_PATH
 
-struct Outcome {
-    int exit_code;
-    std::string out; // stdout and stderr together
-};
+using Outcome = test::CommandOutcome; // stdout and stderr together
 
 /// Runs kdet with @p words, each given to the shell in single quotes (so any byte but NUL passes).
 Outcome run_kdet(const std::vector<std::string>& words) {
@@ -72,12 +70,7 @@ Outcome run_kdet(const std::vector<std::string>& words) {
         for (const char c : w) command += c == '\'' ? std::string("'\\''") : std::string(1, c);
         command += "'";
     }
-    FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-    std::string out;
-    std::array<char, 4096> chunk{};
-    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe)) out += chunk.data();
-    const int status = pclose(pipe);
-    return Outcome{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+    return test::run_command(command + " 2>&1");
 }
 
 TEST(CliFuzz, CollideRefusesMalformedValuesOfItsNewFlagsInOneLineWithExit2) {

@@ -3,6 +3,7 @@
 /// valid value and refuses an invalid one with the library's one message (python/tests/test_options.py
 /// walks it for Python).
 
+#include "run_command.hpp"
 #include "test_support.hpp"
 
 #include <kdet/error.hpp>
@@ -140,18 +141,10 @@ TEST(OptionTable, KdetBenchTakesTheThesissExampleCommandUnchanged) {
 }
 
 #ifdef KDET_CLI_PATH
-struct CliRun {
-    int exit_code;
-    std::string out;
-};
+using CliRun = test::CommandOutcome;
 
 CliRun kdet_cli(const std::string& arguments) {
-    FILE* pipe = popen((std::string(KDET_CLI_PATH) + " " + arguments + " 2>&1").c_str(), "r");
-    std::string out;
-    std::array<char, 4096> chunk{};
-    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe)) out += chunk.data();
-    const int status = pclose(pipe);
-    return CliRun{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+    return test::run_command(std::string(KDET_CLI_PATH) + " " + arguments + " 2>&1");
 }
 
 TEST(OptionTable, KdetCollideAcceptsAndRefusesEveryOptionItShowsAsTheLibraryDoes) {

@@ -6,6 +6,7 @@
 #include "camera.hpp"
 #include "png_reader.hpp"
 #include "renderer.hpp"
+#include "run_command.hpp"
 #include "session.hpp"
 #include "view_test_support.hpp"
 
@@ -68,19 +69,9 @@ std::filesystem::path picture_dir() {
     return dir;
 }
 
-struct Outcome {
-    int exit_code;
-    std::string out;
-};
+using Outcome = kdet::test::CommandOutcome;
 
-Outcome run_command(const std::string& command_line) {
-    FILE* pipe = popen((command_line + " 2>&1").c_str(), "r");
-    std::string out;
-    std::array<char, 4096> chunk{};
-    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe)) out += chunk.data();
-    const int status = pclose(pipe);
-    return Outcome{WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+Outcome run_command(const std::string& command_line) { return kdet::test::run_command(command_line + " 2>&1"); }
 
 /// @brief `kdet view ARGS --screenshot FILE`, read back.
 Picture screenshot(const std::string& arguments, const std::string& name) {
