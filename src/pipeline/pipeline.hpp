@@ -79,6 +79,8 @@ void Pipeline<Exec>::enqueue_results() {
     keys_view_ = exec_.download_view_later(out_keys_.data(), window);
     flags_view_ = exec_.download_view_later(user_colliding_.data(), tets);
     contacts_view_ = exec_.download_view_later(out_contacts_.data(), options_.contacts ? window : 0);
+    distances_view_ = exec_.download_view_later(out_distances_.data(), options_.distances ? window : 0);
+    closest_view_ = exec_.download_view_later(out_closest_.data(), options_.distances ? window : 0);
 }
 
 /// @brief Runs an attempt again from `stage` (grow_for has grown what it needs): the counters of the
@@ -168,8 +170,13 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
 /// hold the window); throws only when the need does not fit either.
 template <class Exec>
 std::size_t Pipeline<Exec>::pairs_window_within_memory(std::size_t wanted, std::size_t needed) {
-    const std::size_t keys = resize_within_memory(out_keys_, wanted, needed);
-    return options_.contacts ? resize_within_memory(out_contacts_, keys, needed) : keys;
+    std::size_t window = resize_within_memory(out_keys_, wanted, needed);
+    if (options_.contacts) window = resize_within_memory(out_contacts_, window, needed);
+    if (options_.distances) {
+        window = resize_within_memory(out_distances_, window, needed);
+        window = resize_within_memory(out_closest_, window, needed);
+    }
+    return window;
 }
 
 template <class Exec>
@@ -210,6 +217,8 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
 
     result.pairs.clear();
     result.contacts.clear();
+    result.distances.clear();
+    result.closest_points.clear();
     result.counts = FrameCounts{};
     FrameCounts& counts = result.counts;
     count_candidates(c, counts);
@@ -234,6 +243,12 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
         result.pairs.resize(colliding_count_);
         pairs_from_keys(begin, keys, colliding_count_, result.pairs.data(), options_.threads);
         if (options_.contacts) result.contacts.assign(contacts, contacts + colliding_count_);
+        if (options_.distances) {
+            const float* distances = exec_.template landed<float>(distances_view_);
+            const ClosestPoints* closest = exec_.template landed<ClosestPoints>(closest_view_);
+            result.distances.assign(distances, distances + colliding_count_);
+            result.closest_points.assign(closest, closest + colliding_count_);
+        }
         flags_by_object(begin, flags, result.colliding, options_.threads);
     }
     result.memory_bytes = memory_bytes();

@@ -42,6 +42,8 @@ struct SceneView {
     const Aabb* object_boxes;
     std::uint32_t tet_count;
     std::uint32_t object_count;
+    /// DetectorOptions::margin: boxes grown by half of it, sizes by all of it, pairs within it reported.
+    float margin = 0.0f;
 };
 
 KDET_HD inline void load_vertices(const SceneView& s, const TetIndices& tet, vec3 out[4]) {
