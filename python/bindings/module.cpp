@@ -218,6 +218,15 @@ struct Frame {
     bool distances_enabled = false;
 };
 
+/// A float32 view of a Frame's per-pair `values` (k rows of `row` floats each), or None when `enabled` is off.
+template <class T>
+nb::object per_pair_floats(nb::handle frame, bool enabled, std::vector<T>& values, std::initializer_list<std::size_t> row) {
+    if (!enabled) return nb::none();
+    std::vector<std::size_t> shape{values.size()};
+    shape.insert(shape.end(), row);
+    return nb::cast(nb::ndarray<nb::numpy, float>(reinterpret_cast<float*>(values.data()), shape.size(), shape.data(), frame));
+}
+
 /// What detect(device_results=True) returns: DLPack arrays of the detector's own buffers (valid until the
 /// next detect()) and the frame's counts and times.
 struct DeviceFrame {
@@ -519,33 +528,27 @@ void bind_results(nb::module_& m) {
             "method 'kdet_no_pairs'.")
         .def_prop_ro(
             "contacts",
-            [](nb::handle self) -> nb::object {
+            [](nb::handle self) {
                 Frame& f = nb::cast<Frame&>(self);
-                if (!f.contacts_enabled) return nb::none();
                 static_assert(sizeof(Contact) == 4 * sizeof(float), "Contact is read as four float32");
-                return nb::cast(rows_view<float, 4>(reinterpret_cast<float*>(f.result.contacts.data()),
-                                                    f.result.contacts.size(), self));
+                return per_pair_floats(self, f.contacts_enabled, f.result.contacts, {4});
             },
             "Per pair (depth, nx, ny, nz) float32: moving tet b by depth along n separates the pair. None unless the "
             "detector was made with contacts=True.")
         .def_prop_ro(
             "distances",
-            [](nb::handle self) -> nb::object {
+            [](nb::handle self) {
                 Frame& f = nb::cast<Frame&>(self);
-                if (!f.distances_enabled) return nb::none();
-                return nb::cast(nb::ndarray<nb::numpy, float, nb::ndim<1>>(f.result.distances.data(),
-                                                                           {f.result.distances.size()}, self));
+                return per_pair_floats(self, f.distances_enabled, f.result.distances, {});
             },
             "Per pair its distance, float32 (k,): 0 where the tets intersect. None unless the detector was made with "
             "distances=True.")
         .def_prop_ro(
             "closest_points",
-            [](nb::handle self) -> nb::object {
+            [](nb::handle self) {
                 Frame& f = nb::cast<Frame&>(self);
-                if (!f.distances_enabled) return nb::none();
                 static_assert(sizeof(ClosestPoints) == 6 * sizeof(float), "ClosestPoints is read as six float32");
-                return nb::cast(nb::ndarray<nb::numpy, float, nb::shape<-1, 2, 3>>(
-                    reinterpret_cast<float*>(f.result.closest_points.data()), {f.result.closest_points.size(), 2, 3}, self));
+                return per_pair_floats(self, f.distances_enabled, f.result.closest_points, {2, 3});
             },
             "Per pair a closest point on tet a, then on tet b, float32 (k, 2, 3); one common point twice where they "
             "intersect. None unless the detector was made with distances=True.")

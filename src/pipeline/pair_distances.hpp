@@ -5,8 +5,7 @@
 
 #include "geometry/tet_distance.hpp"
 #include "geometry/tet_intersect.hpp"
-#include "pipeline/pair_keys.hpp"
-#include "pipeline/scene_view.hpp"
+#include "pipeline/narrow_phase.hpp"
 
 #include <kdet/results.hpp>
 
@@ -14,9 +13,10 @@
 
 namespace kdet {
 
-/// @brief Distance and closest points of each pair given in the caller's ids; the pair's first tet
-/// (the lower id) is a. A pair the exact test finds intersecting gets 0 and a common point, whatever
-/// test reported it. Nothing when the pairs outgrew their window (see ContactKernel).
+/// @brief Distance and closest points of each pair given in the caller's ids (`keys`, `key_count` of
+/// them appended into a `window`), into `distances` and `closest_points`; the pair's first tet (the
+/// lower id) is a. A pair the exact test finds intersecting gets 0 and a common point, whatever test
+/// reported it. Nothing when the pairs outgrew their window (see ContactKernel).
 struct DistanceKernel {
     SceneView scene;
     const std::uint32_t* stored_id; ///< [tets] caller's global id -> stored id
@@ -28,8 +28,7 @@ struct DistanceKernel {
     KDET_HD void operator()(std::uint64_t k) const {
         if (*key_count > window) return;
         vec3 a[4], b[4];
-        load_tet(scene, stored_id[key_first(keys[k])], a);
-        load_tet(scene, stored_id[key_second(keys[k])], b);
+        load_key_tets(scene, stored_id, keys[k], a, b);
         bool exact_stage = false;
         const bool intersecting = tets_intersect_as<NarrowPhase::exact>(a, b, exact_stage);
         vec3 on_a, on_b;
