@@ -81,6 +81,13 @@ struct NarrowPhaseKernel {
     }
 };
 
+/// @brief The two tets of a pair key in the caller's ids: a the first (lower id), b the second.
+KDET_HD inline void load_key_tets(const SceneView& scene, const std::uint32_t* stored_id, std::uint64_t key, vec3 a[4],
+                                  vec3 b[4]) {
+    load_tet(scene, stored_id[key_first(key)], a);
+    load_tet(scene, stored_id[key_second(key)], b);
+}
+
 /// @brief Stage 6: contact of each colliding pair given in the caller's ids; tet b is the pair's second.
 /// Nothing when the pairs outgrew their window: a batch that did not fit left its slots unwritten
 /// (they hold no pair, maybe no valid id), and the narrow phase runs again with a larger window.
@@ -94,8 +101,7 @@ struct ContactKernel {
     KDET_HD void operator()(std::uint64_t k) const {
         if (*key_count > window) return;
         vec3 a[4], b[4];
-        load_tet(scene, stored_id[key_first(keys[k])], a);
-        load_tet(scene, stored_id[key_second(keys[k])], b);
+        load_key_tets(scene, stored_id, keys[k], a, b);
         float depth = 0.0f;
         vec3 direction{0.0f, 0.0f, 0.0f};
         tets_intersect_sat_mtv(a, b, depth, direction);

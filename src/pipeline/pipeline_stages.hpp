@@ -221,7 +221,7 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
 /// @brief Stages 5 and 6: the narrow phase once per candidate (they are unique, see
 /// for_each_larger_neighbour), over the count the candidate stage left in the backend's memory; the
 /// colliding pairs, appended under the caller's ids into the window, sorted into the output order,
-/// and their contacts.
+/// and their contacts and distances.
 template <class Exec>
 void Pipeline<Exec>::narrow_phase_and_results() {
     FrameCounters* c = counters_.data();
@@ -256,6 +256,13 @@ void Pipeline<Exec>::narrow_phase_and_results() {
         exec_.for_each_counted(&c->colliding_pairs, out_contacts_.size(),
                                ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), &c->colliding_pairs,
                                              out_keys_.size(), out_contacts_.data()});
+    }
+    if (options_.distances) {
+        resize_filled(out_distances_, pairs_window_, 0.0f);
+        resize_filled(out_closest_, pairs_window_, ClosestPoints{});
+        exec_.for_each_counted(&c->colliding_pairs, out_distances_.size(),
+                               DistanceKernel{scene_view(), stored_id_.data(), out_keys_.data(), &c->colliding_pairs,
+                                              out_keys_.size(), out_distances_.data(), out_closest_.data()});
     }
     clock_.mark(results_done);
 }
