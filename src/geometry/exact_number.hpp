@@ -41,10 +41,16 @@ public:
     KDET_HD friend Number operator+(const Number& x, const Number& y) { return sum(x, y, false); }
     KDET_HD friend Number operator-(const Number& x, const Number& y) { return sum(x, y, true); }
 
-    KDET_HD friend Number operator*(const Number& x, const Number& y) {
+    KDET_HD friend Number operator*(const Number& x, const Number& y) { return product(x, y); }
+
+private:
+    // Each expression of the margin decision instantiates its own chain of these operations: kept out
+    // of line, they are compiled once, not once per expression (which ptxas takes very long over).
+    KDET_NOINLINE KDET_HD static Number product(const Number& x, const Number& y) {
         Number r;
         if (x.used_ == 0 || y.used_ == 0) return r;
         const int n = x.used_ + y.used_ <= k_limbs ? x.used_ + y.used_ : k_limbs;
+        KDET_NO_UNROLL
         for (int k = 0; k < n; ++k) r.limb_[k] = 0;
         KDET_NO_UNROLL
         for (int i = 0; i < x.used_; ++i) {
@@ -64,10 +70,9 @@ public:
         return r;
     }
 
-private:
     /// @brief x + y, or x - y with `subtract`: both magnitudes in units of the smaller exponent, then
     /// added or the smaller taken from the larger.
-    KDET_HD static Number sum(const Number& x, const Number& y, bool subtract) {
+    KDET_NOINLINE KDET_HD static Number sum(const Number& x, const Number& y, bool subtract) {
         const bool y_negative = y.negative_ != subtract;
         if (y.used_ == 0) return x;
         if (x.used_ == 0) {
@@ -79,12 +84,15 @@ private:
         std::uint32_t a[k_limbs], b[k_limbs];
         const int na = x.aligned(exponent, a), nb = y.aligned(exponent, b);
         const int n = na > nb ? na : nb;
+        KDET_NO_UNROLL
         for (int k = na; k < n; ++k) a[k] = 0;
+        KDET_NO_UNROLL
         for (int k = nb; k < n; ++k) b[k] = 0;
         Number r;
         r.exponent_ = exponent;
         if (x.negative_ == y_negative) {
             std::uint64_t carry = 0;
+            KDET_NO_UNROLL
             for (int k = 0; k < n; ++k) {
                 const std::uint64_t t = static_cast<std::uint64_t>(a[k]) + b[k] + carry;
                 r.limb_[k] = static_cast<std::uint32_t>(t);
@@ -101,6 +109,7 @@ private:
             const std::uint32_t* big = a_larger ? a : b;
             const std::uint32_t* small = a_larger ? b : a;
             std::int64_t borrow = 0;
+            KDET_NO_UNROLL
             for (int i = 0; i < n; ++i) {
                 const std::int64_t t = static_cast<std::int64_t>(big[i]) - small[i] - borrow;
                 borrow = t < 0 ? 1 : 0;
@@ -117,6 +126,7 @@ private:
     KDET_HD int aligned(int exponent, std::uint32_t out[k_limbs]) const {
         const int shift = exponent_ - exponent, words = shift >> 5, bits = shift & 31;
         int n = used_ + words + 1 <= k_limbs ? used_ + words + 1 : k_limbs;
+        KDET_NO_UNROLL
         for (int k = 0; k < n; ++k) out[k] = 0;
         KDET_NO_UNROLL
         for (int k = 0; k < used_ && k + words < n; ++k) {
@@ -134,6 +144,7 @@ private:
         int low = 0;
         while (low < used_ && limb_[low] == 0) ++low;
         if (low == 0) return;
+        KDET_NO_UNROLL
         for (int k = low; k < used_; ++k) limb_[k - low] = limb_[k];
         used_ -= low;
         exponent_ += 32 * low;

@@ -267,7 +267,7 @@ KDET_HD inline double point_tet_distance(dvec3 x, const dvec3 t[4]) {
     double best = INFINITY;
     for (int face = 0; face < 4; ++face) {
         const dvec3 a = t[face_vertex(face, 0)], b = t[face_vertex(face, 1)], c = t[face_vertex(face, 2)];
-        const double d2 = squared_distance(x, closest_on_triangle(x, a, b, c));
+        const double d2 = squared_distance(x, closest_on_triangle(x, a, b, c).point);
         best = d2 < best ? d2 : best;
     }
     return sqrt(best);
@@ -301,7 +301,7 @@ KDET_HD inline dvec3 common_point(const dvec3 a[4], const dvec3 b[4]) {
                 const double hp = dot(n, p - fa), hq = dot(n, q - fa);
                 if (!(hp * hq <= 0.0) || hp == hq) continue;
                 const dvec3 x = p + (hp / (hp - hq)) * (q - p);
-                consider(closest_on_triangle(x, fa, fb, fc));
+                consider(closest_on_triangle(x, fa, fb, fc).point);
             }
         }
     }
