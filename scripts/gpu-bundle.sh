@@ -26,7 +26,7 @@ mkdir -p "$(dirname "$exclude")"
 grep -qx '/.gpu-bundle/' "$exclude" 2>/dev/null || echo '/.gpu-bundle/' >>"$exclude"
 (cd "$repo" && cmake --preset cuda -B "$build" >/dev/null)
 # The cuBQL peer exists where CMake found cuBQL (bench/CMakeLists.txt).
-targets=(kdet_cli kdet_tests kdet_gpu_vs_sweep)
+targets=(kdet_cli kdet_tests kdet_gpu_vs_sweep static_environment)
 # (grep reads the whole list: with -q it would stop early, and make would fail on the broken pipe.)
 cmake --build "$build" --target help | grep ' kdet_gpu_vs_cubql$' >/dev/null && targets+=(kdet_gpu_vs_cubql)
 cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
@@ -38,6 +38,7 @@ rm -rf "$bundle"
 mkdir -p "$bundle/lib"
 cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bundle/"
 [[ ! " ${targets[*]} " == *" kdet_gpu_vs_cubql "* ]] || cp "$build/bench/kdet_gpu_vs_cubql" "$bundle/"
+cp "$build/bench/static_environment" "$bundle/kdet_static_environment"
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"
   # Kept, like the build folder, at the same path every time: the build's CMake cache names its

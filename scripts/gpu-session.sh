@@ -10,6 +10,8 @@
 #   cubql    kdet against a cuBQL BVH + exact test peer (bench/gpu_vs_cubql.cu): the thesis scenes at
 #            resolution 4 and the procedural scene at 1M and 4M tets, self-collision off and on; its
 #            CSV also comes back as $OUT/cubql.csv (for bench/results/gpu-DEVICE/cubql-COMMIT.csv)
+#   scenes   issue 46's scenes (heap, drape, graded at resolution 1 and 4, pass_through_deep), self-collision off
+#            and on, and a body on a 1M-tet static floor against a 20k-tet one (bench/static_environment.cpp)
 #   profile  each kernel's GPU time in two frames of five cases (Nsight Compute), the heaviest case's
 #            occupancy, divergence and cache hits, and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
@@ -25,11 +27,11 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="${KDET_GPU_BUNDLE:-$repo/.gpu-bundle}"
 out="${OUT:-$repo/exports/gpu-session}"
 deadline="${KDET_GPU_DEADLINE:-500}"
-(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|profile|compare|matrix ..." >&2; exit 2; }
+(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|scenes|profile|compare|matrix ..." >&2; exit 2; }
 for part in "$@"; do
   case "$part" in
-  tests | sanitizers | r4 | scaling | peer | cubql | profile | compare | matrix) ;;
-  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, profile, compare, matrix)" >&2; exit 2 ;;
+  tests | sanitizers | r4 | scaling | peer | cubql | scenes | profile | compare | matrix) ;;
+  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, scenes, profile, compare, matrix)" >&2; exit 2 ;;
   esac
 done
 work="$(mktemp -d)"
@@ -108,6 +110,19 @@ for part in "$@"; do
         bench "scaling-$tets-$self" 90 procedural --tets "$tets" -s "$self" -n 3 --frames 55:65
       done
     done
+    ;;
+  scenes)
+    for scene in heap drape graded; do
+      for r in 1 4; do
+        for self in no yes; do
+          bench "scenes-$scene-r$r-self-$self" 90 "$scene" -r "$r" -s "$self" -n 3
+        done
+      done
+    done
+    for self in no yes; do
+      bench "scenes-pass_through_deep-self-$self" 90 pass_through_deep -r 2 -s "$self" -n 3
+    done
+    step static-environment 120 "$bin/kdet_static_environment" 24 cuda
     ;;
   peer)
     step peer 150 "$bin/kdet_gpu_vs_sweep" --csv "$work/peer.csv"

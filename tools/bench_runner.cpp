@@ -105,6 +105,8 @@ BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, const 
             }
             set_scene_tets(detector, scene, frame, tets);
             for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+                // A static object stays where its first frame put it.
+                if (scene.is_static(o) && (run > 0 || frame > config.first_frame)) continue;
                 scene.positions(o, frame, xyz[o]);
                 detector.set_positions(static_cast<ObjectId>(o), xyz[o].data(), xyz[o].size() / 3);
             }

@@ -108,6 +108,15 @@ public:
     /// the collision filters: the last set_pair_collision() of a pair decides it, whatever
     /// set_collision_filter() says before or after.
     void set_pair_collision(ObjectId a, ObjectId b, bool enabled);
+    /// @brief Marks an object static (or moving again; all are moving by default). A static object is
+    /// placed into a grid of its own once, at the next detection, and kept there across frames, so a
+    /// frame's cost follows the moving tets; set_positions() on it places it again at the next
+    /// detection. Pairs of two static objects, and a static object's self-collision, are never
+    /// reported (as in PhysX: they cannot change); a static object collides with the moving objects
+    /// it is checked against as any object does. Changing the flag costs a rebuild, as add_object does.
+    void set_static(ObjectId object, bool is_static);
+    /// @brief Whether set_static() marked the object static.
+    bool is_static(ObjectId object) const;
 
     /// @brief Sets an object's collision filter, as PhysX's filter data and MuJoCo's contype and
     /// conaffinity: two different objects a and b are checked when (group_a & mask_b) != 0 and

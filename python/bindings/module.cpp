@@ -621,6 +621,22 @@ void bind_detector(nb::module_& m) {
                 locked(self, [&] { self.detector.set_pair_collision(ia, ib, enabled); });
             },
             "a"_a, "b"_a, "enabled"_a, "Switches collision between two different objects (on by default).")
+        .def(
+            "set_static",
+            [](PyDetector& self, std::int64_t object, bool is_static) {
+                const ObjectId id = object_id(self, object);
+                locked(self, [&] { self.detector.set_static(id, is_static); });
+            },
+            "object"_a, "is_static"_a = true,
+            "Marks an object static (placed once, kept across frames; set_positions places it again) or moving. "
+            "Pairs of two static objects are never reported.")
+        .def(
+            "is_static",
+            [](PyDetector& self, std::int64_t object) {
+                const ObjectId id = object_id(self, object);
+                return locked(self, [&] { return self.detector.is_static(id); });
+            },
+            "object"_a, "Whether set_static marked the object static.")
         .def("detect", &detect, "device_results"_a = false,
              nb::sig("def detect(self, device_results: bool = False) -> FrameResult | DeviceFrameResult"),
              "Runs one detection (without the GIL). Returns a FrameResult, or with device_results=True a "

@@ -51,6 +51,7 @@ public:
 
 private:
     bool no_pairs() const { return this->options_.method == Method::kdet_no_pairs; }
+    bool keeps_static_grid() const override { return false; }
     bool grids() const override { return no_pairs(); }
     bool makes_pairs() const override { return !no_pairs(); }
     bool candidates_pretested() const override { return false; }

@@ -9,6 +9,7 @@
 #include "pipeline/pair_keys.hpp"
 #include "pipeline/pair_tests.hpp"
 #include "pipeline/scene_view.hpp"
+#include "pipeline/static_grid.hpp"
 
 #include <cstdint>
 
@@ -154,6 +155,8 @@ struct FindCandidatesKernel {
     /// once, since its resumption searches again. Otherwise it searches on, counting the room the
     /// whole frame needs, so that a single rerun fits.
     bool stop_when_full;
+    /// The static grid, which every moving tet also searches (its first search part does).
+    StaticGridSearch statics;
 
     struct Emit {
         const SceneView* scene;
@@ -240,6 +243,10 @@ struct FindCandidatesKernel {
                   excluded_partners(scene, t)};
         const GridParams grid_params = *params;
         for_each_larger_neighbour(scene, grid, grid_params, *layer_mask, t, emit, part);
+        if (part.layer == 0 && part.block == 0 && !emit.finished()) {
+            const ObjectFilter<Emit> filter{scene.pair_active + static_cast<std::uint64_t>(emit.object) * scene.object_count, &emit};
+            for_each_static_neighbour(scene, statics, t, filter, emit);
+        }
         return emit.rejected;
     }
 

@@ -41,7 +41,7 @@ struct Detector::Impl {
     void rebuild_pipeline() {
         const std::string rejected = pull_device_positions();
         pipeline->set_topology(topology);
-        pipeline->set_exclusions(filters.exclusions(topology.object_tet_begin));
+        pipeline->set_exclusions(filters.exclusions(pipeline->object_first_tets()));
         std::fill(positions_dirty.begin(), positions_dirty.end(), 1); // the pipeline's buffers are new
         topology_changed = false;
         if (!rejected.empty()) throw Error(rejected);
@@ -191,12 +191,13 @@ struct Detector::Impl {
         pipeline->upload_positions(uploads);
         std::fill(positions_dirty.begin(), positions_dirty.end(), 0);
 
+        // The pipeline may store an object's tets elsewhere than the topology (static_last).
         const auto& begin = topology.object_tet_begin;
         LocateRequest request;
         request.points = points;
         request.points_on_device = on_device;
-        request.first_tet = object == all_objects ? 0 : begin[object];
-        request.tet_count = (object == all_objects ? begin.back() : begin[object + 1]) - request.first_tet;
+        request.first_tet = object == all_objects ? 0 : pipeline->object_first_tets()[object];
+        request.tet_count = object == all_objects ? begin.back() : begin[object + 1] - begin[object];
         request.options = how;
         std::vector<vec3> converted;
         if (!on_device) {
@@ -416,6 +417,19 @@ void Detector::set_self_collision(ObjectId object, bool enabled) {
     impl_->pair_enabled[object * impl_->objects() + object] = enabled ? 1 : 0;
 }
 
+void Detector::set_static(ObjectId object, bool is_static) {
+    impl_->check_object(object);
+    std::uint8_t& flag = impl_->topology.object_static[object];
+    if ((flag != 0) == is_static) return;
+    flag = is_static ? 1 : 0;
+    impl_->topology_changed = true;
+}
+
+bool Detector::is_static(ObjectId object) const {
+    impl_->check_object(object);
+    return impl_->topology.object_static[object] != 0;
+}
+
 void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
     impl_->check_object(a);
     impl_->check_object(b);
@@ -514,7 +528,7 @@ void Detector::detect_async() {
     Impl& d = *impl_;
     if (d.frame_pending) finish(); // its counters are checked before the next frame overwrites them
     if (d.topology_changed) d.rebuild_pipeline();
-    if (d.filters.exclusions_changed()) d.pipeline->set_exclusions(d.filters.exclusions(d.topology.object_tet_begin));
+    if (d.filters.exclusions_changed()) d.pipeline->set_exclusions(d.filters.exclusions(d.pipeline->object_first_tets()));
     if (d.objects() == 0) {
         d.result = FrameResult{};
         return;
@@ -525,6 +539,7 @@ void Detector::detect_async() {
         const std::uint32_t first = d.object_vertex_begin[o], count = d.object_vertex_begin[o + 1] - first;
         if (d.positions_dirty[o]) uploads.push_back({first, d.positions.data() + first, count});
         if (d.positions_staged[o]) staged.push_back({first, count});
+        if (d.topology.object_static[o] && (d.positions_dirty[o] || d.positions_staged[o])) d.pipeline->static_moved();
     }
     d.pipeline->start(uploads, staged, d.pair_enabled);
     std::fill(d.positions_dirty.begin(), d.positions_dirty.end(), 0);

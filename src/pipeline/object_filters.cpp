@@ -174,36 +174,36 @@ void ObjectFilters::check_room(std::uint64_t added, std::uint64_t removed) const
     if (ids > max_exclusion_ids) throw Error(too_many_ids(ids));
 }
 
-ExclusionLists ObjectFilters::exclusions(const std::vector<std::uint32_t>& object_tet_begin) {
+ExclusionLists ObjectFilters::exclusions(const std::vector<std::uint32_t>& object_first) {
     changed_ = false;
     ExclusionLists out;
     if (entries() == 0) return out;
-    const std::uint32_t tets = object_tet_begin.back();
+    const std::uint32_t tets = object_first.back();
     // Per tet: its ring partners, then its rest partners (in either role), which may repeat a ring
     // partner and come in no order; each tet's list is sorted and made unique afterwards.
     std::vector<std::uint32_t> count(std::size_t{tets} + 1, 0);
     for (std::size_t o = 0; o < ring_lists_.size(); ++o) {
         const std::vector<std::uint32_t>& begin = ring_lists_[o].begin;
-        for (std::size_t t = 0; t + 1 < begin.size(); ++t) count[object_tet_begin[o] + t + 1] += begin[t + 1] - begin[t];
+        for (std::size_t t = 0; t + 1 < begin.size(); ++t) count[object_first[o] + t + 1] += begin[t + 1] - begin[t];
     }
     for (const auto& [objects, keys] : rest_pairs_)
         for (const std::uint64_t key : keys) {
-            ++count[object_tet_begin[objects.first] + static_cast<std::uint32_t>(key >> 32) + 1];
-            ++count[object_tet_begin[objects.second] + static_cast<std::uint32_t>(key) + 1];
+            ++count[object_first[objects.first] + static_cast<std::uint32_t>(key >> 32) + 1];
+            ++count[object_first[objects.second] + static_cast<std::uint32_t>(key) + 1];
         }
     for (std::uint32_t t = 0; t < tets; ++t) count[t + 1] += count[t];
     std::vector<std::uint32_t> partners(count[tets]), cursor(count.begin(), count.end() - 1);
     for (std::size_t o = 0; o < ring_lists_.size(); ++o) {
         const ExclusionLists& lists = ring_lists_[o];
-        const std::uint32_t first = object_tet_begin[o];
+        const std::uint32_t first = object_first[o];
         for (std::size_t t = 0; t + 1 < lists.begin.size(); ++t)
             for (std::uint32_t i = lists.begin[t]; i < lists.begin[t + 1]; ++i)
                 partners[cursor[first + t]++] = first + lists.partners[i];
     }
     for (const auto& [objects, keys] : rest_pairs_)
         for (const std::uint64_t key : keys) {
-            const std::uint32_t t = object_tet_begin[objects.first] + static_cast<std::uint32_t>(key >> 32);
-            const std::uint32_t u = object_tet_begin[objects.second] + static_cast<std::uint32_t>(key);
+            const std::uint32_t t = object_first[objects.first] + static_cast<std::uint32_t>(key >> 32);
+            const std::uint32_t u = object_first[objects.second] + static_cast<std::uint32_t>(key);
             partners[cursor[t]++] = u;
             partners[cursor[u]++] = t;
         }

@@ -53,8 +53,9 @@ public:
     void check_room(std::uint64_t added, std::uint64_t removed = 0) const;
     /// @brief Whether exclusions() changed since it was last called.
     bool exclusions_changed() const { return changed_; }
-    /// @brief Every exclusion in stored ids of the topology whose objects begin at `object_tet_begin`.
-    ExclusionLists exclusions(const std::vector<std::uint32_t>& object_tet_begin);
+    /// @brief Every exclusion in stored ids of a pipeline whose objects' tets begin at `object_first`
+    /// (PipelineBase::object_first_tets(): each object's tets together, the tet count last).
+    ExclusionLists exclusions(const std::vector<std::uint32_t>& object_first);
 
 private:
     std::uint64_t entries() const;

@@ -5,6 +5,7 @@
 
 #include "pipeline/capacity.hpp"
 #include "pipeline/pipeline_stages.hpp"
+#include "pipeline/static_placing.hpp"
 
 #include <kdet/error.hpp>
 
@@ -21,6 +22,7 @@ template <class Exec>
 void Pipeline<Exec>::enqueue_frame() {
     reset_counters();
     adopt_staged_positions();
+    if (frame_tets_ < tets_.size() && !statics_.placed) place_static();
     fill(colliding_, 0u);
     bounds_and_culling();
     if (grids()) grid_geometry();
@@ -253,9 +255,15 @@ void Pipeline<Exec>::start(const std::vector<PositionUpload>& uploads, const std
     clock_.begin_frame();
     clock_.mark(frame_start);
     for (const PositionUpload& u : uploads) exec_.upload(positions_.data() + u.first, u.positions, u.count);
-    exec_.upload(pair_enabled_.data(), pair_enabled.data(), pair_enabled.size());
+    // Two static objects (or one with itself) are never checked: their pairs cannot change.
+    std::vector<std::uint8_t> enabled = pair_enabled;
+    const std::size_t objects = object_boxes_.size();
+    for (std::size_t a = 0; a < objects; ++a)
+        for (std::size_t b = 0; b < objects; ++b)
+            if (topology_.object_static[a] && topology_.object_static[b]) enabled[a * objects + b] = 0;
+    exec_.upload(pair_enabled_.data(), enabled.data(), enabled.size());
     self_collision_ = false;
-    for (std::size_t o = 0, objects = object_boxes_.size(); o < objects; ++o) self_collision_ |= pair_enabled[o * objects + o] != 0;
+    for (std::size_t o = 0; o < objects; ++o) self_collision_ |= enabled[o * objects + o] != 0;
     enqueue_frame();
 }
 

@@ -40,6 +40,9 @@ struct SceneTopology {
     /// miss the caches.
     std::vector<std::uint32_t> vertex_user_id;
     std::uint32_t vertex_count = 0;
+    /// [objects] 1 for a static object (Detector::set_static): the pipeline stores its tets after the
+    /// moving ones (static_last) and places them once.
+    std::vector<std::uint8_t> object_static;
 
     /// @brief Appends an object: its `vertex_count` vertices at `positions` and its `tet_count` tets (four
     /// vertex indices each, into `positions`), stored in spatial order (computed on `threads` threads),
@@ -73,6 +76,10 @@ struct ExclusionLists {
     std::vector<std::uint32_t> partners;
 };
 
+/// @brief `topology` with the tets of its static objects moved behind all others (each object's tets
+/// stay together and in their order), so that a frame runs the first `moving_tets` only.
+SceneTopology static_last(const SceneTopology& topology, std::uint32_t& moving_tets);
+
 /// @brief Each of `count` colliding pairs' keys (two global tet ids in the caller's numbering) as the
 /// caller's object and tet of each side, on host_threads(`threads`) threads: a frame of a
 /// large scene hands out millions of pairs.
@@ -103,9 +110,15 @@ public:
     virtual ~PipelineBase() = default;
     /// @brief Replaces all geometry; positions must be set again afterwards.
     virtual void set_topology(const SceneTopology& topology) = 0;
-    /// @brief Replaces the pairs excluded beyond shared vertices (pair_exclusions.hpp), in stored ids
-    /// of the current topology; set again after every set_topology(), which clears them.
+    /// @brief Replaces the pairs excluded beyond shared vertices (pair_exclusions.hpp), in the stored
+    /// ids object_first_tets() numbers; set again after every set_topology(), which clears them.
     virtual void set_exclusions(const ExclusionLists& lists) = 0;
+    /// @brief Per object, the id of its first tet as this pipeline stores them, then the tet count:
+    /// the given topology's order, or its static objects' tets moved behind (static_last); each
+    /// object's tets stay together and in their order either way.
+    virtual const std::vector<std::uint32_t>& object_first_tets() const = 0;
+    /// @brief A static object's positions changed: the next frame places the static objects again.
+    virtual void static_moved() = 0;
     /// @brief Copies positions already in the backend's memory (in stream order), in any layout, as
     /// float32 into a staging buffer from global vertex `first` on, waiting for nothing; a frame
     /// adopts them (start()'s `staged`) once it has checked that they are finite, so rejected

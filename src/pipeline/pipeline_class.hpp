@@ -21,6 +21,7 @@
 #include "pipeline/pipeline_base.hpp"
 #include "pipeline/positions_check.hpp"
 #include "pipeline/scene_view.hpp"
+#include "pipeline/static_grid.hpp"
 
 #include <kdet/options.hpp>
 #include <kdet/results.hpp>
@@ -44,9 +45,14 @@ public:
     explicit Pipeline(const DetectorOptions& options)
         : exec_(options), clock_(exec_.make_stage_clock()), options_(options) {}
 
-    void set_topology(const SceneTopology& topology) override {
-        topology_ = topology;
+    void set_topology(const SceneTopology& given) override {
+        topology_ = keeps_static_grid() ? static_last(given, frame_tets_) : given;
+        const SceneTopology& topology = topology_;
         const std::size_t tets = topology.tets.size();
+        if (!keeps_static_grid()) frame_tets_ = static_cast<std::uint32_t>(tets);
+        object_first_.assign(topology.object_tet_begin.size(), static_cast<std::uint32_t>(tets));
+        for (std::uint32_t t = static_cast<std::uint32_t>(tets); t-- > 0;) object_first_[topology.tet_object[t]] = t;
+        statics_.placed = statics_.search.active = false;
         tets_.resize_discard(tets);
         exec_.upload(tets_.data(), topology.tets.data(), tets);
         tet_object_.resize_discard(tets);
@@ -95,6 +101,10 @@ public:
         exec_.upload(excluded_.data(), lists.partners.data(), lists.partners.size());
     }
 
+    const std::vector<std::uint32_t>& object_first_tets() const override { return object_first_; }
+
+    void static_moved() override { statics_.placed = false; }
+
     void stage_positions(std::uint32_t first, const PositionsView& positions) override {
         exec_.check_readable(positions.data, "set_positions_on_device: the positions");
         // Allocated on first use: only simulations that hand positions over on the device need it.
@@ -139,7 +149,7 @@ public:
                info_.capacity_bytes() + planes_.capacity_bytes() + slabs_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
-               exclusion_begin_.capacity_bytes() + excluded_.capacity_bytes() + grid_bytes() + counters_.capacity_bytes() +
+               exclusion_begin_.capacity_bytes() + excluded_.capacity_bytes() + grid_bytes() + statics_.bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
                resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
                out_distances_.capacity_bytes() + out_closest_.capacity_bytes() + exec_.scratch_bytes() +
@@ -163,6 +173,9 @@ public:
 
 protected:
     // What a baseline's frame changes of kdet's (BaselinePipeline): the rest of the frame is the same.
+    /// Whether static objects are placed once into a grid of their own (static_grid.hpp); a baseline
+    /// instead runs every tet each frame, and the static flags only switch off static-static pairs.
+    virtual bool keeps_static_grid() const { return true; }
     /// Whether the frame grids the relevant tets (stage 1's sizes and plan, stage 2).
     virtual bool grids() const { return true; }
     /// Whether the frame appends colliding pairs (the narrow phase runs on its candidates).
@@ -184,7 +197,7 @@ protected:
         // margin reports pairs that the slabs separate.
         TetSlabs* slabs = options_.narrow_phase == NarrowPhase::sat_no_edges || options_.margin > 0.0f ? nullptr : slabs_.data();
         return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), slabs, pair_active_.data(),
-                         checked_objects_.data(), object_boxes_.data(), static_cast<std::uint32_t>(tets_.size()),
+                         checked_objects_.data(), object_boxes_.data(), frame_tets_,
                          static_cast<std::uint32_t>(object_boxes_.size()),
                          exclusion_begin_.size() ? exclusion_begin_.data() : nullptr, excluded_.data(), options_.margin};
     }
@@ -211,6 +224,7 @@ protected:
     }
 
     void enqueue_frame();
+    void place_static();
     void adopt_staged_positions();
     void bounds_and_culling();
     void grid_geometry();
@@ -250,6 +264,7 @@ protected:
     typename Exec::stage_clock clock_; // kept between frames: on the GPU it holds CUDA events, created once
     DetectorOptions options_;
     SceneTopology topology_;
+    std::vector<std::uint32_t> object_first_; ///< object_first_tets()
     std::uint32_t stamp_ = 0;
 
     buffer<TetIndices> tets_;
@@ -302,6 +317,9 @@ protected:
     std::size_t colliding_count_ = 0; ///< pairs in out_keys_ after the last detection
     GridView grid_{}; ///< the frame's grid, once populated
     Locator<Exec> locator_; ///< point location's buffers
+    /// The tets a frame runs: the moving ones, stored first (static_last); all of them for a baseline.
+    std::uint32_t frame_tets_ = 0;
+    StaticGridStore<Exec> statics_;
 
     // The frame in flight: the staged ranges it adopts, and what it copies back at its end, read by
     // finish(): the counters, and the results where they land (Exec::landed).

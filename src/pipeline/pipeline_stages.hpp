@@ -18,7 +18,7 @@ namespace kdet {
 template <class Exec>
 void Pipeline<Exec>::bounds_and_culling() {
     const std::size_t objects = object_boxes_.size();
-    const std::uint32_t tets = static_cast<std::uint32_t>(tets_.size());
+    const std::uint32_t tets = frame_tets_;
     FrameCounters* c = counters_.data();
     exec_.for_each(tets, TetBoundsKernel{scene_view()});
     // Tets of one object are contiguous: their boxes reduce run by run, in parallel over all tets.
@@ -36,12 +36,12 @@ void Pipeline<Exec>::bounds_and_culling() {
 template <class Exec>
 void Pipeline<Exec>::grid_geometry() {
     FrameCounters* c = counters_.data();
-    exec_.for_each(tets_.size(), TetSizeKernel{scene_view(), &c->min_size, &c->max_size, &c->min_upper_size, &c->max_lower_size,
+    exec_.for_each(frame_tets_, TetSizeKernel{scene_view(), &c->min_size, &c->max_size, &c->min_upper_size, &c->max_lower_size,
                                                  c->spacing_octaves});
     exec_.for_each(1, GridParamsKernel{&c->min_size, &c->max_size, c->spacing_octaves, &c->region, &c->params,
                                        Tuning::grid_cell_spacings});
     constexpr std::uint32_t chunk = Tuning::plan_chunk;
-    exec_.for_each((tets_.size() + chunk - 1) / chunk,
+    exec_.for_each((frame_tets_ + chunk - 1) / chunk,
                    GridPlanKernel{scene_view(), &c->params, chunk, c->layer_entries, c->layer_cells, &c->layer_mask}, chunk);
 }
 
@@ -128,7 +128,7 @@ GridView Pipeline<Exec>::populate() {
                         block_bounds_.data(), own_cells_.data(), &c->grid_entries, entry_capacity_,
                         &c->overflow_used, &c->grid_failure, &c->cells_claimed, claimed_slots_.data(), slot_count_, slot_bits, capacity,
                         overflow_capacity_, stamp_, 64u, options_.hash};
-    exec_.for_each_in_runs(tets_.size(), PopulateKernel{scene_view(), grid, &c->params});
+    exec_.for_each_in_runs(frame_tets_, PopulateKernel{scene_view(), grid, &c->params});
     exec_.for_each(slot_count_, GatherCellsKernel{scene_view(), grid});
     exec_.sort_lists(list_keys_.data(), sorted_keys_.data(), entry_capacity_, list_begin_.data(), list_end_.data(), slot_count_);
     exec_.for_each(entry_capacity_, PlaceEntriesKernel{scene_view(), grid, sorted_keys_.data()});
@@ -150,16 +150,16 @@ GridView Pipeline<Exec>::populate() {
 template <class Exec>
 std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& grid) {
     // Items are numbered in 32 bits (ResumePoint): a scene too large for that searches its tets whole.
-    const std::uint32_t layer_parts_wanted = Tuning::search_layer_parts(self_collision_, tets_.size());
-    const std::uint32_t block_parts_wanted = Tuning::search_block_parts(self_collision_, tets_.size());
-    const bool split = tets_.size() * layer_parts_wanted * block_parts_wanted <= 0xffffffffu;
+    const std::uint32_t layer_parts_wanted = Tuning::search_layer_parts(self_collision_, frame_tets_);
+    const std::uint32_t block_parts_wanted = Tuning::search_block_parts(self_collision_, frame_tets_);
+    const bool split = std::size_t{frame_tets_} * layer_parts_wanted * block_parts_wanted <= 0xffffffffu;
     const std::uint32_t layer_parts = split ? layer_parts_wanted : 1u;
     const std::uint32_t block_parts = split ? block_parts_wanted : 1u;
     const std::size_t parts = std::size_t{layer_parts} * block_parts;
     constexpr std::uint32_t tets_per_item = Tuning::search_tets_per_item;
     using Search = FindCandidatesKernel<tets_per_item, Tuning::face_planes_in_search>;
-    const std::size_t runs = TetRuns<tets_per_item>::count(static_cast<std::uint32_t>(tets_.size()));
-    const std::size_t all_items = runs * parts, resume_room = tets_.size();
+    const std::size_t runs = TetRuns<tets_per_item>::count(frame_tets_);
+    const std::size_t all_items = runs * parts, resume_room = frame_tets_;
     for (auto& points : resume_points_) points.resize_discard(resume_room);
     // `items` items (resuming where `from` says, or from their start) append to `out`, counting into
     // `into`; those that do not fit are recorded in `stopped`, while there is `stopped_room`.
@@ -168,7 +168,7 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         FrameCounters* c = counters_.data();
         exec_.for_each(items, Search{scene_view(), grid, &c->params, &c->layer_mask, out, &into->rejected, from, stopped,
                                      &into->stopped_items, static_cast<std::uint32_t>(stopped_room), layer_parts,
-                                     block_parts, stop_when_full},
+                                     block_parts, stop_when_full, statics_.search},
                        tets_per_item);
     };
     std::size_t items = all_items;

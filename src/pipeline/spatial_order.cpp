@@ -82,6 +82,7 @@ void SceneTopology::add_object(const vec3* positions, std::uint32_t object_verte
     for (std::uint32_t v = 0; v < object_vertex_count; ++v) number(v);
     vertex_count = first_vertex + object_vertex_count;
     object_tet_begin.push_back(static_cast<std::uint32_t>(tets.size()));
+    object_static.push_back(0);
 }
 
 namespace {

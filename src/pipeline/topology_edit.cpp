@@ -51,6 +51,7 @@ SceneTopology SceneTopology::with_object_replaced(std::uint32_t object, std::uin
     next.vertex_user_id = spliced(vertex_user_id, first_vertex, end_vertex, piece.vertex_user_id,
                                   [&](std::uint32_t id, bool in_piece) { return id + (in_piece ? first_vertex : vertex_shift); });
     next.object_tet_begin = object_tet_begin;
+    next.object_static = object_static;
     for (std::size_t o = object + 1; o < next.object_tet_begin.size(); ++o) next.object_tet_begin[o] += tet_shift;
     next.vertex_count = vertex_count + vertex_shift;
     return next;

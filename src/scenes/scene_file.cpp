@@ -147,6 +147,9 @@ bool parse_object_statement(const Statement& s, ObjectSpec& object) {
             s.fail("wobble needs an amplitude >= 0 and a positive period");
     } else if (w == "key") {
         parse_key(s, object);
+    } else if (w == "static") {
+        s.expect_arguments(0, "nothing");
+        object.is_static = true;
     } else {
         return false;
     }
@@ -201,9 +204,15 @@ SceneSpec parse_scene(const std::string& text, const std::string& source) {
     const Statement& last = statements.back();
     if (spec.frames == 0) last.fail("the scene sets no 'frames'");
     if (spec.objects.empty()) last.fail("the scene has no 'object'");
-    for (const ObjectSpec& o : spec.objects)
+    for (const ObjectSpec& o : spec.objects) {
         if (o.model.empty() && o.file.empty())
             throw Error(source + ":" + std::to_string(o.line) + ": object '" + o.name + "' has no 'mesh' or 'file'");
+        bool keyed = o.wobble_amplitude > 0;
+        for (const auto& keys : o.keys) keyed = keyed || !keys.empty();
+        if (o.is_static && keyed)
+            throw Error(source + ":" + std::to_string(o.line) + ": object '" + o.name +
+                        "' is static but has keys or a wobble: a static object never moves");
+    }
 
     for (const Statement* s : collision_statements) {
         if (s->words[0] == "self") {

@@ -8,8 +8,11 @@ namespace kdet {
 
 void add_scene_objects(Detector& detector, const Scene& scene, bool self) {
     const auto first = static_cast<ObjectId>(detector.object_count());
-    for (std::size_t o = 0; o < scene.num_objects(); ++o)
-        detector.set_self_collision(detector.add_object(scene.rest_mesh(o)), self);
+    for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+        const ObjectId id = detector.add_object(scene.rest_mesh(o));
+        detector.set_self_collision(id, self);
+        detector.set_static(id, scene.is_static(o));
+    }
     for (std::size_t a = 0; a < scene.num_objects(); ++a)
         for (std::size_t b = a + 1; b < scene.num_objects(); ++b)
             if (!scene.checks_pair(a, b))

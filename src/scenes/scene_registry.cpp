@@ -30,7 +30,7 @@ std::unique_ptr<Scene> play(scenes::SceneSpec spec, const std::string& default_n
 std::vector<std::string> scene_names() {
     std::vector<std::string> names = {"procedural"};
     for (const auto& [name, text] : scenes::builtin_scene_files()) names.push_back(name);
-    names.push_back("tearing");
+    names.insert(names.end(), {"tearing", "heap", "drape", "graded"});
     return names;
 }
 
@@ -46,6 +46,9 @@ std::unique_ptr<Scene> read_scene_file(const std::string& path, const SceneReque
 std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& request) {
     if (name == "procedural") return std::make_unique<ProceduralScene>(request.procedural);
     if (name == "tearing") return std::make_unique<scenes::TearingScene>(120);
+    if (name == "heap") return make_heap_scene(request.resolution);
+    if (name == "drape") return make_drape_scene(request.resolution);
+    if (name == "graded") return make_graded_scene(request.resolution);
     for (const auto& [builtin, text] : scenes::builtin_scene_files())
         if (name == builtin) return play(scenes::parse_scene(text, "scenes/" + builtin + ".scene"), builtin, request, ".");
     std::error_code ignored;

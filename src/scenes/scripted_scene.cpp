@@ -122,6 +122,8 @@ bool ScriptedScene::checks_pair(std::size_t a, std::size_t b) const {
     return std::find(spec_.pairs.begin(), spec_.pairs.end(), pair) != spec_.pairs.end();
 }
 
+bool ScriptedScene::is_static(std::size_t object) const { return object < spec_.objects.size() && spec_.objects[object].is_static; }
+
 bool ScriptedScene::checks_self(std::size_t object) const {
     return std::find(spec_.self.begin(), spec_.self.end(), object) != spec_.self.end();
 }

@@ -39,6 +39,7 @@ struct ObjectSpec {
     double wobble_amplitude = 0.0;         ///< fraction of the largest extent
     double wobble_period = 0.0;            ///< frames
     std::array<std::vector<Key>, kNumChannels> keys;
+    bool is_static = false;                ///< `static`: placed once, never moved (no keys or deformations)
 };
 
 /// @brief A scene file as written.
@@ -74,6 +75,7 @@ public:
     void positions(std::size_t object, int frame, std::vector<double>& out) const override;
     bool checks_pair(std::size_t a, std::size_t b) const override;
     bool checks_self(std::size_t object) const override;
+    bool is_static(std::size_t object) const override;
 
     const SceneSpec& spec() const { return spec_; }
 

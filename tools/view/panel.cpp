@@ -212,6 +212,11 @@ void Viewer::panel_scene() {
             ImGui::SameLine();
             ImGui::Text("(group 0x%x, mask 0x%x)", filter.group, filter.mask);
         }
+        if (scene.is_static(o)) {
+            ImGui::SameLine();
+            bool is_static = session_.is_static(o);
+            if (ImGui::Checkbox("static", &is_static)) session_.set_static(o, is_static);
+        }
         ImGui::PopID();
     }
 }

@@ -80,6 +80,8 @@ void ViewSession::open(const ViewSource& source) {
     faces_ = std::move(faces);
     source_ = source;
     positions_.assign(scene_->num_objects(), {});
+    static_.clear();
+    for (std::size_t o = 0; o < scene_->num_objects(); ++o) static_.push_back(scene_->is_static(o) ? 1 : 0);
     if (frame_ >= scene_->num_frames()) frame_ = 0;
     positions_frame_ = -1;
     results_stale_ = true;
@@ -108,6 +110,15 @@ void ViewSession::set_exclusion_rings(int rings) {
     results_stale_ = true;
 }
 
+void ViewSession::set_static(std::size_t object, bool is_static) {
+    // Only a scene's static objects keep their positions in every frame, so only they can be static.
+    const char flag = is_static && scene_->is_static(object) ? 1 : 0;
+    if (static_[object] == flag) return;
+    static_[object] = flag;
+    detector_.reset();
+    results_stale_ = true;
+}
+
 CollisionFilter ViewSession::collision_filter(std::size_t object) const {
     return detector_ ? detector_->collision_filter(static_cast<ObjectId>(object)) : CollisionFilter{};
 }
@@ -120,6 +131,7 @@ void ViewSession::build_detector() {
     if (self_)
         for (std::size_t o = 0; o < scene_->num_objects(); ++o)
             detector->set_self_exclusion_rings(static_cast<ObjectId>(o), exclusion_rings_);
+    for (std::size_t o = 0; o < scene_->num_objects(); ++o) detector->set_static(static_cast<ObjectId>(o), static_[o] != 0);
     detector_ = std::move(detector);
 }
 
@@ -135,9 +147,12 @@ bool ViewSession::update() {
         changed = true;
     }
     if (results_stale_) {
-        if (!detector_) build_detector();
+        const bool fresh = !detector_;
+        if (fresh) build_detector();
+        // A static object's positions are the same in every frame: given once, it stays placed.
         for (std::size_t o = 0; o < scene_->num_objects(); ++o)
-            detector_->set_positions(static_cast<ObjectId>(o), positions_[o].data(), positions_[o].size() / 3);
+            if (fresh || !static_[o])
+                detector_->set_positions(static_cast<ObjectId>(o), positions_[o].data(), positions_[o].size() / 3);
         const auto start = std::chrono::steady_clock::now();
         const double cpu_start = process_cpu_ms();
         result_ = detector_->detect();

@@ -53,6 +53,10 @@ public:
     /// @brief Self-exclusion rings of every object while self-collision is on
     /// (Detector::set_self_exclusion_rings).
     void set_exclusion_rings(int rings);
+    /// @brief Whether a static object of the scene (Scene::is_static) is detected as static
+    /// (Detector::set_static: placed once), or moving, given its positions every frame.
+    void set_static(std::size_t object, bool is_static);
+    bool is_static(std::size_t object) const { return static_[object] != 0; }
     /// @brief Selects a frame; clamped to the scene's frames.
     void set_frame(int frame);
 
@@ -103,6 +107,7 @@ private:
     DetectorOptions options_;
     bool self_ = false;
     int exclusion_rings_ = 0;
+    std::vector<char> static_; ///< per object: detected as static (the scene's flag unless switched off)
     int frame_ = 0;
     int positions_frame_ = -1; ///< frame whose positions are in positions_, -1 for none
     bool results_stale_ = true;

@@ -56,6 +56,9 @@ public:
     virtual bool changes_tets() const { return false; }
     /// @brief The tets of `object` at `frame` (4 indices each, into rest_mesh(object)'s vertices).
     virtual void tets(std::size_t object, int /*frame*/, std::vector<std::uint32_t>& out) const { out = rest_mesh(object).tets; }
+    /// @brief Whether @p object never moves (its positions are the same in every frame): it is added as
+    /// a static object (Detector::set_static) and its positions are given once (default: none).
+    virtual bool is_static(std::size_t /*object*/) const { return false; }
 };
 
 /// @brief Sets the tets of `scene`'s objects at `frame` in `detector` (ids in scene order from
@@ -66,7 +69,8 @@ void set_scene_tets(Detector& detector, const Scene& scene, int frame, std::vect
 
 /// @brief Adds every object of @p scene to @p detector (ids in scene order, from the detector's next
 /// id on), with self-collision of each object as @p self says (the thesis's `-s`, whatever the
-/// scene's checks_self) and collisions between the object pairs the scene checks only.
+/// scene's checks_self), collisions between the object pairs the scene checks only, and its static
+/// objects static.
 void add_scene_objects(Detector& detector, const Scene& scene, bool self);
 
 /// @brief Size of a ProceduralScene.
@@ -120,6 +124,26 @@ private:
     TetMesh torus_;
     double start_separation_ = 0.0; ///< distance of the two centres at frame 0
 };
+
+/// @brief `heap`: small boxes (2 x 2 x 2 cubes, 48 tets each; 125, 343, 729 or 1000 of them at
+/// resolution 1-4) released layer by layer over a static floor (object 0), falling and coming to rest
+/// in columns that overlap a little sideways and downwards: many objects and contacts between them
+/// and with the floor. Deterministic, built in code. Throws kdet::Error for a resolution outside 1-4.
+std::unique_ptr<Scene> make_heap_scene(int resolution);
+
+/// @brief `drape`: a square sheet one cube (three tets) thick falls onto a static ball (object 0),
+/// lies a third of its thickness into it, wraps over it down to the equator (a large contact area) and
+/// then pleats around it where it hangs until the pleats fold over themselves (self-contact). Sheets of
+/// 40 to 160 cubes a side at resolution 1-4 (9,600 to 153,600 tets). Throws kdet::Error for a
+/// resolution outside 1-4.
+std::unique_ptr<Scene> make_drape_scene(int resolution);
+
+/// @brief `graded`: a static unit block whose cubes halve in size toward a point inside it, from a
+/// quarter of the block down 10 to 13 times at resolution 1-4 (tet sizes over 3 to 3.9 decades; not
+/// conforming where cube sizes change),
+/// and an upright torus of 10k-40k tets of one size rolling along x through that point. Throws
+/// kdet::Error for a resolution outside 1-4.
+std::unique_ptr<Scene> make_graded_scene(int resolution);
 
 /// @brief What open_scene needs besides the name.
 struct SceneRequest {
