@@ -1,13 +1,16 @@
-"""Point location: kdet.locate against libigl's in_element with its AABB tree (PyPI libigl), on one
-CPU, same mesh and points; the answers are compared where both define one.
+"""Point location: kdet.locate against libigl's in_element with its AABB tree (PyPI libigl) and, when
+VTK is installed (PyPI vtk), VTK's vtkStaticCellLocator::FindCell, on one CPU, same mesh and points;
+the answers are compared where both define one.
 
     python bench/locate_vs_libigl.py --cubes 55 --points 1000000 --threads 2
 
 The mesh is a box of cubes split into six tets each (about 6 * cubes^3 tets), its vertices moved at
 random by up to a fifth of a cube (no tet inverts), so that points rarely fall on a face; the points
-are uniform in the box. libigl returns one containing tet per point (or -1); kdet every tet whose closed
-set holds the point: each libigl answer must be among kdet's, and kdet must find none where libigl
-finds none, up to points libigl's floating-point test calls the other way (counted, not failed).
+are uniform in the box. libigl and VTK return one containing tet per point (or -1); kdet every tet
+whose closed set holds the point: each peer's answer must be among kdet's, and kdet must find none
+where the peer finds none, up to points the peer's floating-point test calls the other way (counted,
+not failed). VTK runs FindCell per point in C++ through vtkProbeFilter, with a vtkStaticCellLocator as
+its locator, probing a cell array of tet ids (one thread: VTK's SMP back end is set to sequential).
 run-locate-vs-libigl.sh installs the peers into a virtual environment and runs this.
 """
 
@@ -18,6 +21,12 @@ import numpy as np
 
 import igl
 import kdet
+
+try:
+    import vtk
+    from vtk.util import numpy_support
+except ImportError:
+    vtk = None
 
 
 def box_mesh(n, rng):
@@ -75,16 +84,57 @@ def main():
 
     counts = np.diff(r.offsets.astype(np.int64))
     held = counts > 0
-    igl_held = found >= 0
+    print(f"kdet.locate       {t_kdet * 1e3:9.1f} ms  (points held: {int(held.sum())}, hits {len(r.tets)})")
+    report("igl AABB+in_element", t_igl, t_kdet, found, r, held)
+    if vtk is None:
+        print("VTK: not installed (pip install vtk)")
+        return
+    t_vtk, found_vtk = best_of(args.runs, lambda: vtk_locate(vertices, tets, points))
+    report("vtk StaticCellLocator", t_vtk, t_kdet, found_vtk, r, held)
+
+
+def report(name, t_peer, t_kdet, found, r, held):
+    peer_held = found >= 0
     mismatched = 0
-    for p in np.nonzero(igl_held)[0]:
+    for p in np.nonzero(peer_held)[0]:
         if found[p] not in r.tets[r.offsets[p]:r.offsets[p + 1]]:
             mismatched += 1
-    only_kdet = int(np.sum(held & ~igl_held))
-    print(f"kdet.locate       {t_kdet * 1e3:9.1f} ms  (points held: {int(held.sum())}, hits {len(r.tets)})")
-    print(f"igl AABB+in_element {t_igl * 1e3:7.1f} ms  (points held: {int(igl_held.sum())})")
-    print(f"ratio igl/kdet    {t_igl / t_kdet:9.2f}")
-    print(f"libigl's tet not among kdet's: {mismatched}; held by kdet only: {only_kdet}")
+    only_kdet = int(np.sum(held & ~peer_held))
+    print(f"{name:22s}{t_peer * 1e3:9.1f} ms  (points held: {int(peer_held.sum())}); ratio peer/kdet {t_peer / t_kdet:.2f}; "
+          f"its tet not among kdet's: {mismatched}; held by kdet only: {only_kdet}")
+
+
+def vtk_locate(vertices, tets, points):
+    """The tet VTK's static cell locator finds for each point (FindCell, through a probe), or -1."""
+    vtk.vtkSMPTools.SetBackend("Sequential")
+    grid = vtk.vtkUnstructuredGrid()
+    vtk_points = vtk.vtkPoints()
+    vtk_points.SetData(numpy_support.numpy_to_vtk(vertices, deep=True))
+    grid.SetPoints(vtk_points)
+    cells = vtk.vtkCellArray()
+    offsets = np.arange(0, 4 * len(tets) + 1, 4, dtype=np.int64)
+    cells.SetData(numpy_support.numpy_to_vtkIdTypeArray(offsets, deep=True),
+                  numpy_support.numpy_to_vtkIdTypeArray(tets.astype(np.int64).ravel(), deep=True))
+    grid.SetCells(vtk.VTK_TETRA, cells)
+    ids = numpy_support.numpy_to_vtk(np.arange(len(tets), dtype=np.float64), deep=True)
+    ids.SetName("tet")
+    grid.GetCellData().AddArray(ids)
+    source = vtk.vtkPolyData()
+    query = vtk.vtkPoints()
+    query.SetData(numpy_support.numpy_to_vtk(points, deep=True))
+    source.SetPoints(query)
+    probe = vtk.vtkProbeFilter()
+    probe.SetInputData(source)
+    probe.SetSourceData(grid)
+    # SetCellLocator replaced SetCellLocatorPrototype in VTK 9.7.
+    set_locator = getattr(probe, "SetCellLocator", None) or probe.SetCellLocatorPrototype
+    set_locator(vtk.vtkStaticCellLocator())
+    probe.PassCellArraysOff()
+    probe.Update()
+    out = probe.GetOutput().GetPointData()
+    tet = numpy_support.vtk_to_numpy(out.GetArray("tet")).astype(np.int64)
+    valid = numpy_support.vtk_to_numpy(out.GetArray(probe.GetValidPointMaskArrayName())).astype(bool)
+    return np.where(valid, tet, -1)
 
 
 if __name__ == "__main__":

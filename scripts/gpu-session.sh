@@ -10,8 +10,9 @@
 #   cubql    kdet against a cuBQL BVH + exact test peer (bench/gpu_vs_cubql.cu): the thesis scenes at
 #            resolution 4 and the procedural scene at 1M and 4M tets, self-collision off and on; its
 #            CSV also comes back as $OUT/cubql.csv (for bench/results/gpu-DEVICE/cubql-COMMIT.csv)
-#   scenes   issue 46's scenes (heap, drape, graded at resolution 1 and 4, pass_through_deep), self-collision off
-#            and on, and a body on a 1M-tet static floor against a 20k-tet one (bench/static_environment.cpp)
+#   scenes   issue 46's scenes (heap, drape, graded at resolution 1 and 4, pass_through_deep, tearing),
+#            self-collision off and on, heap r4 without its collision filters, and a body on a 1M-tet
+#            static floor against a 20k-tet one (bench/static_environment.cpp)
 #   profile  each kernel's GPU time in two frames of five cases (Nsight Compute), the heaviest case's
 #            occupancy, divergence and cache hits, and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
@@ -121,7 +122,9 @@ for part in "$@"; do
     done
     for self in no yes; do
       bench "scenes-pass_through_deep-self-$self" 90 pass_through_deep -r 2 -s "$self" -n 3
+      bench "scenes-tearing-self-$self" 90 tearing -s "$self" -n 3
     done
+    bench "scenes-heap-r4-filters-off" 90 heap -r 4 -s no -n 3 --filters off
     step static-environment 120 "$bin/kdet_static_environment" 24 cuda
     ;;
   peer)

@@ -141,6 +141,10 @@ TEST(BenchArgs, EveryMistakeIsOneLineNamingTheFlagAndWhatItAccepts) {
         {{"--frames", "0"}, "invalid value '0' for --frames: expected an integer in [1, 100000]"},
         {{"--scene-frames", "0"}, "invalid value '0' for --scene-frames: expected an integer in [1, 100000]"},
         {{"--tets", "5"}, "invalid value '5' for --tets: expected an integer in [100, 20000000]"},
+        {{"--rings", "5", "-s", "yes"}, "invalid value '5' for --rings: expected an integer in [0, 4]"},
+        {{"--rings", "1"}, "bench: --rings needs -s yes"},
+        {{"--filters", "no"}, "invalid value 'no' for --filters: expected on or off"},
+        {{"--mpi", "--filters", "off"}, "bench: --rings and --filters off are not available with --mpi"},
         {{"--frobnicate"}, "bench: unknown option '--frobnicate'"},
         {{"-r"}, "bench: option '-r' needs a value <resolution>"},
         {{"-h"}, "bench: option '-h' needs a value <hash>"},
@@ -314,7 +318,8 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
                                                   "overlap test",      "self collisions", "hashing algorithm",
                                                   "#frames",           "first frame", "total runs", "#tetsA",
                                                   "#tetsB",            "#verticesA", "#verticesB"};
-    const std::vector<std::string> more_keys = {"backend", "threads", "bucket capacity", "device", "compiler", "compiler flags",
+    const std::vector<std::string> more_keys = {"backend", "threads", "bucket capacity", "exclusion rings",
+                                                "collision filters", "device", "compiler", "compiler flags",
                                                 "kdet version", "peak memory bytes", "time unit"};
     std::vector<std::string> keys;
     std::map<std::string, std::string> header;
@@ -330,6 +335,8 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     EXPECT_EQ(header["bucket capacity"], config.options.bucket_capacity ? std::to_string(config.options.bucket_capacity) : "automatic");
     EXPECT_EQ(header["algorithm"], "kdet");
     EXPECT_EQ(header["self collisions"], "yes");
+    EXPECT_EQ(header["exclusion rings"], "0");
+    EXPECT_EQ(header["collision filters"], "on");
     EXPECT_EQ(header["#frames"], "3");
     EXPECT_EQ(header["first frame"], "1");
     EXPECT_EQ(header["total runs"], "2");
@@ -353,6 +360,40 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     EXPECT_EQ(brute.runs[0].size(), 6u);
     EXPECT_EQ(brute.stem.find("_f"), std::string::npos) << brute.stem;
     EXPECT_NE(brute.stem.find("_gpu_sat_none_g128_"), std::string::npos) << brute.stem;
+}
+
+TEST(BenchRunner, RingsAndFiltersFlags) {
+    EXPECT_EQ(parse_words({"-s", "yes", "--rings", "2"}).rings, 2);
+    EXPECT_EQ(parse_words({}).rings, 0);
+    EXPECT_FALSE(parse_words({"--filters", "off"}).filters);
+    EXPECT_TRUE(parse_words({"--filters", "on"}).filters);
+
+    // heap's filters leave out the pairs of boxes side by side in a layer: off, the bench counts them.
+    BenchConfig config;
+    config.runs = 1;
+    config.first_frame = config.last_frame = 119;
+    const auto heap = open_scene("heap");
+    const auto pairs = [&](const BenchOutcome& o) { return value_of(o.runs.at(0).at(0), "collision pairs"); };
+    const BenchOutcome on = run_benchmark(config, *heap, [](int, int) { return true; });
+    config.filters = false;
+    const BenchOutcome off = run_benchmark(config, *heap, [](int, int) { return true; });
+    EXPECT_GT(pairs(off), pairs(on));
+    EXPECT_NE(off.stem.find("_f119-119_filters-off"), std::string::npos) << off.stem;
+    EXPECT_EQ(on.stem.find("filters"), std::string::npos) << on.stem;
+
+    // Rings leave out the self pairs of drape's folds that lie near each other in the mesh.
+    config = BenchConfig{};
+    config.runs = 1;
+    config.first_frame = config.last_frame = 119;
+    config.self = true;
+    const auto drape = open_scene("drape");
+    const BenchOutcome plain = run_benchmark(config, *drape, [](int, int) { return true; });
+    config.rings = 2;
+    const BenchOutcome ringed = run_benchmark(config, *drape, [](int, int) { return true; });
+    EXPECT_LT(pairs(ringed), pairs(plain));
+    EXPECT_NE(ringed.stem.find("_rings2"), std::string::npos) << ringed.stem;
+    std::map<std::string, std::string> header(ringed.header.begin(), ringed.header.end());
+    EXPECT_EQ(header["exclusion rings"], "2");
 }
 
 TEST(BenchRunner, ProgressCanStopIt) {

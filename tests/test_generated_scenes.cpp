@@ -1,7 +1,8 @@
 // The scenes of issue 46 built in code (heap, drape, graded) and the scene file's `static` statement: the
 // scenes are deterministic, their static objects never move, and a frame's pairs with the static
 // objects placed once equal those with every object moving (which tests/test_pipeline.cpp holds to
-// brute force), minus the pairs of two static objects.
+// brute force), minus the pairs of two static objects; heap's collision filters leave out what brute
+// force with the same filters leaves out.
 
 #include "test_support.hpp"
 
@@ -131,6 +132,49 @@ TEST(GeneratedScenes, GradedSizesSpanThreeDecades) {
     EXPECT_GE(largest / smallest, 1000.0);
     expect_static_objects_still(*graded);
     expect_static_placement_changes_nothing(*graded, {50, 59, 70}, true);
+}
+
+/// The pairs of `scene` at `frame` found by `method`, its objects added as add_scene_objects does.
+std::vector<TetPair> scene_pairs(const Scene& scene, int frame, Method method, bool filters) {
+    DetectorOptions options;
+    options.method = method;
+    Detector detector(options);
+    if (filters) {
+        add_scene_objects(detector, scene, false);
+    } else {
+        for (std::size_t o = 0; o < scene.num_objects(); ++o) detector.add_object(scene.rest_mesh(o));
+    }
+    std::vector<float> xyz;
+    for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+        scene.positions(o, frame, xyz);
+        detector.set_positions(static_cast<ObjectId>(o), xyz.data(), xyz.size() / 3);
+    }
+    return detector.detect().pairs;
+}
+
+TEST(GeneratedScenes, HeapFiltersLeaveOutPairsWithinALayer) {
+    const auto heap = open_scene("heap");
+    EXPECT_EQ(heap->collision_filter(0).group, CollisionFilter{}.group) << "the floor";
+    EXPECT_EQ(heap->collision_filter(0).mask, CollisionFilter{}.mask);
+    const int frame = heap->num_frames() - 1; // every layer at rest on the one below
+    const std::vector<TetPair> filtered = scene_pairs(*heap, frame, Method::kdet, true);
+    EXPECT_EQ(filtered, scene_pairs(*heap, frame, Method::brute_force_loop, true));
+    // The same as every pair with the filters' rule applied afterwards.
+    std::vector<TetPair> kept;
+    std::size_t floor = 0, layers = 0, same_layer = 0;
+    for (const TetPair& p : scene_pairs(*heap, frame, Method::kdet, false)) {
+        const CollisionFilter a = heap->collision_filter(p.object_a), b = heap->collision_filter(p.object_b);
+        if ((a.group & b.mask) != 0 && (b.group & a.mask) != 0) {
+            kept.push_back(p);
+            (p.object_a == 0 ? floor : layers) += 1;
+        } else {
+            same_layer += a.group == b.group;
+        }
+    }
+    EXPECT_EQ(filtered, kept);
+    EXPECT_GT(floor, 0u) << "the bottom layer lies in the floor";
+    EXPECT_GT(layers, 0u) << "layers press on each other";
+    EXPECT_GT(same_layer, 0u) << "bodies side by side in a layer overlap, and the filters leave them out";
 }
 
 TEST(GeneratedScenes, SameFramesEveryTime) {

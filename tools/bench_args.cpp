@@ -45,6 +45,9 @@ more options:
   --backend B          where detection runs: )" + find_option("backend")->values_help(defaults) + R"(; cuda needs a GPU
 )" + option_help_line(*find_option("threads"), front_end_bench, defaults) +
            option_help_line(*find_option("bucket_capacity"), front_end_bench, defaults) + R"(  --frames A:B         run frames A to B only (0-based, inclusive)
+  --rings K            with -s yes: also leave out tets within K mesh edges of each other in every
+                       object (self-exclusion rings, 0-)" + std::to_string(max_exclusion_rings) + R"(; default 0: only tets sharing a vertex)
+  --filters on|off     the scene's collision filters between objects (heap's groups; default on)
   --quiet              no per-frame table and no progress bar; only the summary
   --mpi                run on the ranks of mpirun (kdet::mpi), each on its part of the scene, and
                        write per frame the tets and bytes they exchanged (DIR/STEM_mpi-npN-P.csv)
@@ -99,6 +102,10 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     });
     parser.option("-n", "runs", [&](const std::string& v) { config.runs = static_cast<int>(parse_integer("-n", v, 1, 20)); });
     parser.option("-s", "yes|no", [&](const std::string& v) { config.self = parse_choice("-s", v, {"yes", "y", "no", "n"})[0] == 'y'; });
+    parser.option("--rings", "K", [&](const std::string& v) {
+        config.rings = static_cast<int>(parse_integer("--rings", v, 0, max_exclusion_rings));
+    });
+    parser.option("--filters", "on|off", [&](const std::string& v) { config.filters = parse_choice("--filters", v, {"on", "off"}) == "on"; });
     parser.option("-d", "folder", [&](const std::string& v) {
         if (v.empty()) throw UsageError("invalid value '' for -d: expected a folder");
         config.output_dir = v;
@@ -126,6 +133,9 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     parser.parse(argc, argv, first);
     if (!scene.empty()) config.scene = scene[0];
     if (!config.partition.empty() && !config.mpi) throw UsageError("bench: --partition needs --mpi");
+    if (config.rings > 0 && !config.self) throw UsageError("bench: --rings needs -s yes (rings act within an object)");
+    if (config.mpi && (config.rings > 0 || !config.filters))
+        throw UsageError("bench: --rings and --filters off are not available with --mpi");
     return config;
 }
 

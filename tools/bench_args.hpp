@@ -23,6 +23,8 @@ struct BenchConfig {
     DetectorOptions options = bench_default_options(); ///< -c, -o, -h, -g, --backend, --threads
     int runs = 10;                              ///< -n
     bool self = false;                          ///< -s
+    int rings = 0;                              ///< --rings: self-exclusion rings of every object, with -s
+    bool filters = true;                        ///< --filters: the scene's collision filters
     std::string output_dir = "exports/benchmark_data"; ///< -d
     int first_frame = 0;                        ///< --frames A:B (0-based, inclusive)
     int last_frame = -1;                        ///< -1: up to the scene's last frame

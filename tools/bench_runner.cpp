@@ -49,6 +49,8 @@ std::string stem_of(const BenchConfig& config, const Scene& scene, int last_fram
                        std::to_string(tets) + "tets";
     if (config.first_frame != 0 || last_frame != scene.num_frames() - 1)
         stem += "_f" + std::to_string(config.first_frame) + "-" + std::to_string(last_frame);
+    if (config.rings > 0) stem += "_rings" + std::to_string(config.rings);
+    if (!config.filters) stem += "_filters-off";
     return stem;
 }
 
@@ -73,6 +75,8 @@ std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene
             {"backend", to_string(o.backend)},
             {"threads", std::to_string(threads)},
             {"bucket capacity", o.bucket_capacity ? std::to_string(o.bucket_capacity) : "automatic"},
+            {"exclusion rings", std::to_string(config.rings)},
+            {"collision filters", config.filters ? "on" : "off"},
             {"device", detector.device_name()},
             {"compiler", compiler()},
             {"compiler flags", KDET_BENCH_CXX_FLAGS},
@@ -90,6 +94,11 @@ int last_frame_of(const BenchConfig& config, const Scene& scene) {
 BenchOutcome run_benchmark(const BenchConfig& config, const Scene& scene, const BenchProgress& progress) {
     Detector detector(config.options);
     add_scene_objects(detector, scene, config.self);
+    for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+        const auto id = static_cast<ObjectId>(o);
+        if (config.rings > 0) detector.set_self_exclusion_rings(id, config.rings);
+        if (!config.filters) detector.set_collision_filter(id, CollisionFilter{}.group, CollisionFilter{}.mask);
+    }
 
     const int last = last_frame_of(config, scene);
     BenchOutcome outcome;

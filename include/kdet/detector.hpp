@@ -129,9 +129,10 @@ public:
     /// @brief Within one object, leaves out tets that have vertices within `rings` mesh edges of each
     /// other, besides those sharing a vertex (`rings` = 0, the default, leaves out only those), for
     /// meshes whose neighbouring elements come close by design. The detector keeps, per tet, the sorted
-    /// list of the tets this adds, which the search consults before any test; it grows with the cube of
-    /// `rings`. Throws kdet::Error for `rings` outside [0, max_exclusion_rings]. Kept across set_tets()
-    /// (the lists are made again for the new tets).
+    /// list of the later tets this adds (each pair once), which the search consults before any test; it
+    /// grows with the cube of `rings`. The lists are built on the detector's backend, after a pending
+    /// detect_async() frame. Throws kdet::Error for `rings` outside [0, max_exclusion_rings]. Kept
+    /// across set_tets() (the lists are made again for the new tets).
     void set_self_exclusion_rings(ObjectId object, int rings);
     int self_exclusion_rings(ObjectId object) const;
 

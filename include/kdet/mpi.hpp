@@ -62,7 +62,7 @@ struct ExchangeStats {
     std::uint64_t bytes_sent = 0;     ///< of the tets, plus the bounds and cells every rank gathers
     std::uint64_t bytes_received = 0;
     std::uint32_t ranks_sent_to = 0;  ///< other ranks that got at least one tet from this one
-    bool rebuilt = false;             ///< the local detector was built anew (its set of tets changed)
+    bool rebuilt = false;             ///< the local detector's set of tets changed (updated with set_tets)
     double exchange_ms = 0;           ///< gathering bounds and cells, choosing and exchanging tets
     double local_ms = 0;              ///< the local detector: building it when needed, detect()
     double total_ms = 0;              ///< the whole detect(), the agreement on errors included

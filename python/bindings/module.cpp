@@ -5,6 +5,7 @@
 #include "detector.hpp"
 #include "fields.hpp"
 #include "locate.hpp"
+#include "scenes.hpp"
 #ifdef KDET_HAS_CUDA
 #include <cuda_runtime.h>
 #endif
@@ -723,4 +724,5 @@ NB_MODULE(_kdet, m) {
     bind_detector(m);
     bind_collide(m);
     bind_locate(m, &options_from_keywords);
+    bind_scenes(m);
 }

@@ -34,3 +34,14 @@ def test_draw_collisions_writes_a_picture(models, tmp_path):
     printed = run("draw_collisions.py", models, "--out", str(out))
     assert re.match(r"\d+ colliding pairs", printed) and int(printed.split()[0]) > 100
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_embed_surface_carries_every_point(models):
+    lines = run("embed_surface.py", models).splitlines()
+    embedded, total = map(int, re.match(r"(\d+) of (\d+) surface points embedded", lines[0]).groups())
+    # The bunny's surface vertices are vertices of its tet mesh: each is held, most by several tets.
+    assert embedded == total == 3485
+    shared = int(re.search(r"\((\d+) on faces", lines[0]).group(1))
+    assert shared > total // 2
+    deviation = float(re.search(r"mapped point (\S+)", lines[1]).group(1))
+    assert deviation < 1e-6

@@ -28,12 +28,13 @@ struct PointTetSigns {
     int face[4];
 };
 
-/// @brief Whether the closed tet v holds p, exactly. A tet with volume holds p iff no orientation with a
+/// @brief Whether the closed tet v, whose orientation (orient3d_sign of its vertices) is given, holds
+/// p, exactly. A tet with volume holds p iff no orientation with a
 /// vertex replaced by p has the opposite sign of the tet's own (zero: p lies on that face's plane).
 /// A tet without volume is decided by the exact tet-tet test against the point as a tet of four equal
 /// vertices, which handles flat and collinear tets.
-KDET_HD inline bool tet_holds_point(const vec3 v[4], vec3 p, PointTetSigns& signs) {
-    signs.tet = orient3d_sign(v[0], v[1], v[2], v[3]);
+KDET_HD inline bool tet_holds_point(const vec3 v[4], vec3 p, int orientation, PointTetSigns& signs) {
+    signs.tet = orientation;
     if (signs.tet == 0) {
         const vec3 point[4] = {p, p, p, p};
         bool exact_stage = false;
@@ -50,6 +51,12 @@ KDET_HD inline bool tet_holds_point(const vec3 v[4], vec3 p, PointTetSigns& sign
         }
     }
     return holds;
+}
+
+/// @brief As above, with the tet's orientation computed here (a caller testing many points against
+/// one tet computes it once instead).
+KDET_HD inline bool tet_holds_point(const vec3 v[4], vec3 p, PointTetSigns& signs) {
+    return tet_holds_point(v, p, orient3d_sign(v[0], v[1], v[2], v[3]), signs);
 }
 
 /// @brief A point's place relative to a tet, in double: barycentric coordinates (of the point when the

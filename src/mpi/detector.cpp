@@ -419,12 +419,15 @@ void Detector::Impl::exchange(const std::vector<PartSummary>& summaries, std::ve
     result.exchange.bytes_received += total_recv * sizeof(TetRecord) + (n - 1) * sizeof(int);
 }
 
-/// Builds (or, when its tets are the same as last frame's, updates) the local detector from the owned
-/// tets and @p received. Returns an error found in the received positions, or "".
+/// Builds the local detector from the owned tets and @p received, or updates it: set_tets() for the
+/// objects whose local tets changed, set_positions() for the others. Returns an error found in the
+/// received positions, or "".
 std::string Detector::Impl::build_local(std::vector<TetRecord>& received, bool& rebuilt) {
     std::sort(received.begin(), received.end(),
               [](const TetRecord& x, const TetRecord& y) { return std::tie(x.object, x.tet) < std::tie(y.object, y.tet); });
-    rebuilt = !local || local_objects.size() != objects.size();
+    const bool anew = !local || local_objects.size() != objects.size();
+    rebuilt = anew;
+    std::vector<std::uint8_t> changed(objects.size(), 0);
     std::vector<LocalObject> next(objects.size());
     std::size_t at = 0;
     for (std::size_t o = 0; o < objects.size(); ++o) {
@@ -474,10 +477,11 @@ std::string Detector::Impl::build_local(std::vector<TetRecord>& received, bool& 
                                                                                  std::lower_bound(extra_ids.begin(), extra_ids.end(), g) -
                                                                                  extra_ids.begin())));
             }
-        if (!rebuilt && (lo.ghost_ids != local_objects[o].ghost_ids || lo.tets != local_objects[o].tets)) rebuilt = true;
+        changed[o] = !anew && (lo.ghost_ids != local_objects[o].ghost_ids || lo.tets != local_objects[o].tets);
+        rebuilt = rebuilt || changed[o];
     }
     local_objects = std::move(next);
-    if (rebuilt) {
+    if (anew) {
         local.reset();
         auto fresh = std::make_unique<kdet::Detector>(options);
         for (std::size_t o = 0; o < objects.size(); ++o) {
@@ -492,9 +496,15 @@ std::string Detector::Impl::build_local(std::vector<TetRecord>& received, bool& 
         }
         local = std::move(fresh);
     } else {
-        for (std::size_t o = 0; o < objects.size(); ++o)
-            local->set_positions(static_cast<ObjectId>(o), local_objects[o].positions.data(),
-                                 local_objects[o].positions.size() / 3);
+        // An object whose tets changed is updated in place: its switches stay, the others are untouched.
+        for (std::size_t o = 0; o < objects.size(); ++o) {
+            const LocalObject& lo = local_objects[o];
+            const PositionsView xyz{lo.positions.data(), false, lo.positions.size() / 3, 3, 1};
+            if (changed[o])
+                local->set_tets(static_cast<ObjectId>(o), lo.tets.data(), lo.tets.size() / 4, xyz);
+            else
+                local->set_positions(static_cast<ObjectId>(o), xyz);
+        }
     }
     return {};
 }

@@ -303,8 +303,8 @@ struct Detector::Impl {
                             std::uint32_t vertex_count, int rings) const {
         if (rings == 0) return {};
         const std::uint32_t first = scene.object_tet_begin[object];
-        return ring_exclusions(scene.tets.data() + first, scene.object_tet_begin[object + 1] - first, first_vertex,
-                               vertex_count, rings, object, host_threads());
+        return pipeline->ring_exclusions(scene.tets.data() + first, scene.object_tet_begin[object + 1] - first, first_vertex,
+                                         vertex_count, rings, object);
     }
 
     /// Replaces an object's vertices and tets by checked ones (prepare_edit() done).
@@ -455,6 +455,7 @@ void Detector::set_self_exclusion_rings(ObjectId object, int rings) {
         throw Error("object " + std::to_string(object) + ": exclusion rings " + std::to_string(rings) + " out of range [0, " +
                     std::to_string(max_exclusion_rings) + "]");
     if (rings == d.filters.rings(object)) return;
+    if (d.frame_pending) finish(); // the lists are built on the pipeline's backend, after its frame
     const std::uint32_t first = d.object_vertex_begin[object];
     ExclusionLists lists = d.rings_of(d.topology, object, first, d.object_vertex_begin[object + 1] - first, rings);
     d.filters.check_room(lists.partners.size(), d.filters.ring_ids(object));
@@ -475,7 +476,7 @@ std::size_t Detector::exclude_rest_contacts(ObjectId object, ObjectId other) {
     d.prepare_edit(*this);
     const ObjectId a = std::min(object, other), b = std::max(object, other);
     const std::vector<std::uint64_t> keys = d.colliding_now(a, b);
-    d.filters.check_room(2 * keys.size());
+    d.filters.check_room(keys.size());
     d.filters.add_rest_pairs(a, b, keys);
     return keys.size();
 }

@@ -11,26 +11,60 @@
 
 namespace kdet {
 
-/// @brief Stage 2: inserts each relevant tet into every cell its box overlaps on its layer. Once an
-/// insert has failed (the table must grow), the remaining tets give up at once: the pass reruns anyway.
+/// @brief Stage 2's populate step, written once for every hashed grid and parameterised by what the
+/// grid stores for a (cell, tet): per tet t that Store::place puts on a layer (its box and that layer;
+/// false: not gridded), Store::open sees the range of cells its box overlaps there (false: the tet is
+/// kept another way), Store::add keeps one (cell, tet) per cell of the range (false: stop) and
+/// Store::close ends the tet. Store::Tet is what one tet's steps share.
+template <class Store>
 struct PopulateKernel {
-    SceneView scene;
-    GridView grid;
-    const GridParams* params; ///< GridParamsKernel's
+    Store store;
 
     KDET_HD void operator()(std::uint64_t t) const {
-        const TetInfo& info = scene.info[t];
-        if (info.layer < 0 || atomic_load_acquire(grid.failure)) return;
-        const CellRange r = cell_range(*params, info.box, info.layer);
-        const bool own_cells = has_own_cells(r);
-        for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-            const std::uint32_t bucket =
-                grid_insert(grid, make_cell(x, y, z, info.layer), static_cast<std::uint32_t>(t), first_cell_axes(r, x, y, z));
-            if (bucket == no_bucket) return false;
-            if (own_cells) grid.own_cells[t].bucket[own_cell_index(r, x, y, z)] = bucket;
-            return true;
-        });
+        Aabb box;
+        int layer;
+        if (!store.place(t, box, layer)) return;
+        const CellRange r = cell_range(store.params(), box, layer);
+        typename Store::Tet tet;
+        if (!store.open(t, r, layer, tet)) return;
+        if (for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) { return store.add(tet, x, y, z); }))
+            store.close(tet);
     }
+};
+
+/// @brief What the collision grid stores: each relevant tet in the hash table's bucket of every cell
+/// its box overlaps on its layer (and those buckets, for a tet with cells of its own). Once an insert
+/// has failed (the table must grow), the remaining tets give up at once: the pass reruns anyway.
+struct TableCells {
+    SceneView scene;
+    GridView grid;
+    const GridParams* grid_params; ///< GridParamsKernel's
+
+    struct Tet {
+        std::uint32_t id;
+        int layer;
+        CellRange range;
+        bool own_cells;
+    };
+    KDET_HD const GridParams& params() const { return *grid_params; }
+    KDET_HD bool place(std::uint64_t t, Aabb& box, int& layer) const {
+        const TetInfo& info = scene.info[t];
+        if (info.layer < 0 || atomic_load_acquire(grid.failure)) return false;
+        box = info.box;
+        layer = info.layer;
+        return true;
+    }
+    KDET_HD bool open(std::uint64_t t, const CellRange& r, int layer, Tet& tet) const {
+        tet = Tet{static_cast<std::uint32_t>(t), layer, r, has_own_cells(r)};
+        return true;
+    }
+    KDET_HD bool add(Tet& tet, std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
+        const std::uint32_t bucket = grid_insert(grid, make_cell(x, y, z, tet.layer), tet.id, first_cell_axes(tet.range, x, y, z));
+        if (bucket == no_bucket) return false;
+        if (tet.own_cells) grid.own_cells[tet.id].bucket[own_cell_index(tet.range, x, y, z)] = bucket;
+        return true;
+    }
+    KDET_HD void close(Tet&) const {}
 };
 
 /// @brief Stage 2, after populating: one work item per main bucket, the i-th for the cell claimed

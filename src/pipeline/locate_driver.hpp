@@ -82,7 +82,7 @@ public:
     }
 
     std::size_t memory_bytes() const {
-        return points_.capacity_bytes() + order_.capacity_bytes() + held_.capacity_bytes() + boxes_.capacity_bytes() + entry_boxes_.capacity_bytes() + keys_.capacity_bytes() +
+        return points_.capacity_bytes() + sorted_points_.capacity_bytes() + order_.capacity_bytes() + held_.capacity_bytes() + boxes_.capacity_bytes() + orientation_.capacity_bytes() + entry_boxes_.capacity_bytes() + keys_.capacity_bytes() +
                slot_begin_.capacity_bytes() + slot_end_.capacity_bytes() + big_.capacity_bytes() + hits_.capacity_bytes() + hits_grown_.capacity_bytes() +
                offsets_.capacity_bytes() + objects_.capacity_bytes() + tets_.capacity_bytes() + barycentrics_.capacity_bytes() +
                closest_points_.capacity_bytes() + distances_.capacity_bytes() + counters_.capacity_bytes();
@@ -135,9 +135,10 @@ private:
     LocateGridView build_grid(Exec& exec, const LocateScene& scene, const LocateRequest& request, HashFunction hash) {
         const std::uint32_t count = request.tet_count;
         boxes_.resize_discard(count);
+        orientation_.resize_discard(count);
         big_.resize_discard(std::max<std::uint32_t>(count, 1));
         LocateCounters* c = counters_.data();
-        exec.for_each(count, LocateTetBoxesKernel{scene.positions, scene.tets, request.first_tet, boxes_.data(), c});
+        exec.for_each(count, LocateTetBoxesKernel{scene.positions, scene.tets, request.first_tet, boxes_.data(), orientation_.data(), c});
         const LocateCounters sizes = read_counters(exec);
         GridParams params{};
         std::uint32_t slot_bits = 10;
@@ -171,7 +172,7 @@ private:
         if (keys_.size() < std::size_t{4} * count) keys_.resize_discard(std::size_t{4} * count);
         for (;;) {
             const KeyAppender out{keys_.data(), keys_.size(), &c->entries, nullptr};
-            exec.for_each(count, LocateInsertKernel{boxes_.data(), params, hash, slot_bits, out, big_.data(), c});
+            exec.for_each(count, PopulateKernel<LocateCells>{LocateCells{boxes_.data(), params, hash, slot_bits, out, big_.data(), c}});
             const LocateCounters inserted = read_counters(exec);
             if (inserted.entries <= keys_.size()) {
                 entries_ = inserted.entries;
@@ -195,7 +196,7 @@ private:
         exec.for_each(entries_, LocateSlotRunsKernel{keys_.data(), entries_, slot_begin_.data(), slot_end_.data()});
         entry_boxes_.resize_discard(std::max<std::uint64_t>(entries_, 1));
         exec.for_each(entries_, LocateEntryBoxesKernel{keys_.data(), boxes_.data(), entry_boxes_.data()});
-        return LocateGridView{scene.positions, scene.tets, scene.user_id, request.first_tet, boxes_.data(), keys_.data(),
+        return LocateGridView{scene.positions, scene.tets, scene.user_id, request.first_tet, boxes_.data(), orientation_.data(), keys_.data(),
                               entry_boxes_.data(), entries_, slot_begin_.data(), slot_end_.data(), big_.data(), big_count_, params, hash,
                               slot_bits, layer_mask_};
     }
@@ -207,12 +208,15 @@ private:
                         bytes_text(wanted * sizeof(std::uint64_t)));
     }
 
-    /// The order the queries run in: the points sorted along a Morton curve (LocatePointOrderKernel).
+    /// The order the queries run in: the points sorted along a Morton curve (LocatePointOrderKernel),
+    /// and their coordinates in that order.
     void order_points(Exec& exec, std::size_t n) {
         order_.resize_discard(std::max<std::size_t>(n, 1));
         exec.for_each(n, LocatePointOrderKernel{points_.data(), order_lo_, order_scale_, order_.data()});
         exec.sort(order_.data(), n, &counters_.data()->points, 62,
                   high_word_key_bits(std::max<std::uint64_t>(n, 1)) - 32);
+        sorted_points_.resize_discard(n);
+        exec.for_each(n, LocateSortedPointsKernel{points_.data(), order_.data(), sorted_points_.data()});
     }
 
     /// The hits' keys, sorted: the tets that hold each point, then, for `within`, the nearest tet of
@@ -222,7 +226,7 @@ private:
         if (hits_.size() < n + 1024) hits_.resize_discard(n + 1024);
         for (;;) {
             const KeyAppender out{hits_.data(), hits_.size(), &c->hits, nullptr};
-            exec.for_each(n, LocateContainingKernel{grid, points_.data(), order_.data(), out, held_.data()});
+            exec.for_each(n, LocateContainingKernel{grid, sorted_points_.data(), order_.data(), out, held_.data()});
             const LocateCounters found = read_counters(exec);
             hit_count_ = found.hits;
             if (found.hits <= hits_.size()) break;
@@ -239,7 +243,7 @@ private:
                 hits_.swap(hits_grown_);
             }
             const KeyAppender out{hits_.data(), hits_.size(), &c->hits, nullptr};
-            exec.for_each(n, LocateNearestKernel{grid, points_.data(), order_.data(), held_.data(), within, out});
+            exec.for_each(n, LocateNearestKernel{grid, sorted_points_.data(), order_.data(), held_.data(), within, out});
             hit_count_ = read_counters(exec).hits;
         }
         const auto points = static_cast<std::uint32_t>(n);
@@ -263,9 +267,11 @@ private:
     }
 
     buffer<vec3> points_;
+    buffer<vec3> sorted_points_; ///< per query
     buffer<std::uint64_t> order_; ///< the points' keys in the order the queries run
     buffer<std::uint8_t> held_;
     buffer<Aabb> boxes_;
+    buffer<std::int8_t> orientation_;
     buffer<Aabb> entry_boxes_;
     buffer<std::uint64_t> keys_;
     buffer<std::uint32_t> slot_begin_, slot_end_;

@@ -15,91 +15,7 @@ std::string too_many_ids(std::uint64_t ids) {
     return "exclusions would hold " + std::to_string(ids) + " tet ids, more than " + std::to_string(max_exclusion_ids);
 }
 
-/// One thread's marks for the rings around one tet at a time: a vertex or tet is marked for tet t
-/// when its stamp is t + 1, so nothing is cleared between tets.
-struct RingScratch {
-    std::vector<std::uint32_t> vertex_stamp, tet_stamp, frontier, next;
-    RingScratch(std::uint32_t vertices, std::uint32_t tets) : vertex_stamp(vertices, 0), tet_stamp(tets, 0) {}
-};
-
-/// The tets around tet t as ring_exclusions() defines them, sorted, into `out`.
-void ring_partners(const TetIndices* tets, std::uint32_t first_vertex, const std::vector<std::uint32_t>& vertex_begin,
-                   const std::vector<std::uint32_t>& vertex_tets, int rings, std::uint32_t t, RingScratch& s,
-                   std::vector<std::uint32_t>& out) {
-    const std::uint32_t stamp = t + 1;
-    out.clear();
-    s.frontier.clear();
-    for (std::uint32_t v : tets[t].v) {
-        v -= first_vertex;
-        if (s.vertex_stamp[v] != stamp) s.vertex_stamp[v] = stamp, s.frontier.push_back(v);
-    }
-    // Tets sharing a vertex with t are left out already: marked, not listed.
-    for (std::uint32_t v : s.frontier)
-        for (std::uint32_t i = vertex_begin[v]; i < vertex_begin[v + 1]; ++i) s.tet_stamp[vertex_tets[i]] = stamp;
-    for (int ring = 0; ring < rings; ++ring) {
-        s.next.clear();
-        for (std::uint32_t v : s.frontier)
-            for (std::uint32_t i = vertex_begin[v]; i < vertex_begin[v + 1]; ++i)
-                for (std::uint32_t x : tets[vertex_tets[i]].v) {
-                    x -= first_vertex;
-                    if (s.vertex_stamp[x] != stamp) s.vertex_stamp[x] = stamp, s.next.push_back(x);
-                }
-        for (std::uint32_t v : s.next)
-            for (std::uint32_t i = vertex_begin[v]; i < vertex_begin[v + 1]; ++i) {
-                const std::uint32_t u = vertex_tets[i];
-                if (s.tet_stamp[u] != stamp) s.tet_stamp[u] = stamp, out.push_back(u);
-            }
-        s.frontier.swap(s.next);
-    }
-    std::sort(out.begin(), out.end());
-}
-
 } // namespace
-
-ExclusionLists ring_exclusions(const TetIndices* tets, std::uint32_t tet_count, std::uint32_t first_vertex,
-                               std::uint32_t vertex_count, int rings, std::uint32_t object, int threads) {
-    // Each vertex's tets, as a compressed row array.
-    std::vector<std::uint32_t> vertex_begin(std::size_t{vertex_count} + 1, 0), vertex_tets(4 * std::size_t{tet_count});
-    for (std::uint32_t t = 0; t < tet_count; ++t)
-        for (std::uint32_t v : tets[t].v) ++vertex_begin[v - first_vertex + 1];
-    for (std::uint32_t v = 0; v < vertex_count; ++v) vertex_begin[v + 1] += vertex_begin[v];
-    {
-        std::vector<std::uint32_t> cursor(vertex_begin.begin(), vertex_begin.end() - 1);
-        for (std::uint32_t t = 0; t < tet_count; ++t)
-            for (std::uint32_t v : tets[t].v) vertex_tets[cursor[v - first_vertex]++] = t;
-    }
-    // Two passes over the tets, each list found on its own: one counts, one writes in place.
-    ExclusionLists lists;
-    lists.begin.assign(std::size_t{tet_count} + 1, 0);
-    const auto n = static_cast<std::ptrdiff_t>(tet_count);
-    for (int pass = 0; pass < 2; ++pass) {
-#pragma omp parallel num_threads(threads)
-        {
-            RingScratch scratch(vertex_count, tet_count);
-            std::vector<std::uint32_t> found;
-#pragma omp for schedule(dynamic, 64)
-            for (std::ptrdiff_t i = 0; i < n; ++i) {
-                const auto t = static_cast<std::uint32_t>(i);
-                ring_partners(tets, first_vertex, vertex_begin, vertex_tets, rings, t, scratch, found);
-                if (pass == 0)
-                    lists.begin[t + 1] = static_cast<std::uint32_t>(found.size());
-                else
-                    std::copy(found.begin(), found.end(), lists.partners.begin() + lists.begin[t]);
-            }
-        }
-        if (pass == 1) break;
-        std::uint64_t total = 0;
-        for (std::uint32_t t = 0; t < tet_count; ++t) {
-            total += lists.begin[t + 1];
-            if (total > max_exclusion_ids)
-                throw Error("object " + std::to_string(object) + ": " + std::to_string(rings) + " exclusion rings: " +
-                            too_many_ids(total));
-            lists.begin[t + 1] = static_cast<std::uint32_t>(total);
-        }
-        lists.partners.resize(total);
-    }
-    return lists;
-}
 
 void ObjectFilters::add_object(std::vector<std::uint8_t>& pair_enabled) {
     group_.push_back(1);
@@ -165,7 +81,7 @@ void ObjectFilters::forget_tets(std::uint32_t object) {
 std::uint64_t ObjectFilters::entries() const {
     std::uint64_t ids = 0;
     for (const ExclusionLists& lists : ring_lists_) ids += lists.partners.size();
-    for (const auto& pairs : rest_pairs_) ids += 2 * pairs.second.size();
+    for (const auto& pairs : rest_pairs_) ids += pairs.second.size();
     return ids;
 }
 
@@ -179,18 +95,21 @@ ExclusionLists ObjectFilters::exclusions(const std::vector<std::uint32_t>& objec
     ExclusionLists out;
     if (entries() == 0) return out;
     const std::uint32_t tets = object_first.back();
-    // Per tet: its ring partners, then its rest partners (in either role), which may repeat a ring
-    // partner and come in no order; each tet's list is sorted and made unique afterwards.
+    // Per tet: its ring partners (later tets of its object, whose stored tets keep their order), then
+    // the rest partners of which it is the lower tet, which may repeat a ring partner and come in no
+    // order; each tet's list is sorted and made unique afterwards.
+    const auto lower = [&](const std::pair<std::uint32_t, std::uint32_t>& objects, std::uint64_t key) {
+        const std::uint32_t t = object_first[objects.first] + static_cast<std::uint32_t>(key >> 32);
+        const std::uint32_t u = object_first[objects.second] + static_cast<std::uint32_t>(key);
+        return t < u ? std::make_pair(t, u) : std::make_pair(u, t);
+    };
     std::vector<std::uint32_t> count(std::size_t{tets} + 1, 0);
     for (std::size_t o = 0; o < ring_lists_.size(); ++o) {
         const std::vector<std::uint32_t>& begin = ring_lists_[o].begin;
         for (std::size_t t = 0; t + 1 < begin.size(); ++t) count[object_first[o] + t + 1] += begin[t + 1] - begin[t];
     }
     for (const auto& [objects, keys] : rest_pairs_)
-        for (const std::uint64_t key : keys) {
-            ++count[object_first[objects.first] + static_cast<std::uint32_t>(key >> 32) + 1];
-            ++count[object_first[objects.second] + static_cast<std::uint32_t>(key) + 1];
-        }
+        for (const std::uint64_t key : keys) ++count[lower(objects, key).first + 1];
     for (std::uint32_t t = 0; t < tets; ++t) count[t + 1] += count[t];
     std::vector<std::uint32_t> partners(count[tets]), cursor(count.begin(), count.end() - 1);
     for (std::size_t o = 0; o < ring_lists_.size(); ++o) {
@@ -202,10 +121,8 @@ ExclusionLists ObjectFilters::exclusions(const std::vector<std::uint32_t>& objec
     }
     for (const auto& [objects, keys] : rest_pairs_)
         for (const std::uint64_t key : keys) {
-            const std::uint32_t t = object_first[objects.first] + static_cast<std::uint32_t>(key >> 32);
-            const std::uint32_t u = object_first[objects.second] + static_cast<std::uint32_t>(key);
+            const auto [t, u] = lower(objects, key);
             partners[cursor[t]++] = u;
-            partners[cursor[u]++] = t;
         }
     out.begin.assign(std::size_t{tets} + 1, 0);
     out.partners.reserve(partners.size());

@@ -15,13 +15,6 @@
 
 namespace kdet {
 
-/// @brief Per tet of one object's `tet_count` stored tets (ids local to the object; their vertices
-/// numbered from `first_vertex`, `vertex_count` of them), the sorted local ids of the tets that share
-/// no vertex with it but have a vertex within `rings` mesh edges of one of its vertices, found on
-/// `threads` threads. Throws kdet::Error naming `object` when the lists hold more than 2^32 - 1 ids.
-ExclusionLists ring_exclusions(const TetIndices* tets, std::uint32_t tet_count, std::uint32_t first_vertex,
-                               std::uint32_t vertex_count, int rings, std::uint32_t object, int threads);
-
 class ObjectFilters {
 public:
     /// @brief The filters of a new object (group 1, every mask bit): its row and column of the
@@ -35,7 +28,8 @@ public:
     std::uint32_t group(std::uint32_t object) const { return group_[object]; }
     std::uint32_t mask(std::uint32_t object) const { return mask_[object]; }
 
-    /// @brief An object's rings and its lists (ring_exclusions(), local ids); 0 rings and no lists for none.
+    /// @brief An object's rings and its lists (PipelineBase::ring_exclusions(), local ids); 0 rings and no
+    /// lists for none.
     void set_rings(std::uint32_t object, int rings, ExclusionLists lists);
     int rings(std::uint32_t object) const { return rings_[object]; }
     /// @brief The ids an object's ring lists hold.
@@ -54,7 +48,8 @@ public:
     /// @brief Whether exclusions() changed since it was last called.
     bool exclusions_changed() const { return changed_; }
     /// @brief Every exclusion in stored ids of a pipeline whose objects' tets begin at `object_first`
-    /// (PipelineBase::object_first_tets(): each object's tets together, the tet count last).
+    /// (PipelineBase::object_first_tets(): each object's tets together, the tet count last), each pair
+    /// listed under its lower stored id only.
     ExclusionLists exclusions(const std::vector<std::uint32_t>& object_first);
 
 private:

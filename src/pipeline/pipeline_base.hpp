@@ -68,9 +68,9 @@ struct SceneTopology {
                                        std::size_t tet_count, int threads = 1) const;
 };
 
-/// @brief Per stored tet, the sorted stored ids of the tets it is never paired with beyond shared
-/// vertices (pair_exclusions.hpp): a compressed row array, begin[t] to begin[t + 1] indexing
-/// partners; empty when nothing is excluded.
+/// @brief Per stored tet, the sorted stored ids of the later tets it is never paired with beyond
+/// shared vertices (pair_exclusions.hpp: each pair under its lower tet): a compressed row array,
+/// begin[t] to begin[t + 1] indexing partners; empty when nothing is excluded.
 struct ExclusionLists {
     std::vector<std::uint32_t> begin;
     std::vector<std::uint32_t> partners;
@@ -113,6 +113,10 @@ public:
     /// @brief Replaces the pairs excluded beyond shared vertices (pair_exclusions.hpp), in the stored
     /// ids object_first_tets() numbers; set again after every set_topology(), which clears them.
     virtual void set_exclusions(const ExclusionLists& lists) = 0;
+    /// @brief One object's self-exclusion rings, built on this pipeline's backend
+    /// (build_ring_exclusions in exclusion_rings.hpp); uses none of the pipeline's state.
+    virtual ExclusionLists ring_exclusions(const TetIndices* tets, std::uint32_t tet_count, std::uint32_t first_vertex,
+                                           std::uint32_t vertex_count, int rings, std::uint32_t object) const = 0;
     /// @brief Per object, the id of its first tet as this pipeline stores them, then the tet count:
     /// the given topology's order, or its static objects' tets moved behind (static_last); each
     /// object's tets stay together and in their order either way.

@@ -13,6 +13,7 @@
 #include "pipeline/bounding_boxes.hpp"
 #include "pipeline/capacity.hpp"
 #include "pipeline/candidate_search.hpp"
+#include "pipeline/exclusion_rings.hpp"
 #include "pipeline/frame_counters.hpp"
 #include "pipeline/grid_populate.hpp"
 #include "pipeline/grid_sizing.hpp"
@@ -99,6 +100,11 @@ public:
         exec_.upload(exclusion_begin_.data(), lists.begin.data(), exclusion_begin_.size());
         excluded_.resize_discard(lists.partners.size());
         exec_.upload(excluded_.data(), lists.partners.data(), lists.partners.size());
+    }
+
+    ExclusionLists ring_exclusions(const TetIndices* tets, std::uint32_t tet_count, std::uint32_t first_vertex,
+                                   std::uint32_t vertex_count, int rings, std::uint32_t object) const override {
+        return build_ring_exclusions(exec_, tets, tet_count, first_vertex, vertex_count, rings, object);
     }
 
     const std::vector<std::uint32_t>& object_first_tets() const override { return object_first_; }

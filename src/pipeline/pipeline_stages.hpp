@@ -128,7 +128,7 @@ GridView Pipeline<Exec>::populate() {
                         block_bounds_.data(), own_cells_.data(), &c->grid_entries, entry_capacity_,
                         &c->overflow_used, &c->grid_failure, &c->cells_claimed, claimed_slots_.data(), slot_count_, slot_bits, capacity,
                         overflow_capacity_, stamp_, 64u, options_.hash};
-    exec_.for_each_in_runs(frame_tets_, PopulateKernel{scene_view(), grid, &c->params});
+    exec_.for_each_in_runs(frame_tets_, PopulateKernel<TableCells>{TableCells{scene_view(), grid, &c->params}});
     exec_.for_each(slot_count_, GatherCellsKernel{scene_view(), grid});
     exec_.sort_lists(list_keys_.data(), sorted_keys_.data(), entry_capacity_, list_begin_.data(), list_end_.data(), slot_count_);
     exec_.for_each(entry_capacity_, PlaceEntriesKernel{scene_view(), grid, sorted_keys_.data()});

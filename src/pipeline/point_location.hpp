@@ -6,7 +6,8 @@
 ///
 /// The grid is the hierarchical one of the collision pipeline (grid_math.hpp: layer l has cell size
 /// c0 * 2^l, a tet goes to the layer whose cells its box's extent fits, so it spans at most two cells
-/// per axis), stored for queries by points instead of tets: each (cell slot, tet) is one 64-bit key,
+/// per axis), filled by the pipeline's populate step (PopulateKernel) and stored for queries by points
+/// instead of tets: each (cell slot, tet) is one 64-bit key,
 /// sorted, and a table gives each slot's run of keys. A point visits one cell per occupied layer;
 /// a box (a point grown by `within`) the cells it overlaps. Cells whose hashes share a slot only add
 /// candidates: every candidate passes a box test and the exact test.
@@ -15,6 +16,7 @@
 #include "geometry/point_tet.hpp"
 #include "grid/grid_math.hpp"
 #include "pipeline/bounding_boxes.hpp"
+#include "pipeline/grid_populate.hpp"
 #include "pipeline/pair_keys.hpp"
 #include "pipeline/scene_view.hpp"
 
@@ -43,19 +45,21 @@ KDET_HD inline float box_extent(const Aabb& b) {
     return max_f(b.hi.x - b.lo.x, max_f(b.hi.y - b.lo.y, b.hi.z - b.lo.z));
 }
 
-/// @brief Per located tet (stored tets first .. first + count): its box, the histogram of extents and
-/// the region.
+/// @brief Per located tet (stored tets first .. first + count): its box and orientation (each query
+/// that tests the tet reads it instead of computing it), the histogram of extents and the region.
 struct LocateTetBoxesKernel {
     const vec3* positions;
     const TetIndices* tets;
     std::uint32_t first;
     Aabb* boxes; ///< per located tet
+    std::int8_t* orientation; ///< per located tet: point_query::orient3d_sign of its vertices
     LocateCounters* counters;
     KDET_HD void operator()(std::uint64_t i) const {
         vec3 v[4];
         for (int k = 0; k < 4; ++k) v[k] = positions[tets[first + i].v[k]];
         const Aabb box = tet_box(v);
         boxes[i] = box;
+        orientation[i] = static_cast<std::int8_t>(point_query::orient3d_sign(v[0], v[1], v[2], v[3]));
         atomic_fetch_add_gathered(&counters->octaves[float_octave(box_extent(box))], 1u);
         const float lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
         for (int a = 0; a < 3; ++a) {
@@ -74,35 +78,52 @@ KDET_HD inline std::uint32_t locate_slot(HashFunction hash, std::uint32_t x, std
     return table_slot(hash_cell(hash, make_cell(x, y, z, layer), 0u), slot_bits);
 }
 
-/// @brief Per located tet: a key (slot << 32 | tet) per cell its box overlaps on its layer, or, when it
-/// spans more than two cells along an axis there (larger than the top layer's cells), its index in
-/// the list that every query scans.
-struct LocateInsertKernel {
+/// @brief What point location's grid stores (run by the populate step, PopulateKernel): per located
+/// tet, on the layer its box's extent picks, a key (slot << 32 | tet) per cell its box overlaps, or,
+/// when it spans more than two cells along an axis there (larger than the top layer's cells), its
+/// index in the list that every query scans.
+struct LocateCells {
     const Aabb* boxes;
-    GridParams params;
+    GridParams grid;
     HashFunction hash;
     std::uint32_t slot_bits;
     KeyAppender out;
     std::uint32_t* big; ///< [located tets]
     LocateCounters* counters;
-    KDET_HD void operator()(std::uint64_t i) const {
-        const Aabb box = boxes[i];
-        const int layer = layer_of(params, box_extent(box));
-        const CellRange r = cell_range(params, box, layer);
+
+    struct Tet {
+        std::uint64_t keys[8];
+        std::uint32_t count;
+        std::uint32_t id;
+        int layer;
+    };
+    KDET_HD const GridParams& params() const { return grid; }
+    KDET_HD bool place(std::uint64_t i, Aabb& box, int& layer) const {
+        box = boxes[i];
+        layer = layer_of(grid, box_extent(box));
+        return true;
+    }
+    KDET_HD bool open(std::uint64_t i, const CellRange& r, int layer, Tet& tet) const {
         if (r.hi[0] - r.lo[0] > 1u || r.hi[1] - r.lo[1] > 1u || r.hi[2] - r.lo[2] > 1u) {
             big[atomic_fetch_add(&counters->big_count, 1u)] = static_cast<std::uint32_t>(i);
-            return;
+            return false;
         }
         const std::uint32_t bit = 1u << layer;
         if (!(atomic_load_acquire(&counters->layer_mask) & bit)) atomic_fetch_or(&counters->layer_mask, bit);
-        std::uint64_t keys[8];
-        std::uint32_t n = 0;
-        for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-            keys[n++] = static_cast<std::uint64_t>(locate_slot(hash, x, y, z, layer, slot_bits)) << 32 | i;
-            return true;
-        });
-        out.write(keys, n);
+        tet.count = 0;
+        tet.id = static_cast<std::uint32_t>(i);
+        tet.layer = layer;
+        return true;
     }
+    KDET_HD bool add(Tet& tet, std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
+        // Two of a tet's cells that share a slot keep one key: a query scans each slot's keys once.
+        const std::uint64_t key = static_cast<std::uint64_t>(locate_slot(hash, x, y, z, tet.layer, slot_bits)) << 32 | tet.id;
+        for (std::uint32_t k = 0; k < tet.count; ++k)
+            if (tet.keys[k] == key) return true;
+        tet.keys[tet.count++] = key;
+        return true;
+    }
+    KDET_HD void close(Tet& tet) const { out.write(tet.keys, tet.count); }
 };
 
 /// @brief After the keys are sorted: the run of keys of each slot, [begin, end) (both 0 for a slot
@@ -135,6 +156,7 @@ struct LocateGridView {
     const std::uint32_t* user_id; ///< stored tet -> the caller's global id
     std::uint32_t first;          ///< stored id of located tet 0
     const Aabb* boxes;
+    const std::int8_t* orientation; ///< per located tet
     const std::uint64_t* keys;
     const Aabb* entry_boxes; ///< the box of each key's tet
     std::uint64_t key_count;
@@ -164,16 +186,13 @@ KDET_HD inline void locate_candidates(const LocateGridView& g, const Aabb& box, 
         const std::uint64_t cells = std::uint64_t{r.hi[0] - r.lo[0] + 1} * (r.hi[1] - r.lo[1] + 1) * (r.hi[2] - r.lo[2] + 1);
         if (cells > slots) {
             for (std::uint64_t k = 0; k < g.key_count; ++k)
-                if (k == 0 || g.keys[k] != g.keys[k - 1])
-                    try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), g.entry_boxes[k], -1);
+                try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), g.entry_boxes[k], -1);
             break;
         }
         for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
             const std::uint32_t slot = locate_slot(g.hash, x, y, z, layer, g.slot_bits);
-            // A tet in two cells of one slot has two equal keys, side by side once sorted.
             for (std::uint32_t k = g.begin[slot], e = g.end[slot]; k < e; ++k)
-                if (k == g.begin[slot] || g.keys[k] != g.keys[k - 1])
-                    try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), g.entry_boxes[k], layer);
+                try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), g.entry_boxes[k], layer);
             return true;
         });
     }
@@ -209,13 +228,22 @@ struct LocatePointOrderKernel {
     }
 };
 
-/// @brief Per point: a hit for every tet that holds it (exactly), and whether it has one.
+/// @brief Per query (item): its point's coordinates, copied from the caller's order into the queries'
+/// (one pass whose reads overlap, where each query's read of its point waited on memory).
+struct LocateSortedPointsKernel {
+    const vec3* points;
+    const std::uint64_t* order; ///< LocatePointOrderKernel's keys, sorted
+    vec3* sorted;
+    KDET_HD void operator()(std::uint64_t item) const { sorted[item] = points[key_second(order[item])]; }
+};
+
+/// @brief Per query: a hit for every tet that holds its point (exactly), and whether it has one.
 struct LocateContainingKernel {
     LocateGridView grid;
-    const vec3* points;
+    const vec3* points;         ///< per query (LocateSortedPointsKernel)
     const std::uint64_t* order; ///< LocatePointOrderKernel's keys, sorted: item i queries point key_second(order[i])
     KeyAppender out;
-    std::uint8_t* held; ///< per point
+    std::uint8_t* held; ///< per query
     struct Visit {
         const LocateGridView* grid;
         vec3 p;
@@ -227,19 +255,19 @@ struct LocateContainingKernel {
             vec3 v[4];
             load_located(*grid, stored, v);
             point_query::PointTetSigns signs;
-            if (!point_query::tet_holds_point(v, p, signs)) return;
+            if (!point_query::tet_holds_point(v, p, grid->orientation[t], signs)) return;
             batch->push(hit_key(point, grid->user_id[stored]));
             ++hits;
         }
     };
     KDET_HD void operator()(std::uint64_t item) const {
         const std::uint32_t i = key_second(order[item]);
-        const vec3 p = points[i];
+        const vec3 p = points[item];
         KeyBatch batch(&out);
         Visit visit{&grid, p, i, &batch, 0};
         locate_candidates(grid, Aabb{p, p}, visit);
         batch.flush();
-        held[i] = visit.hits > 0 ? 1 : 0;
+        held[item] = visit.hits > 0 ? 1 : 0;
     }
 };
 
@@ -262,9 +290,9 @@ KDET_HD inline float grown_up(float x, double d) {
 /// smaller global id on a tie), if any.
 struct LocateNearestKernel {
     LocateGridView grid;
-    const vec3* points;
+    const vec3* points;         ///< as LocateContainingKernel's
     const std::uint64_t* order; ///< as LocateContainingKernel's
-    const std::uint8_t* held;
+    const std::uint8_t* held;   ///< per query
     double within;
     KeyAppender out;
     struct Visit {
@@ -285,9 +313,9 @@ struct LocateNearestKernel {
         }
     };
     KDET_HD void operator()(std::uint64_t item) const {
+        if (held[item]) return;
         const std::uint32_t i = key_second(order[item]);
-        if (held[i]) return;
-        const vec3 p = points[i];
+        const vec3 p = points[item];
         const Aabb box{{grown_down(p.x, within), grown_down(p.y, within), grown_down(p.z, within)},
                        {grown_up(p.x, within), grown_up(p.y, within), grown_up(p.z, within)}};
         Visit visit{&grid, p, within, 0xffffffffu};

@@ -14,7 +14,8 @@
 namespace kdet::scenes {
 
 /// @brief Objects with rest meshes (one mesh shared by the objects that are alike), a motion that gives
-/// each object's positions at a frame, and which objects are static and self-collide.
+/// each object's positions at a frame, which objects are static and self-collide, and their collision
+/// filters (none unless set_filters() gives them).
 class GeneratedScene final : public Scene {
 public:
     /// @brief Writes object `o`'s vertex positions at `frame` as x y z doubles into `out` (resized).
@@ -48,6 +49,11 @@ public:
         positions(object, frame, exact);
         out.assign(exact.begin(), exact.end());
     }
+    /// @brief Object o's collision filter becomes filters[o].
+    void set_filters(std::vector<CollisionFilter> filters) { filters_ = std::move(filters); }
+    CollisionFilter collision_filter(std::size_t object) const override {
+        return object < filters_.size() ? filters_[object] : CollisionFilter{};
+    }
     bool checks_self(std::size_t object) const override { return object < self_.size() && self_[object]; }
     bool is_static(std::size_t object) const override { return object < static_.size() && static_[object]; }
 
@@ -65,6 +71,7 @@ private:
     std::vector<TetMesh> meshes_;
     std::vector<std::size_t> mesh_of_;
     std::vector<bool> static_, self_;
+    std::vector<CollisionFilter> filters_;
     Motion motion_;
 };
 

@@ -74,9 +74,19 @@ std::unique_ptr<Scene> make_heap_scene(int resolution) {
             out[3 * v + 2] = z + pz;
         }
     };
-    return std::make_unique<scenes::GeneratedScene>("heap", kFrames, std::vector<TetMesh>{std::move(floor), std::move(body)},
-                                                    std::move(mesh_of), std::move(is_static), std::vector<bool>(bodies + 1, false),
-                                                    std::move(motion));
+    // The floor keeps the default filter (group 1, every mask bit); a body is in its layer's group and
+    // collides with the floor and the other layers' group, so bodies side by side in one layer do not
+    // collide (as debris of one kind set not to collide with itself).
+    std::vector<CollisionFilter> filters(bodies + 1);
+    for (std::size_t b = 0; b < bodies; ++b) {
+        const std::uint32_t layer = static_cast<std::uint32_t>(b / side / side) % 2;
+        filters[b + 1] = CollisionFilter{2u << layer, 1u | (4u >> layer)};
+    }
+    auto scene = std::make_unique<scenes::GeneratedScene>("heap", kFrames, std::vector<TetMesh>{std::move(floor), std::move(body)},
+                                                          std::move(mesh_of), std::move(is_static),
+                                                          std::vector<bool>(bodies + 1, false), std::move(motion));
+    scene->set_filters(std::move(filters));
+    return scene;
 }
 
 } // namespace kdet

@@ -12,6 +12,9 @@ void add_scene_objects(Detector& detector, const Scene& scene, bool self) {
         const ObjectId id = detector.add_object(scene.rest_mesh(o));
         detector.set_self_collision(id, self);
         detector.set_static(id, scene.is_static(o));
+        const CollisionFilter filter = scene.collision_filter(o);
+        if (filter.group != CollisionFilter{}.group || filter.mask != CollisionFilter{}.mask)
+            detector.set_collision_filter(id, filter.group, filter.mask);
     }
     for (std::size_t a = 0; a < scene.num_objects(); ++a)
         for (std::size_t b = a + 1; b < scene.num_objects(); ++b)

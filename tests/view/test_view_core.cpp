@@ -323,6 +323,46 @@ std::vector<TetPair> reference_pairs(const Scene& scene, int frame, bool self) {
     return detector.detect().pairs;
 }
 
+TEST(ViewSession, ATornMeshFollowsTheScenesTetsFrameByFrame) {
+    ViewSource source;
+    source.scene = "tearing";
+    ViewSession session(source, DetectorOptions{}, false);
+    const Scene& scene = session.scene();
+    ASSERT_TRUE(scene.changes_tets());
+    std::vector<std::uint32_t> tets;
+    std::size_t previous = scene.rest_mesh(0).num_tets() + 1;
+    // Forward through the tear, then back to an earlier frame: the tets grow again.
+    for (int frame : {0, 17, 50, 95, 119, 40}) {
+        session.set_frame(frame);
+        const std::uint64_t topology = session.topology_version();
+        ASSERT_TRUE(session.update());
+        scene.tets(0, frame, tets);
+        EXPECT_EQ(session.mesh(0).tets, tets) << "frame " << frame;
+        if (frame != 40) {
+            EXPECT_LT(tets.size() / 4, previous) << "the slab loses tets by frame " << frame;
+        }
+        if (frame != 0) {
+            EXPECT_GT(session.topology_version(), topology) << "frame " << frame;
+        }
+        previous = tets.size() / 4;
+        TetMesh torn = scene.rest_mesh(0);
+        torn.tets = tets;
+        EXPECT_EQ(session.faces()[0].boundary, analyse_faces(torn).boundary) << "frame " << frame;
+        // The detector's pairs are those of a detector given this frame's tets from the start.
+        Detector reference(DetectorOptions{});
+        std::vector<float> xyz;
+        for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+            TetMesh mesh = scene.rest_mesh(o);
+            scene.tets(o, frame, mesh.tets);
+            const ObjectId id = reference.add_object(mesh);
+            scene.positions(o, frame, xyz);
+            reference.set_positions(id, xyz.data(), xyz.size() / 3);
+        }
+        EXPECT_EQ(session.result().pairs, reference.detect().pairs) << "frame " << frame;
+    }
+    EXPECT_EQ(session.mesh(1).tets, scene.rest_mesh(1).tets) << "the box keeps its tets";
+}
+
 TEST(ViewSession, ShowsTheDetectorsPairsForTheFrame) {
     ViewSession session(procedural(4000, 21), DetectorOptions{}, false);
     EXPECT_FALSE(session.has_result());

@@ -419,6 +419,42 @@ TEST(ViewRenderer, VertexBuffersAreUpdatedInPlace) {
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
+TEST(ViewRenderer, ATornMeshIsDrawnAsItsTetsChange) {
+    REQUIRE_GL();
+    ViewSource source;
+    source.scene = "tearing";
+    ViewSession session(source, DetectorOptions{}, false);
+    Renderer renderer;
+    OffscreenTarget target(200, 150, 1);
+    const auto picture = [&](const Renderer& r) {
+        target.bind();
+        r.draw(camera_for(session.positions(), 200, 150), 0, 0, 200, 150, DisplaySettings{}, Bounds{});
+        return target.read_rgb();
+    };
+    std::vector<std::uint32_t> tets;
+    std::size_t previous = 0;
+    for (int frame : {0, 30, 60, 90, 119, 45}) {
+        session.set_frame(frame);
+        session.update();
+        renderer.update(session);
+        // The surface drawn is that of this frame's tets, not the slab as it was.
+        TetMesh torn = session.scene().rest_mesh(0);
+        session.scene().tets(0, frame, tets);
+        torn.tets = tets;
+        const std::size_t triangles = analyse_faces(torn).boundary.size() / 3;
+        EXPECT_EQ(renderer.surface_triangles(0), triangles) << "frame " << frame;
+        if (frame != 0) {
+            EXPECT_NE(triangles, previous) << "the tear changes the surface by frame " << frame;
+        }
+        previous = triangles;
+        // A renderer made for this frame alone draws the same picture as the one that followed the tear.
+        Renderer fresh;
+        fresh.update(session);
+        EXPECT_TRUE(picture(renderer) == picture(fresh)) << "frame " << frame;
+    }
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
 TEST(ViewRenderer, TheSelectionIsDrawnOverEverything) {
     REQUIRE_GL();
     ViewSession session(test::nested_boxes(), DetectorOptions{}, false);

@@ -205,12 +205,12 @@ void Viewer::panel_scene() {
         ImGui::PushID(static_cast<int>(o));
         ImGui::ColorButton("##color", ImVec4(c.r, c.g, c.b, 1.0f), ImGuiColorEditFlags_NoTooltip, ImVec2(12, 12));
         ImGui::SameLine();
-        ImGui::Text("object %zu: %zu tets, %zu surface triangles", o, scene.rest_mesh(o).num_tets(),
+        ImGui::Text("object %zu: %zu tets, %zu triangles", o, session_.mesh(o).num_tets(),
                     session_.faces()[o].boundary.size() / 3);
         const CollisionFilter filter = session_.collision_filter(o);
         if (filter.group != CollisionFilter{}.group || filter.mask != CollisionFilter{}.mask) {
             ImGui::SameLine();
-            ImGui::Text("(group 0x%x, mask 0x%x)", filter.group, filter.mask);
+            ImGui::Text("group 0x%x mask 0x%x", filter.group, filter.mask);
         }
         if (scene.is_static(o)) {
             ImGui::SameLine();

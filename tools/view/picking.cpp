@@ -64,7 +64,7 @@ std::optional<TetRef> pick_tet(const ViewSession& session, const OrbitCamera& ca
     const Scene& scene = session.scene();
     Hit colliding, surface;
     for (const TetRef& ref : colliding_tets(session)) {
-        const std::uint32_t* v = &scene.rest_mesh(ref.object).tets[4 * static_cast<std::size_t>(ref.tet)];
+        const std::uint32_t* v = &session.mesh(ref.object).tets[4 * static_cast<std::size_t>(ref.tet)];
         for (const auto& corners : tet_face_vertices) {
             const std::uint32_t face[3] = {v[corners[0]], v[corners[1]], v[corners[2]]};
             cast.triangle(ref.object, ref.tet, face, colliding);
@@ -88,7 +88,7 @@ std::vector<float> vertices_of(const ViewSession& session, const std::vector<Tet
     std::vector<float> points;
     points.reserve(12 * tets.size());
     for (const TetRef& t : tets) {
-        const std::uint32_t* v = &session.scene().rest_mesh(t.object).tets[4 * static_cast<std::size_t>(t.tet)];
+        const std::uint32_t* v = &session.mesh(t.object).tets[4 * static_cast<std::size_t>(t.tet)];
         const std::vector<float>& p = session.positions()[t.object];
         for (int k = 0; k < 4; ++k) points.insert(points.end(), {p[3 * v[k]], p[3 * v[k] + 1], p[3 * v[k] + 2]});
     }

@@ -165,7 +165,7 @@ void Renderer::release_buffer(unsigned& buffer, std::size_t bytes) {
 void Renderer::release_scene() {
     for (ObjectBuffers& o : objects_) {
         release_buffer(o.positions, o.vertex_bytes);
-        release_buffer(o.surface_indices, o.surface_count * sizeof(std::uint32_t));
+        release_buffer(o.surface_indices, o.surface_capacity * sizeof(std::uint32_t));
         release_buffer(o.highlight_indices, o.highlight_capacity * sizeof(std::uint32_t));
         glDeleteVertexArrays(1, &o.surface_array);
         glDeleteVertexArrays(1, &o.highlight_array);
@@ -182,7 +182,7 @@ void Renderer::load_scene(const ViewSession& session) {
         const TetMesh& mesh = scene.rest_mesh(o);
         const std::vector<std::uint32_t>& surface = session.faces()[o].boundary;
         b.vertex_bytes = mesh.num_vertices() * 3 * sizeof(float);
-        b.surface_count = surface.size();
+        b.surface_count = b.surface_capacity = surface.size();
         glGenVertexArrays(1, &b.surface_array);
         glBindVertexArray(b.surface_array);
         b.positions = make_buffer(GL_ARRAY_BUFFER, b.vertex_bytes, nullptr, GL_DYNAMIC_DRAW);
@@ -203,12 +203,14 @@ void Renderer::load_scene(const ViewSession& session) {
     glBindVertexArray(0);
     scene_radius_ = std::max(box.radius(), 1e-6f);
     scene_version_ = session.scene_version();
+    topology_version_ = session.topology_version();
     positions_version_ = result_version_ = 0;
     contacts_.vertices = selection_.vertices = 0;
 }
 
 void Renderer::update(const ViewSession& session) {
     if (session.scene_version() != scene_version_) load_scene(session);
+    if (session.topology_version() != topology_version_) upload_surfaces(session);
     if (session.positions_version() != positions_version_) {
         for (std::size_t o = 0; o < objects_.size(); ++o) {
             const std::vector<float>& xyz = session.positions()[o];
@@ -225,6 +227,28 @@ void Renderer::update(const ViewSession& session) {
     }
 }
 
+void Renderer::upload_surfaces(const ViewSession& session) {
+    for (std::size_t o = 0; o < objects_.size(); ++o) {
+        ObjectBuffers& b = objects_[o];
+        const std::vector<std::uint32_t>& surface = session.faces()[o].boundary;
+        b.surface_count = surface.size();
+        if (b.surface_count == 0) continue;
+        glBindVertexArray(b.surface_array);
+        if (b.surface_count > b.surface_capacity) {
+            // A tear adds boundary faces a few at a time: grown geometrically, it is rarely remade.
+            release_buffer(b.surface_indices, b.surface_capacity * sizeof(std::uint32_t));
+            b.surface_capacity = std::max(b.surface_count, 2 * b.surface_capacity);
+            b.surface_indices = make_buffer(GL_ELEMENT_ARRAY_BUFFER, b.surface_capacity * sizeof(std::uint32_t), nullptr,
+                                            GL_STATIC_DRAW);
+        }
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b.surface_indices);
+        glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(b.surface_count * sizeof(std::uint32_t)),
+                        surface.data());
+        glBindVertexArray(0);
+    }
+    topology_version_ = session.topology_version();
+}
+
 void Renderer::upload_highlights(const ViewSession& session) {
     const FrameResult& result = session.result();
     for (std::size_t o = 0; o < objects_.size(); ++o) {
@@ -232,7 +256,7 @@ void Renderer::upload_highlights(const ViewSession& session) {
         scratch_indices_.clear();
         // Faces between two colliding tets are hidden inside the region: only its surface is drawn.
         if (o < result.colliding.size())
-            append_flagged_region(session.scene().rest_mesh(o), session.faces()[o], result.colliding[o], scratch_indices_);
+            append_flagged_region(session.mesh(o), session.faces()[o], result.colliding[o], scratch_indices_);
         b.highlight_count = scratch_indices_.size();
         if (b.highlight_count == 0) continue;
         if (b.highlight_count > b.highlight_capacity) {
@@ -256,7 +280,7 @@ void Renderer::upload_contacts(const ViewSession& session) {
     scratch_vertices_.clear();
     if (!result.contacts.empty()) {
         const auto centroid = [&](std::uint32_t object, std::uint32_t tet, int axis) {
-            const std::uint32_t* v = &session.scene().rest_mesh(object).tets[4 * static_cast<std::size_t>(tet)];
+            const std::uint32_t* v = &session.mesh(object).tets[4 * static_cast<std::size_t>(tet)];
             const std::vector<float>& p = session.positions()[object];
             return 0.25f * (p[3 * v[0] + axis] + p[3 * v[1] + axis] + p[3 * v[2] + axis] + p[3 * v[3] + axis]);
         };
@@ -300,7 +324,7 @@ void Renderer::select(const ViewSession& session, const std::vector<TetRef>& tet
     scratch_vertices_.clear();
     for (const TetRef& ref : tets) {
         if (ref.object >= session.positions().size()) continue;
-        const std::uint32_t* v = &session.scene().rest_mesh(ref.object).tets[4 * static_cast<std::size_t>(ref.tet)];
+        const std::uint32_t* v = &session.mesh(ref.object).tets[4 * static_cast<std::size_t>(ref.tet)];
         const std::vector<float>& p = session.positions()[ref.object];
         for (const auto& corners : tet_face_vertices)
             for (const int c : corners) {

@@ -58,6 +58,9 @@ public:
     void select(const ViewSession& session, const std::vector<TetRef>& tets);
 
     const BufferStats& stats() const { return stats_; }
+    /// @brief Boundary triangles of @p object the surface buffers hold: those of the session's
+    /// mesh(object) as of the last update().
+    std::size_t surface_triangles(std::size_t object) const { return objects_.at(object).surface_count / 3; }
     /// @brief Contact normals the last update() prepared (0 without contacts).
     std::size_t contact_lines() const { return contacts_.vertices / 2; }
 
@@ -66,7 +69,8 @@ private:
         unsigned positions = 0;       ///< vertex buffer, x y z float per vertex
         unsigned surface_array = 0, surface_indices = 0;
         unsigned highlight_array = 0, highlight_indices = 0;
-        std::size_t surface_count = 0;   ///< indices
+        std::size_t surface_count = 0;   ///< indices drawn
+        std::size_t surface_capacity = 0;
         std::size_t highlight_count = 0; ///< indices drawn
         std::size_t highlight_capacity = 0;
         std::size_t vertex_bytes = 0;
@@ -85,6 +89,8 @@ private:
     void release_buffer(unsigned& buffer, std::size_t bytes);
     void release_scene();
     void load_scene(const ViewSession& session);
+    /// @brief Refills the surface index buffers after the session's tets changed.
+    void upload_surfaces(const ViewSession& session);
     void upload_highlights(const ViewSession& session);
     void upload_contacts(const ViewSession& session);
     void draw_objects(bool surfaces, bool highlights) const;
@@ -92,7 +98,7 @@ private:
     unsigned mesh_program_ = 0, background_program_ = 0, empty_array_ = 0;
     Stream contacts_, selection_;
     std::vector<ObjectBuffers> objects_;
-    std::uint64_t scene_version_ = 0, positions_version_ = 0, result_version_ = 0;
+    std::uint64_t scene_version_ = 0, positions_version_ = 0, result_version_ = 0, topology_version_ = 0;
     float scene_radius_ = 1.0f;
     std::vector<std::uint32_t> scratch_indices_;
     std::vector<float> scratch_vertices_;

@@ -74,9 +74,13 @@ void ViewSession::open(const ViewSource& source) {
     std::unique_ptr<Scene> scene = open_view_source(source);
     std::vector<MeshFaces> faces;
     for (std::size_t o = 0; o < scene->num_objects(); ++o) faces.push_back(analyse_faces(scene->rest_mesh(o)));
+    std::vector<TetMesh> meshes;
+    if (scene->changes_tets())
+        for (std::size_t o = 0; o < scene->num_objects(); ++o) meshes.push_back(scene->rest_mesh(o));
     // Release the old detector before the new scene's buffers are made.
     detector_.reset();
     scene_ = std::move(scene);
+    meshes_ = std::move(meshes);
     faces_ = std::move(faces);
     source_ = source;
     positions_.assign(scene_->num_objects(), {});
@@ -132,7 +136,23 @@ void ViewSession::build_detector() {
         for (std::size_t o = 0; o < scene_->num_objects(); ++o)
             detector->set_self_exclusion_rings(static_cast<ObjectId>(o), exclusion_rings_);
     for (std::size_t o = 0; o < scene_->num_objects(); ++o) detector->set_static(static_cast<ObjectId>(o), static_[o] != 0);
+    detector_tets_.clear();
+    if (scene_->changes_tets())
+        for (std::size_t o = 0; o < scene_->num_objects(); ++o) detector_tets_.push_back(scene_->rest_mesh(o).tets);
     detector_ = std::move(detector);
+}
+
+bool ViewSession::read_tets() {
+    bool changed = false;
+    std::vector<std::uint32_t> tets;
+    for (std::size_t o = 0; o < meshes_.size(); ++o) {
+        scene_->tets(o, frame_, tets);
+        if (tets == meshes_[o].tets) continue;
+        meshes_[o].tets.swap(tets);
+        faces_[o] = analyse_faces(meshes_[o]);
+        changed = true;
+    }
+    return changed;
 }
 
 bool ViewSession::update() {
@@ -140,6 +160,7 @@ bool ViewSession::update() {
     if (positions_frame_ != frame_) {
         const auto start = std::chrono::steady_clock::now();
         for (std::size_t o = 0; o < scene_->num_objects(); ++o) scene_->positions(o, frame_, positions_[o]);
+        if (read_tets()) ++topology_version_;
         positions_ms_ = milliseconds_since(start);
         positions_frame_ = frame_;
         ++positions_version_;
@@ -149,6 +170,7 @@ bool ViewSession::update() {
     if (results_stale_) {
         const bool fresh = !detector_;
         if (fresh) build_detector();
+        set_scene_tets(*detector_, *scene_, frame_, detector_tets_);
         // A static object's positions are the same in every frame: given once, it stays placed.
         for (std::size_t o = 0; o < scene_->num_objects(); ++o)
             if (fresh || !static_[o])

@@ -74,7 +74,11 @@ public:
     int frame() const { return frame_; }
     int num_frames() const { return scene_->num_frames(); }
 
-    /// @brief Each object's boundary and face neighbours, computed once when the scene opens.
+    /// @brief Each object's tets at frame() as of the last update() (they change only in a scene
+    /// whose tets change, Scene::changes_tets) with the scene's rest positions.
+    const TetMesh& mesh(std::size_t object) const { return meshes_.empty() ? scene_->rest_mesh(object) : meshes_[object]; }
+    /// @brief Each object's boundary and face neighbours for mesh(object), computed when the scene
+    /// opens and again when its tets change.
     const std::vector<MeshFaces>& faces() const { return faces_; }
     /// @brief Positions (x y z per vertex) of each object at frame() as of the last update().
     const std::vector<std::vector<float>>& positions() const { return positions_; }
@@ -97,13 +101,19 @@ public:
     std::uint64_t result_version() const { return result_version_; }
     /// @brief Steps whenever another scene is opened (its meshes and surfaces changed).
     std::uint64_t scene_version() const { return scene_version_; }
+    /// @brief Steps whenever an object's tets (mesh() and faces()) change within the scene.
+    std::uint64_t topology_version() const { return topology_version_; }
 
 private:
     void build_detector();
+    /// @brief Takes the tets of frame_ from a scene whose tets change; true when any changed.
+    bool read_tets();
 
     ViewSource source_;
     std::unique_ptr<Scene> scene_;
+    std::vector<TetMesh> meshes_;  ///< each object's current mesh, only for a scene whose tets change
     std::vector<MeshFaces> faces_;
+    std::vector<std::vector<std::uint32_t>> detector_tets_; ///< each object's tets as the detector has them
     DetectorOptions options_;
     bool self_ = false;
     int exclusion_rings_ = 0;
@@ -116,7 +126,7 @@ private:
     FrameResult result_;
     bool has_result_ = false;
     double positions_ms_ = 0, detect_ms_ = 0, detect_cpu_ms_ = 0;
-    std::uint64_t positions_version_ = 0, result_version_ = 0, scene_version_ = 0;
+    std::uint64_t positions_version_ = 0, result_version_ = 0, scene_version_ = 0, topology_version_ = 0;
 };
 
 } // namespace kdet::view

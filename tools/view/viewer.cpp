@@ -224,6 +224,7 @@ void Viewer::handle_click(int scene_x, int scene_width, int scene_height) {
     selected_ = pick_tet(session_, camera_, io.MousePos.x - static_cast<float>(scene_x), io.MousePos.y, scene_width,
                          scene_height, config_.display, scene_box_);
     selection_version_ = 0;
+    selection_topology_ = session_.topology_version();
 }
 
 void Viewer::handle_input(int scene_height) {
@@ -297,8 +298,11 @@ void Viewer::run() {
         const bool computed = !bench_job_ && session_.update();
         renderer_->update(session_);
         if (selection_version_ != session_.result_version()) {
-            // The selection follows its tet through the frames; a new scene drops it.
-            if (selected_ && selected_->object >= session_.scene().num_objects()) selected_.reset();
+            // The selection follows its tet through the frames; a new scene drops it, and so do new tets
+            // (a tear numbers them anew).
+            if (selected_ && (selected_->object >= session_.scene().num_objects() ||
+                              session_.topology_version() != selection_topology_))
+                selected_.reset();
             partners_ = selected_ ? partners_of(session_.result(), *selected_) : std::vector<Partner>{};
             std::vector<TetRef> shown;
             if (selected_) shown.push_back(*selected_);
@@ -379,7 +383,7 @@ void Viewer::profile(int width, int height) {
     reset_camera(static_cast<float>(width) / static_cast<float>(height));
     std::size_t tets = 0, triangles = 0;
     for (std::size_t o = 0; o < session_.scene().num_objects(); ++o) {
-        tets += session_.scene().rest_mesh(o).num_tets();
+        tets += session_.mesh(o).num_tets();
         triangles += session_.faces()[o].boundary.size() / 3;
     }
     std::printf("profile: scene %s, %zu objects, %zu tets, %zu surface triangles, %d frames; method %s, test %s, "

@@ -94,6 +94,7 @@ private:
     std::optional<TetRef> selected_;
     std::vector<Partner> partners_;      ///< of the selected tet, in the shown frame
     std::uint64_t selection_version_ = 0; ///< the session's result version partners_ belong to
+    std::uint64_t selection_topology_ = 0; ///< the session's topology version when the tet was picked
     int bench_runs_ = 3;
     std::string bench_dir_ = "exports/benchmark_data";
     std::unique_ptr<BenchJob> bench_job_;

@@ -17,6 +17,12 @@ Frame by frame (buffers persist between frames)::
         result = detector.detect()        # releases the GIL
         result.pairs                      # (k, 4) uint32: object_a, tet_a, object_b, tet_b
 
+The benchmark scenes of `kdet bench` (scene_names(): tearing, heap, drape, ...), played as it plays them::
+
+    scene = kdet.open_scene("tearing", resolution=1)
+    for frame, result in kdet.run_scene(scene, self_collision=False):
+        len(result.pairs)                 # the CSV's "collision pairs" of `kdet bench tearing`
+
 Two tets collide when their closed sets share a point; tets of one object that share a vertex are
 adjacent and never reported. OPTIONS describes every keyword of Detector (and of collide()): its
 type, default, choices or range, help, and its flags on the command line. Names are those of
@@ -43,16 +49,21 @@ from ._kdet import (
     FrameCounts,
     FrameResult,
     LocateResult,
+    Scene,
     StageTimes,
     TetMesh,
     __version__,
+    add_scene_objects,
     cuda_available,
     cuda_unavailable_reason,
     from_meshio,
+    open_scene,
     read_tet_mesh,
+    scene_names,
     version,
     write_tet_mesh,
 )
+from ._scenes import run_scene
 
 __all__ = [
     "BACKENDS",
@@ -66,16 +77,21 @@ __all__ = [
     "FrameCounts",
     "FrameResult",
     "LocateResult",
+    "Scene",
     "StageTimes",
     "TetMesh",
     "__version__",
+    "add_scene_objects",
     "collide",
     "collide_self",
     "cuda_available",
     "cuda_unavailable_reason",
     "from_meshio",
     "locate",
+    "open_scene",
     "read_tet_mesh",
+    "run_scene",
+    "scene_names",
     "version",
     "write_tet_mesh",
 ]

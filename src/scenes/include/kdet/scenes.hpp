@@ -49,6 +49,9 @@ public:
     virtual void positions(std::size_t object, int frame, std::vector<double>& out) const = 0;
     /// @brief Whether the scene asks for collisions between objects @p a and @p b (default: every pair).
     virtual bool checks_pair(std::size_t a, std::size_t b) const { return a != b; }
+    /// @brief The collision filter of @p object (Detector::set_collision_filter), which leaves out more
+    /// pairs between objects than checks_pair does (default: group 1, every mask bit: none).
+    virtual CollisionFilter collision_filter(std::size_t /*object*/) const { return {}; }
     /// @brief Whether the scene asks for self-collisions of @p object (default: none).
     virtual bool checks_self(std::size_t /*object*/) const { return false; }
     /// @brief Whether the tets of some object change between frames (cutting, tearing): then a
@@ -69,8 +72,8 @@ void set_scene_tets(Detector& detector, const Scene& scene, int frame, std::vect
 
 /// @brief Adds every object of @p scene to @p detector (ids in scene order, from the detector's next
 /// id on), with self-collision of each object as @p self says (the thesis's `-s`, whatever the
-/// scene's checks_self), collisions between the object pairs the scene checks only, and its static
-/// objects static.
+/// scene's checks_self), collisions between the object pairs the scene checks only, its collision
+/// filters, and its static objects static.
 void add_scene_objects(Detector& detector, const Scene& scene, bool self);
 
 /// @brief Size of a ProceduralScene.
@@ -128,7 +131,9 @@ private:
 /// @brief `heap`: small boxes (2 x 2 x 2 cubes, 48 tets each; 125, 343, 729 or 1000 of them at
 /// resolution 1-4) released layer by layer over a static floor (object 0), falling and coming to rest
 /// in columns that overlap a little sideways and downwards: many objects and contacts between them
-/// and with the floor. Deterministic, built in code. Throws kdet::Error for a resolution outside 1-4.
+/// and with the floor. Collision filters keep the bodies of one layer from colliding with each other
+/// (group 2 for even layers, 4 for odd ones, each masking the floor's group 1 and the other layers'
+/// group), so their sideways overlaps are left out while layers press on each other and the floor. Deterministic, built in code. Throws kdet::Error for a resolution outside 1-4.
 std::unique_ptr<Scene> make_heap_scene(int resolution);
 
 /// @brief `drape`: a square sheet one cube (three tets) thick falls onto a static ball (object 0),
