@@ -255,6 +255,30 @@ TEST(Margin, EveryMethodFindsTheSamePairsInSoupsAndTheyLieWithinTheMargin) {
     }
 }
 
+// The pairs found apart, which the margin's kernel decides afterwards, outgrow a candidate buffer of
+// one slot (kdet_no_pairs keeps them there, the brute-force methods pass them all as candidates): the
+// frame grows it and runs again, losing none.
+TEST(Margin, PairsLeftToTheMarginOutgrowingTheirBufferAreAllDecided) {
+    const TetMesh a = test::random_soup(200, 4.0, 2.0, 11), b = test::random_soup(200, 4.0, 2.0, 12);
+    for (Method method : {Method::kdet, Method::kdet_no_pairs, Method::brute_force_loop, Method::brute_force_pairs}) {
+        FrameResult results[2];
+        for (int tiny = 0; tiny < 2; ++tiny) {
+            DetectorOptions o;
+            o.method = method;
+            o.margin = 0.3f;
+            o.initial_candidate_capacity = tiny ? 1 : 0;
+            Detector d(o);
+            d.add_object(a);
+            d.add_object(b);
+            results[tiny] = d.detect();
+        }
+        EXPECT_EQ(results[1].pairs, results[0].pairs) << to_string(method);
+        EXPECT_EQ(results[1].colliding, results[0].colliding) << to_string(method);
+        EXPECT_GT(results[0].counts.colliding_tets, 0u) << to_string(method);
+        EXPECT_GT(results[1].counts.buffer_regrows, 0u) << to_string(method);
+    }
+}
+
 TEST(Margin, AtZeroTheResultIsTodays) {
     const TetMesh m = test::load_model("octopus-low.mesh");
     const TetMesh moved = test::moved(m, 0.3, 0.05 * test::extent_of(m), 0.0, 0.0);

@@ -1,11 +1,12 @@
 #pragma once
 /// @file pair_tests.hpp
 /// @brief The decisions on a pair of stored tets that the grid's search, the narrow phase and the
-/// baselines share: adjacency and boxes, the pre-test, the narrow phase's test.
+/// baselines share: adjacency and boxes, the pre-test, the narrow phase's test. None of them decides
+/// the margin: the pairs they find apart go to NearPairsKernel (near_pairs.hpp), which alone holds
+/// that decision, so that it is compiled once and not into every test's kernels.
 
 #include "geometry/face_planes.hpp"
 #include "geometry/slabs.hpp"
-#include "geometry/tet_distance.hpp"
 #include "geometry/tet_intersect.hpp"
 #include "pipeline/pair_exclusions.hpp"
 #include "pipeline/scene_view.hpp"
@@ -16,13 +17,7 @@
 
 namespace kdet {
 
-/// @brief Whether a pair that the test (or the face planes) found apart lies within the scene's
-/// margin (exactly: tet_distance.hpp); never without a margin.
-KDET_HD inline bool within_margin(const SceneView& s, const vec3 a[4], const vec3 b[4]) {
-    return s.margin > 0.0f && narrow::disjoint_tets_within(a, b, s.margin);
-}
-
-/// @brief The narrow-phase test alone on stored tets first < second (and the margin): the lower stored
+/// @brief The narrow-phase test alone on stored tets first < second: the lower stored
 /// id goes first, so every method sees the same floating-point computation. `exact_stage` is set when
 /// the pair reached the exact stage of NarrowPhase::exact. `after_pretest`: see tets_intersect_as.
 template <NarrowPhase Test>
@@ -31,22 +26,22 @@ KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint
     vec3 a[4], b[4];
     load_tet(s, first, a);
     load_tet(s, second, b);
-    return tets_intersect_as<Test>(a, b, exact_stage, after_pretest) || within_margin(s, a, b);
+    return tets_intersect_as<Test>(a, b, exact_stage, after_pretest);
 }
 
 /// @brief The decision for a grid method's pair (first < second) whose boxes overlap, that is not
 /// adjacent and that the slabs did not separate: the face planes' verdict where they are sure (the
 /// answer the test gives, see face_planes.hpp), else the test. `planes_separate` is set when the
-/// planes proved the pair apart (and not within the margin).
+/// planes proved the pair apart.
 template <NarrowPhase Test>
 KDET_HD inline bool planes_or_test_collide(const SceneView& s, std::uint32_t first, std::uint32_t second,
                                            bool& exact_stage, bool& planes_separate) {
     // Both tets' planes and the vertices beside them are this frame's.
     const TetPlanes &pa = s.planes[first], &pb = s.planes[second];
     const PlaneVerdict verdict = face_plane_pretest(pa, pa.vertex, pb, pb.vertex, false);
-    planes_separate = verdict == PlaneVerdict::separated && !within_margin(s, pa.vertex, pb.vertex);
-    if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting || !planes_separate;
-    return tets_intersect_as<Test>(pa.vertex, pb.vertex, exact_stage, true) || within_margin(s, pa.vertex, pb.vertex);
+    planes_separate = verdict == PlaneVerdict::separated;
+    if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
+    return tets_intersect_as<Test>(pa.vertex, pb.vertex, exact_stage, true);
 }
 
 /// @brief The decision for a grid method's pair whose boxes overlap and that is not adjacent (first <

@@ -227,6 +227,7 @@ template <class Exec>
 void Pipeline<Exec>::refuse_frame(const std::string& need, std::uint64_t bytes) {
     buffer<std::uint64_t>().swap(candidates_);
     buffer<std::uint64_t>().swap(candidates_grown_);
+    buffer<std::uint64_t>().swap(near_);
     buffer<std::uint64_t>().swap(out_keys_);
     buffer<Contact>().swap(out_contacts_);
     buffer<float>().swap(out_distances_);

@@ -18,6 +18,7 @@
 #include "pipeline/grid_populate.hpp"
 #include "pipeline/grid_sizing.hpp"
 #include "pipeline/narrow_phase.hpp"
+#include "pipeline/near_pairs.hpp"
 #include "pipeline/pair_distances.hpp"
 #include "pipeline/pipeline_base.hpp"
 #include "pipeline/positions_check.hpp"
@@ -156,7 +157,7 @@ public:
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
                exclusion_begin_.capacity_bytes() + excluded_.capacity_bytes() + grid_bytes() + statics_.bytes() + counters_.capacity_bytes() +
-               candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
+               candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() + near_.capacity_bytes() +
                resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
                out_distances_.capacity_bytes() + out_closest_.capacity_bytes() + exec_.scratch_bytes() +
                locator_.memory_bytes();
@@ -307,6 +308,7 @@ protected:
     buffer<FrameCounters> counters_;
     buffer<std::uint64_t> candidates_;
     buffer<std::uint64_t> candidates_grown_; ///< the next candidate buffer while one grows keeping its contents
+    buffer<std::uint64_t> near_; ///< with a margin, parallel to candidates_: NarrowPhaseKernel::near
     buffer<ResumePoint> resume_points_[2];  ///< where search items stopped (one per tet), read by one run and written by the next
     buffer<std::uint64_t> out_keys_;  ///< the colliding pairs; its size is the window they are appended to
     buffer<Contact> out_contacts_;
