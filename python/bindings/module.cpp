@@ -72,7 +72,7 @@ void set_option(const OptionInfo& o, nb::handle value, DetectorOptions& options)
     case OptionType::boolean:
         if (!PyBool_Check(value.ptr())) throw wrong_type("a bool");
         return o.set_number(options, value.ptr() == Py_True);
-    case OptionType::integer:
+    case OptionType::integer: {
         if (value.is_none() && o.unset_by_default()) return o.put(options, o.get(DetectorOptions{}));
         if (!PyLong_Check(value.ptr()) || PyBool_Check(value.ptr()))
             throw wrong_type(o.unset_by_default() ? "an int or None" : "an int");
@@ -81,6 +81,7 @@ void set_option(const OptionInfo& o, nb::handle value, DetectorOptions& options)
         if (overflow)
             throw Error(std::string(o.label) + " " + nb::cast<std::string>(nb::str(value)) + " out of range");
         return o.set_number(options, number);
+    }
     case OptionType::real:
         if (!(PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr())) || PyBool_Check(value.ptr()))
             throw wrong_type("a float");
