@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <string>
 
@@ -40,8 +41,14 @@ TEST(OptionFuzz, EveryOptionReadsRandomTextIntoItsRangeOrRefusesItInOneLine) {
                 EXPECT_GE(value, 0) << option.name << " <- '" << text << "'";
                 EXPECT_LT(value, static_cast<long long>(option.names().size())) << option.name << " <- '" << text << "'";
             } else {
-                EXPECT_GE(value, option.min) << option.name << " <- '" << text << "'";
-                EXPECT_LE(value, option.max) << option.name << " <- '" << text << "'";
+                if (option.type == OptionType::real) {
+                    // A real's value is its float's bits: the number itself must be a finite distance.
+                    const double real = option.real(options);
+                    EXPECT_TRUE(std::isfinite(real) && real >= 0.0) << option.name << " <- '" << text << "': " << real;
+                } else {
+                    EXPECT_GE(value, option.min) << option.name << " <- '" << text << "'";
+                    EXPECT_LE(value, option.max) << option.name << " <- '" << text << "'";
+                }
                 // What was read reads back the same (text() is what help and --json show).
                 DetectorOptions again;
                 option.parse(option.text(options), again, shown);

@@ -37,6 +37,7 @@ std::string invalid_text(const OptionInfo& o) {
     switch (o.type) {
     case OptionType::choice: return "nope";
     case OptionType::boolean: return "maybe";
+    case OptionType::real: return "-1";
     case OptionType::integer: break;
     }
     return o.max < std::numeric_limits<long long>::max() ? std::to_string(o.max + 1) : std::to_string(o.min - 1);
@@ -73,7 +74,9 @@ TEST(OptionTable, EveryEntryReadsItsOwnTextBackAndRefusesAnotherWithOneMessage) 
         const std::string bad = invalid_text(o);
         EXPECT_EQ(refusal(o, o.name, bad), invalid_value_message(o.name, bad, o.expected()));
         EXPECT_EQ(invalid_value_message(o.name, bad, o.expected()).find('\n'), std::string::npos);
-        if (o.type != OptionType::choice) {
+        if (o.type == OptionType::real) {
+            EXPECT_THROW(o.set_real(options, -1.0), Error);
+        } else if (o.type != OptionType::choice) {
             EXPECT_THROW(o.set_number(options, o.min - 1), Error);
             if (o.max < std::numeric_limits<long long>::max()) {
                 EXPECT_THROW(o.set_number(options, o.max + 1), Error);

@@ -34,10 +34,12 @@ struct Objects {
     std::vector<bool> self;
 };
 
-/// Brute force on every pair, without static flags, then the pairs static objects cannot report removed.
-std::vector<TetPair> oracle(const Objects& s) {
+/// Brute force on every pair (within `margin`), without static flags, then the pairs static objects
+/// cannot report removed.
+std::vector<TetPair> oracle(const Objects& s, float margin = 0.0f) {
     DetectorOptions options;
     options.method = Method::brute_force_loop;
+    options.margin = margin;
     Detector detector(options);
     for (std::size_t o = 0; o < s.meshes.size(); ++o)
         detector.set_self_collision(detector.add_object(s.meshes[o]), s.self[o]);
@@ -74,9 +76,9 @@ Objects random_setup(unsigned seed) {
     return s;
 }
 
-/// Checks the detector's next frame against the oracle; returns the pairs found.
-std::size_t expect_pairs(Detector& detector, const Objects& s, const std::string& what) {
-    const std::vector<TetPair> expected = oracle(s);
+/// Checks the detector's next frame against the oracle (within `margin`); returns the pairs found.
+std::size_t expect_pairs(Detector& detector, const Objects& s, const std::string& what, float margin = 0.0f) {
+    const std::vector<TetPair> expected = oracle(s, margin);
     const FrameResult& r = detector.detect();
     EXPECT_EQ(r.pairs.size(), expected.size()) << what;
     EXPECT_TRUE(r.pairs == expected) << what;
@@ -96,6 +98,24 @@ TEST(Static, RandomMixesEqualBruteForce) {
         }
     }
     EXPECT_GT(pairs, 1000u);
+}
+
+TEST(Static, PairsWithinAMarginEqualBruteForce) {
+    // Margins below the finest tets' size and several times it: a moving tet must find every static tet
+    // within the margin, whichever of them is larger and however far the grown boxes reach.
+    std::size_t pairs = 0, without_margin = 0;
+    for (unsigned seed = 1; seed <= 2; ++seed) {
+        const Objects s = random_setup(seed);
+        without_margin += oracle(s).size();
+        for (float margin : {0.004f, 0.05f}) {
+            DetectorOptions options;
+            options.margin = margin;
+            Detector detector(options);
+            add_all(detector, s);
+            pairs += expect_pairs(detector, s, "seed " + std::to_string(seed) + ", margin " + std::to_string(margin), margin);
+        }
+    }
+    EXPECT_GT(pairs, 2 * without_margin);
 }
 
 TEST(Static, SizesDifferingHundredTimesBothWays) {

@@ -20,7 +20,8 @@ namespace {
 
 const char* collide_help = R"(usage: kdet collide A [B] [options]
 
-Reports the colliding tetrahedron pairs between meshes A and B, or inside A with --self.
+Reports the colliding tetrahedron pairs between meshes A and B, or inside A with --self
+(with --margin D, every pair at most D apart).
 A and B are TetGen meshes (name, name.node or name.ele) or MEDIT .mesh files.
 Tetrahedra of one mesh that share a vertex are adjacent and never reported.
 
@@ -31,6 +32,8 @@ options:
   --pairs FILE         write 'i j' per line: 0-based tet indices in file order, sorted
   --contacts FILE      write 'i j depth nx ny nz' per colliding pair: moving B's tet j by depth
                        along (nx, ny, nz) separates it from A's tet i (from the 44-axis SAT)
+  --distances FILE     write 'i j distance ax ay az bx by bz' per pair: the distance and a closest
+                       point on A's tet i, then on B's tet j (a common point when they intersect)
   --check-exact        judge the chosen test against CGAL's exact predicates and print its
                        false positives and false negatives on these meshes
   --json               print one JSON object instead of text
@@ -55,16 +58,25 @@ std::string one_line(const nlohmann::ordered_json& value) {
 /// @brief Milliseconds to the nanosecond, printed as such rather than with the binary fraction's tail.
 double milliseconds(double value) { return std::round(value * 1e6) / 1e6; }
 
-/// @brief Writes one line per colliding pair; with contacts, depth and direction follow the indices.
-void write_pair_lines(const std::string& path, const FrameResult& result, bool with_contacts) {
+/// @brief What follows a pair's indices in write_pair_lines.
+enum class PairColumns { none, contacts, distances };
+
+/// @brief Writes one line per colliding pair; with contacts, depth and direction follow the indices,
+/// with distances the distance and the two closest points.
+void write_pair_lines(const std::string& path, const FrameResult& result, PairColumns columns) {
     std::ofstream out(path);
     if (!out) throw Error(path + ": cannot open file for writing");
     out.precision(9);
     for (std::size_t k = 0; k < result.pairs.size(); ++k) {
         out << result.pairs[k].tet_a << ' ' << result.pairs[k].tet_b;
-        if (with_contacts) {
+        if (columns == PairColumns::contacts) {
             const Contact& c = result.contacts[k];
             out << ' ' << c.depth << ' ' << c.direction[0] << ' ' << c.direction[1] << ' ' << c.direction[2];
+        } else if (columns == PairColumns::distances) {
+            const ClosestPoints& p = result.closest_points[k];
+            out << ' ' << result.distances[k];
+            for (float x : p.on_a) out << ' ' << x;
+            for (float x : p.on_b) out << ' ' << x;
         }
         out << '\n';
     }
@@ -84,7 +96,7 @@ int run_collide(int argc, char** argv) {
     DetectorOptions options;
     std::vector<std::string> meshes;
     bool self = false, json = false, help = false, check = false, mpi = false;
-    std::string pairs_path, contacts_path, partition;
+    std::string pairs_path, contacts_path, distances_path, partition;
     ReadOptions read_options;
     int rings = 0;
 
@@ -96,6 +108,7 @@ int run_collide(int argc, char** argv) {
     parser.flag("--help", help);
     parser.option("--pairs", "FILE", [&](const std::string& v) { pairs_path = v; });
     parser.option("--contacts", "FILE", [&](const std::string& v) { contacts_path = v; });
+    parser.option("--distances", "FILE", [&](const std::string& v) { distances_path = v; });
     parser.flag("--check-exact", check);
     parser.flag("--mpi", mpi);
     parser.option("--partition", "slabs|random", [&](const std::string& v) {
@@ -116,17 +129,21 @@ int run_collide(int argc, char** argv) {
     if (rings > 0 && !self) throw UsageError("collide: --exclusion-rings acts within one mesh: it needs --self");
     if (rings > 0 && check)
         throw UsageError("collide: --check-exact judges every pair, so it cannot follow --exclusion-rings");
-    if (options.method == Method::kdet_no_pairs && (!pairs_path.empty() || !contacts_path.empty() || check))
-        throw UsageError("collide: --pairs, --contacts and --check-exact need a method that builds pairs; "
+    if (options.method == Method::kdet_no_pairs &&
+        (!pairs_path.empty() || !contacts_path.empty() || !distances_path.empty() || check))
+        throw UsageError("collide: --pairs, --contacts, --distances and --check-exact need a method that builds pairs; "
                          "kdet_no_pairs only flags tets");
+    if (check && options.margin > 0.0f)
+        throw UsageError("collide: --check-exact judges intersections, not pairs within a margin; drop one of them");
     if (!partition.empty() && !mpi) throw UsageError("collide: --partition needs --mpi");
-    if (mpi && (json || check || !contacts_path.empty() || rings > 0))
-        throw UsageError("collide: --json, --contacts, --check-exact and --exclusion-rings do not work with --mpi");
+    if (mpi && (json || check || !contacts_path.empty() || !distances_path.empty() || rings > 0))
+        throw UsageError("collide: --json, --contacts, --distances, --check-exact and --exclusion-rings do not work with --mpi");
     if (mpi) return run_collide_mpi({meshes, self, pairs_path, partition, read_options, options});
     std::string unavailable;
     if (check && !exact_check_available(&unavailable))
         throw UsageError("collide: --check-exact is not available: " + unavailable);
     options.contacts = !contacts_path.empty();
+    options.distances = !distances_path.empty();
 
     const TetMesh a = read_tet_mesh(meshes[0], read_options);
     const TetMesh b = self ? TetMesh{} : read_tet_mesh(meshes[1], read_options);
@@ -140,8 +157,9 @@ int run_collide(int argc, char** argv) {
         detector.add_object(b);
     }
     const FrameResult& result = detector.detect();
-    if (!pairs_path.empty()) write_pair_lines(pairs_path, result, false);
-    if (!contacts_path.empty()) write_pair_lines(contacts_path, result, true);
+    if (!pairs_path.empty()) write_pair_lines(pairs_path, result, PairColumns::none);
+    if (!contacts_path.empty()) write_pair_lines(contacts_path, result, PairColumns::contacts);
+    if (!distances_path.empty()) write_pair_lines(distances_path, result, PairColumns::distances);
     ExactReport exact;
     if (check) {
         std::vector<IndexPair> reported;
@@ -162,6 +180,7 @@ int run_collide(int argc, char** argv) {
         out["self"] = self;
         if (self) out["exclusion_rings"] = rings;
         for (const char* name : {"method", "test", "hash", "backend"}) out[name] = find_option(name)->text(options);
+        out["margin"] = find_option("margin")->real(options);
         out["candidates"] = c.candidates;
         out["narrow_phase_candidates"] = c.narrow_phase_candidates;
         out["colliding_pairs"] = c.colliding_pairs;
@@ -191,6 +210,7 @@ int run_collide(int argc, char** argv) {
     std::printf("\n");
     std::printf("method            %s, test %s, hash %s, backend %s\n", to_string(options.method),
                 to_string(options.narrow_phase), to_string(options.hash), to_string(options.backend));
+    if (options.margin > 0.0f) std::printf("margin            %s\n", find_option("margin")->text(options).c_str());
     std::printf("candidates        %llu (%llu to the narrow phase)\n", static_cast<unsigned long long>(c.candidates),
                 static_cast<unsigned long long>(c.narrow_phase_candidates));
     if (options.method != Method::kdet_no_pairs)

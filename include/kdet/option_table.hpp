@@ -21,6 +21,7 @@ enum class OptionType {
     choice,  ///< one of a list of names (Backend, Method, NarrowPhase, HashFunction)
     integer, ///< a whole number in [min, max]
     boolean, ///< true or false
+    real,    ///< a finite number >= 0 (a distance), stored as a float
 };
 
 /// @brief The front ends that show an option (a bit set).
@@ -45,7 +46,8 @@ struct OptionInfo {
     long long min, max;     ///< integer: accepted range; a default outside it means "unset" (Python None)
     const char* zero_means; ///< integer whose range starts at 0: what 0 asks for ("chosen from the scene")
     unsigned front_ends;    ///< FrontEnd bits
-    /// @brief The value in @p options: a choice's index in names(), an integer, or 0/1.
+    /// @brief The value in @p options: a choice's index in names(), an integer, 0/1, or a real's float
+    /// bits (real() reads it as a number).
     long long (*get)(const DetectorOptions& options);
     /// @brief Stores @p value (as get() returns it) without checking it.
     void (*put)(DetectorOptions& options, long long value);
@@ -72,6 +74,11 @@ struct OptionInfo {
     void set_number(DetectorOptions& options, long long value) const;
     /// @brief Whether the default lies outside [min, max]: an integer that is unset until given.
     bool unset_by_default() const;
+    /// @brief A real option's value.
+    double real(const DetectorOptions& options) const;
+    /// @brief Stores a real option's value given as a number, or throws kdet::Error "NAME: expected a
+    /// finite number >= 0, got VALUE" (also for a value beyond float's range).
+    void set_real(DetectorOptions& options, double value) const;
 };
 
 /// @brief Every option, in the order help texts list them.

@@ -94,6 +94,12 @@ struct DetectorOptions {
     /// Return depth and direction per colliding pair, whatever the narrow-phase test: a stage after
     /// the test computes them with the 44-axis SAT's minimum translation vector.
     bool contacts = false;
+    /// Report every pair whose closed sets lie at most this distance apart (finite, >= 0), decided
+    /// exactly for the float coordinates and this float; 0: the pairs that touch or intersect.
+    float margin = 0.0f;
+    /// Return per pair its distance (0 when the tets intersect) and a closest point on each tet (a
+    /// common point when they intersect): FrameResult::distances and closest_points.
+    bool distances = false;
     /// CUDA backend: the stream (a cudaStream_t) every kernel, copy and sort of the detector runs on,
     /// so positions that the caller's kernels write on that stream are read after them. Null: the
     /// default stream. Must stay null on the CPU backend.

@@ -29,6 +29,13 @@ struct Contact {
     float direction[3];
 };
 
+/// @brief A closest point on each tet of a pair (DetectorOptions::distances): on the pair's first tet
+/// (object_a, tet_a), then on its second; one common point twice when the tets intersect.
+struct ClosestPoints {
+    float on_a[3];
+    float on_b[3];
+};
+
 /// @brief A detection's results where the backend keeps them: GPU memory for Backend::cuda, host
 /// memory for Backend::cpu. Valid until the next detect(). Tets are numbered globally: object o's
 /// tet i is Detector::first_tet(o) + i, objects following each other in id order (a removed object
@@ -39,6 +46,8 @@ struct DeviceResults {
     const std::uint32_t* colliding = nullptr; ///< per global tet: nonzero when it collides
     std::size_t tet_count = 0;
     const Contact* contacts = nullptr;        ///< parallel to pair_keys when contacts are on, else null
+    const float* distances = nullptr;         ///< parallel to pair_keys when distances are on, else null
+    const ClosestPoints* closest_points = nullptr; ///< likewise
 };
 
 /// @brief Milliseconds spent in each stage of one detection.
@@ -76,6 +85,8 @@ struct FrameCounts {
 struct FrameResult {
     std::vector<TetPair> pairs;                  ///< sorted ascending, unique
     std::vector<Contact> contacts;               ///< parallel to pairs when contacts are enabled
+    std::vector<float> distances;                ///< parallel to pairs when distances are enabled
+    std::vector<ClosestPoints> closest_points;   ///< parallel to pairs when distances are enabled
     std::vector<std::vector<std::uint8_t>> colliding; ///< [object][tet] = 1 if the tet collides
     FrameCounts counts;
     StageTimes times;

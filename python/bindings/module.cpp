@@ -72,7 +72,7 @@ void set_option(const OptionInfo& o, nb::handle value, DetectorOptions& options)
     case OptionType::boolean:
         if (!PyBool_Check(value.ptr())) throw wrong_type("a bool");
         return o.set_number(options, value.ptr() == Py_True);
-    case OptionType::integer:
+    case OptionType::integer: {
         if (value.is_none() && o.unset_by_default()) return o.put(options, o.get(DetectorOptions{}));
         if (!PyLong_Check(value.ptr()) || PyBool_Check(value.ptr()))
             throw wrong_type(o.unset_by_default() ? "an int or None" : "an int");
@@ -81,6 +81,11 @@ void set_option(const OptionInfo& o, nb::handle value, DetectorOptions& options)
         if (overflow)
             throw Error(std::string(o.label) + " " + nb::cast<std::string>(nb::str(value)) + " out of range");
         return o.set_number(options, number);
+    }
+    case OptionType::real:
+        if (!(PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr())) || PyBool_Check(value.ptr()))
+            throw wrong_type("a float");
+        return o.set_real(options, nb::cast<double>(value));
     }
 }
 
@@ -133,6 +138,7 @@ const char* detector_signature() {
             out += std::string(", ") + o.name + ": ";
             if (o.type == OptionType::choice) out += "str = '" + o.default_text() + "'";
             else if (o.type == OptionType::boolean) out += o.get(DetectorOptions{}) ? "bool = True" : "bool = False";
+            else if (o.type == OptionType::real) out += "float = " + o.default_text();
             else if (o.unset_by_default()) out += "int | None = None";
             else out += "int = " + o.default_text();
         }
@@ -213,12 +219,22 @@ nb::object to_meshio(nb::handle self) {
 struct Frame {
     FrameResult result;
     bool contacts_enabled = false;
+    bool distances_enabled = false;
 };
+
+/// A float32 view of a Frame's per-pair `values` (k rows of `row` floats each), or None when `enabled` is off.
+template <class T>
+nb::object per_pair_floats(nb::handle frame, bool enabled, std::vector<T>& values, std::initializer_list<std::size_t> row) {
+    if (!enabled) return nb::none();
+    std::vector<std::size_t> shape{values.size()};
+    shape.insert(shape.end(), row);
+    return nb::cast(nb::ndarray<nb::numpy, float>(reinterpret_cast<float*>(values.data()), shape.size(), shape.data(), frame));
+}
 
 /// What detect(device_results=True) returns: DLPack arrays of the detector's own buffers (valid until the
 /// next detect()) and the frame's counts and times.
 struct DeviceFrame {
-    nb::object pair_keys, colliding, contacts;
+    nb::object pair_keys, colliding, contacts, distances, closest_points;
     FrameCounts counts;
     StageTimes times;
     std::size_t memory_bytes = 0;
@@ -306,7 +322,7 @@ nb::object completed_frame(nb::handle handle, bool device_results, const FrameRe
             device_frame->times = result.times;
             device_frame->memory_bytes = result.memory_bytes;
         } else {
-            frame = std::make_unique<Frame>(Frame{result, options.contacts});
+            frame = std::make_unique<Frame>(Frame{result, options.contacts, options.distances});
         }
     }
     if (frame) return nb::cast(frame.release(), nb::rv_policy::take_ownership);
@@ -324,6 +340,12 @@ nb::object completed_frame(nb::handle handle, bool device_results, const FrameRe
                                  ? device_view(reinterpret_cast<const float*>(buffers.contacts), {buffers.pair_count, 4},
                                                handle, device_type, device_id)
                                  : nb::none();
+    device_frame->distances =
+        buffers.distances ? device_view(buffers.distances, {buffers.pair_count}, handle, device_type, device_id) : nb::none();
+    device_frame->closest_points =
+        buffers.closest_points ? device_view(reinterpret_cast<const float*>(buffers.closest_points),
+                                             {buffers.pair_count, 2, 3}, handle, device_type, device_id)
+                               : nb::none();
     return nb::cast(device_frame.release(), nb::rv_policy::take_ownership);
 }
 
@@ -342,6 +364,7 @@ nb::dict options_dict(const DetectorOptions& options) {
         const long long value = o.get(options);
         if (o.type == OptionType::choice) d[o.name] = o.text(options);
         else if (o.type == OptionType::boolean) d[o.name] = value != 0;
+        else if (o.type == OptionType::real) d[o.name] = o.real(options);
         else if (o.unset_by_default() && value == o.get(DetectorOptions{})) d[o.name] = nb::none();
         else d[o.name] = value;
     }
@@ -374,7 +397,7 @@ nb::dict options_table() {
     for (const OptionInfo& o : option_table()) {
         if (!o.shown_on(front_end_python)) continue;
         nb::dict entry;
-        const char* types[] = {"choice", "integer", "boolean"};
+        const char* types[] = {"choice", "integer", "boolean", "real"};
         entry["type"] = types[static_cast<int>(o.type)];
         entry["default"] = defaults[o.name];
         if (o.type == OptionType::choice) entry["choices"] = names_of(o.name);
@@ -486,15 +509,30 @@ void bind_results(nb::module_& m) {
             "method 'kdet_no_pairs'.")
         .def_prop_ro(
             "contacts",
-            [](nb::handle self) -> nb::object {
+            [](nb::handle self) {
                 Frame& f = nb::cast<Frame&>(self);
-                if (!f.contacts_enabled) return nb::none();
                 static_assert(sizeof(Contact) == 4 * sizeof(float), "Contact is read as four float32");
-                return nb::cast(rows_view<float, 4>(reinterpret_cast<float*>(f.result.contacts.data()),
-                                                    f.result.contacts.size(), self));
+                return per_pair_floats(self, f.contacts_enabled, f.result.contacts, {4});
             },
             "Per pair (depth, nx, ny, nz) float32: moving tet b by depth along n separates the pair. None unless the "
             "detector was made with contacts=True.")
+        .def_prop_ro(
+            "distances",
+            [](nb::handle self) {
+                Frame& f = nb::cast<Frame&>(self);
+                return per_pair_floats(self, f.distances_enabled, f.result.distances, {});
+            },
+            "Per pair its distance, float32 (k,): 0 where the tets intersect. None unless the detector was made with "
+            "distances=True.")
+        .def_prop_ro(
+            "closest_points",
+            [](nb::handle self) {
+                Frame& f = nb::cast<Frame&>(self);
+                static_assert(sizeof(ClosestPoints) == 6 * sizeof(float), "ClosestPoints is read as six float32");
+                return per_pair_floats(self, f.distances_enabled, f.result.closest_points, {2, 3});
+            },
+            "Per pair a closest point on tet a, then on tet b, float32 (k, 2, 3); one common point twice where they "
+            "intersect. None unless the detector was made with distances=True.")
         .def_prop_ro(
             "colliding",
             [](nb::handle self) {
@@ -531,6 +569,9 @@ void bind_results(nb::module_& m) {
                 "uint64 (k,): (global_a << 32) | global_b per colliding pair, global_a < global_b, sorted.")
         .def_ro("colliding", &DeviceFrame::colliding, "uint32 (tets,): nonzero where the global tet collides.")
         .def_ro("contacts", &DeviceFrame::contacts, "float32 (k, 4) (depth, nx, ny, nz), or None without contacts.")
+        .def_ro("distances", &DeviceFrame::distances, "float32 (k,) per pair, or None without distances.")
+        .def_ro("closest_points", &DeviceFrame::closest_points,
+                "float32 (k, 2, 3) per pair, or None without distances.")
         .def_ro("counts", &DeviceFrame::counts)
         .def_ro("times", &DeviceFrame::times)
         .def_ro("memory_bytes", &DeviceFrame::memory_bytes);
@@ -551,7 +592,8 @@ void bind_detector(nb::module_& m) {
             },
             nb::sig(detector_signature()),
             "Names (backend, method, test, hash) are those of kdet.BACKENDS, METHODS, TESTS and HASHES, in any case, "
-            "'-' or '_'. threads=None uses all cores. contacts=True adds depth and direction per pair. cuda_stream "
+            "'-' or '_'. threads=None uses all cores. contacts=True adds depth and direction per pair. margin=D reports every "
+            "pair at most D apart; distances=True adds each pair's distance and closest points. cuda_stream "
             "(backend='cuda'): the stream all of the detector's GPU work runs on, as an int or a stream object "
             "(PyTorch, CuPy, Warp, __cuda_stream__); None is the default stream. "
             "results_to_host=False keeps results on the device (detect(device_results=True)).")

@@ -24,6 +24,8 @@ def valid(entry):
         return entry["choices"][-1]
     if entry["type"] == "integer":
         return entry["range"][1] if entry["range"][1] < 2**40 else entry["range"][0]
+    if entry["type"] == "real":
+        return 0.25
     return not entry["default"]
 
 
@@ -56,6 +58,10 @@ def test_every_keyword_takes_a_valid_value_and_refuses_an_invalid_one(name):
         if high < 2**40:
             with pytest.raises(kdet.Error, match=rf"out of range \[{low}, {high}\]"):
                 kdet.Detector(**{name: high + 1})
+    elif entry["type"] == "real":
+        for bad in (-1.0, float("nan"), float("inf"), 1e39):
+            with pytest.raises(kdet.Error, match=f"^{name}: expected a finite number >= 0, got "):
+                kdet.Detector(**{name: bad})
     with pytest.raises(TypeError, match=f"^{name}: expected"):
         kdet.Detector(**{name: object()})
 

@@ -23,6 +23,7 @@
 /// Tets of zero volume (with --allow-degenerate) are decided in the plane or on the line that holds
 /// the pair (decide_exactly). docs/narrow-phase.md has the bounds' derivation and the measurements.
 
+#include "geometry/dvec3.hpp"
 #include "geometry/exact_sum.hpp"
 #include "geometry/tet_pair.hpp"
 
@@ -159,20 +160,6 @@ KDET_HD inline AxisVerdict filter_verdict(const FilterProjections& s, float boun
 }
 
 // ---- Levels 2 and 3: double, then exact. Out of line: only pairs with an open axis get here.
-
-struct dvec3 {
-    double x, y, z;
-};
-KDET_HD inline dvec3 widen(vec3 v) { return {v.x, v.y, v.z}; }
-KDET_HD inline dvec3 operator-(dvec3 a, dvec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-KDET_HD inline double dot(dvec3 a, dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-KDET_HD inline dvec3 cross(dvec3 a, dvec3 b) {
-    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-KDET_HD inline double norm1(dvec3 v) { return fabs(v.x) + fabs(v.y) + fabs(v.z); }
-KDET_HD inline double max_d(double a, double b) { return a > b ? a : b; }
-KDET_HD inline double norm_inf(dvec3 v) { return max_d(fabs(v.x), max_d(fabs(v.y), fabs(v.z))); }
-KDET_HD inline double component(dvec3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
 
 /// @brief One of the 12 edges of the pair as its two input points: 0..5 of a, 6..11 of b.
 struct Segment {

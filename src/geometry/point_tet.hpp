@@ -4,9 +4,11 @@
 /// barycentric coordinates in it, or the tet's closest point to it, in double.
 
 #include "geometry/exact_test.hpp"
-#include "geometry/point_triangle.hpp"
+#include "geometry/closest_points.hpp"
 
 namespace kdet::point_query {
+
+using narrow::dvec3;
 
 /// @brief Exact sign of orient3d(a, b, c, d) = det(b - a, c - a, d - a) for float points: the double
 /// determinant where its proven bound decides, the exact sum otherwise (narrow::sign_det3).
@@ -73,9 +75,9 @@ KDET_HD inline PointInTet closest_on_tet_boundary(const vec3 v[4], vec3 p) {
     double best_d = 0.0;
     for (int k = 0; k < 4; ++k) {
         const int i0 = k == 0 ? 1 : 0, i1 = k <= 1 ? 2 : 1, i2 = k <= 2 ? 3 : 2;
-        const ClosestOnTriangle c =
-            closest_on_triangle(q, narrow::widen(v[i0]), narrow::widen(v[i1]), narrow::widen(v[i2]));
-        const double d = distance_squared(q, c.point);
+        const narrow::ClosestOnTriangle c =
+            narrow::closest_on_triangle(q, narrow::widen(v[i0]), narrow::widen(v[i1]), narrow::widen(v[i2]));
+        const double d = narrow::squared_distance(q, c.point);
         if (k == 0 || d < best_d) {
             best_d = d;
             best.closest = c.point;

@@ -46,6 +46,15 @@ struct Box {
             if (o.hi[k] < lo[k] || hi[k] < o.lo[k]) return false;
         return true;
     }
+    /// Grows the box by `half_margin` per side, rounded outward, so that the boxes of two tets at most
+    /// DetectorOptions::margin apart overlap and the pair travels.
+    void grow(float half_margin) {
+        if (!(half_margin > 0.0f)) return;
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = std::nextafter(lo[k] - half_margin, -std::numeric_limits<float>::infinity());
+            hi[k] = std::nextafter(hi[k] + half_margin, std::numeric_limits<float>::infinity());
+        }
+    }
 };
 
 /// What every rank gathers about every other rank's part of one object.
@@ -327,6 +336,7 @@ std::string Detector::Impl::summarize(std::vector<unsigned char>& record) const 
         std::vector<Box> boxes(object.tet_ids.size());
         for (std::size_t t = 0; t < boxes.size(); ++t) {
             for (int c = 0; c < 4; ++c) boxes[t].add(&object.positions[3 * object.tets[4 * t + c]]);
+            boxes[t].grow(options.margin / 2);
             for (int k = 0; k < 3; ++k) {
                 s.box.lo[k] = std::min(s.box.lo[k], boxes[t].lo[k]);
                 s.box.hi[k] = std::max(s.box.hi[k], boxes[t].hi[k]);
@@ -367,6 +377,7 @@ void Detector::Impl::exchange(const std::vector<PartSummary>& summaries, std::ve
         for (std::size_t t = 0; t < object.tet_ids.size(); ++t) {
             Box box;
             for (int c = 0; c < 4; ++c) box.add(&object.positions[3 * object.tets[4 * t + c]]);
+            box.grow(options.margin / 2);
             for (int r : near) {
                 bool send = false;
                 for (std::size_t b = 0; b < n_objects && !send; ++b) {

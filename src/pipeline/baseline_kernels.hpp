@@ -17,16 +17,20 @@
 namespace kdet {
 
 /// @brief The brute-force methods' predicate: adjacency, boxes, then the test itself, without the
-/// pre-test, so that they stay the oracle the grid methods (which use it) are compared with.
+/// pre-test, so that they stay the oracle the grid methods (which use it) are compared with. With a
+/// margin every pair whose grown boxes overlap passes too: the narrow phase tests it again and hands
+/// it to NearPairsKernel where it does not intersect.
 template <NarrowPhase Test>
 KDET_HD inline bool tets_collide_tested(const SceneView& s, std::uint32_t t, std::uint32_t u, bool& exact_stage) {
     const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
-    return may_collide(s, first, second) && test_pair<Test>(s, first, second, exact_stage);
+    return may_collide(s, first, second) && (test_pair<Test>(s, first, second, exact_stage) || s.margin > 0.0f);
 }
 
 /// @brief The thesis's old method (algorithm 4.2): test inline and only flag colliding tets,
 /// skipping a pair when both tets are already flagged. An item searches a run of TetsPerItem tets
-/// (TetRuns) and adds its counts once.
+/// (TetRuns) and adds its counts once. With a margin, each pair tested and found apart is appended
+/// to `near` (stored tets, lower first; an overflow reruns the stage with more room), which
+/// NearPairsKernel decides.
 template <NarrowPhase Test, std::uint32_t TetsPerItem>
 struct NoPairsKernel {
     SceneView scene;
@@ -36,6 +40,7 @@ struct NoPairsKernel {
     std::uint32_t* colliding;
     unsigned long long* tests_run;
     unsigned long long* exact_stage_pairs;
+    KeyAppender near;
 
     struct TestAndFlag {
         const NoPairsKernel* kernel;
@@ -49,10 +54,13 @@ struct NoPairsKernel {
             ++tests;
             const std::uint32_t first = t < u ? t : u, second = t < u ? u : t;
             bool reached_exact = false;
-            if (may_collide(kernel->scene, first, second) &&
-                candidate_collides<Test>(kernel->scene, first, second, reached_exact)) {
-                atomic_store_relaxed(&flags[t], 1u);
-                atomic_store_relaxed(&flags[u], 1u);
+            if (may_collide(kernel->scene, first, second)) {
+                if (candidate_collides<Test>(kernel->scene, first, second, reached_exact)) {
+                    atomic_store_relaxed(&flags[t], 1u);
+                    atomic_store_relaxed(&flags[u], 1u);
+                } else if (kernel->scene.margin > 0.0f) {
+                    kernel->near.push(pair_key(first, second));
+                }
             }
             exact_stage += reached_exact;
         }

@@ -88,18 +88,25 @@ std::optional<FrameCounters> BaselinePipeline<Exec>::candidate_stage() {
 }
 
 /// @brief kdet_no_pairs: the grid's search of each tet, testing the pairs inline and flagging the
-/// colliding tets (NoPairsKernel).
+/// colliding tets (NoPairsKernel). With a margin the pairs it found apart go to the candidate buffer,
+/// which it does not use otherwise (it grows like kdet's when they overflow it), and
+/// NearPairsKernel flags the tets of those within the margin.
 template <class Exec>
 void BaselinePipeline<Exec>::flag_colliding_tets() {
     FrameCounters* c = this->counters_.data();
     const std::uint32_t tets = static_cast<std::uint32_t>(this->tets_.size());
+    auto& near = this->candidates_;
+    const KeyAppender near_out{near.data(), near.size(), &c->candidates, nullptr};
     with_narrow_phase(this->options_.narrow_phase, [&](auto test) {
         using Search = NoPairsKernel<decltype(test)::value, Tuning::search_tets_per_item>;
         this->exec_.for_each(TetRuns<Tuning::search_tets_per_item>::count(tets),
                              Search{this->scene_view(), this->grid_, &c->params, &c->layer_mask, this->colliding_.data(),
-                                    &baseline_counters_.data()->tests_run, &c->exact_stage_pairs},
+                                    &baseline_counters_.data()->tests_run, &c->exact_stage_pairs, near_out},
                              Tuning::search_tets_per_item);
     });
+    if (this->options_.margin > 0.0f)
+        this->exec_.for_each_counted(&c->candidates, near.size(),
+                                     NearPairsKernel{this->scene_view(), near.data(), this->colliding_.data(), nullptr, KeyAppender{}});
 }
 
 /// @brief Both brute-force methods: every pair of enabled objects is tested, colliding pairs appended.

@@ -7,17 +7,35 @@
 #include "grid/bucket_table.hpp"
 #include "pipeline/scene_view.hpp"
 
+#include <cfloat>
+#include <cmath>
 #include <cstdint>
 
 namespace kdet {
 
-/// @brief Stage 1: box of each tet; no size and no layer yet.
+/// @brief At least half of `margin`: what each side of a tet's box grows by.
+KDET_HD inline float half_margin(float margin) {
+    const float half = 0.5f * margin;
+    return half + half < margin ? nextafterf(half, INFINITY) : half;
+}
+
+/// @brief `box` grown by `half` on every side, each bound rounded outward (and kept finite): two tets
+/// at most 2 half apart have overlapping grown boxes, since along every axis their boxes are at most
+/// that apart.
+KDET_HD inline Aabb grown_box(const Aabb& box, float half) {
+    const auto down = [half](float x) { return fmaxf(nextafterf(x - half, -INFINITY), -FLT_MAX); };
+    const auto up = [half](float x) { return fminf(nextafterf(x + half, INFINITY), FLT_MAX); };
+    return Aabb{{down(box.lo.x), down(box.lo.y), down(box.lo.z)}, {up(box.hi.x), up(box.hi.y), up(box.hi.z)}};
+}
+
+/// @brief Stage 1: box of each tet, grown by half the margin; no size and no layer yet.
 struct TetBoundsKernel {
     SceneView scene;
     KDET_HD void operator()(std::uint64_t t) const {
         vec3 v[4];
         load_tet(scene, static_cast<std::uint32_t>(t), v);
-        scene.info[t] = TetInfo{tet_box(v), 0.0f, -1};
+        const Aabb box = tet_box(v);
+        scene.info[t] = TetInfo{scene.margin > 0.0f ? grown_box(box, half_margin(scene.margin)) : box, 0.0f, -1};
     }
 };
 

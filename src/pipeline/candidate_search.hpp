@@ -191,7 +191,8 @@ struct FindCandidatesKernel {
         KDET_HD void pretest(std::uint32_t u) {
             const TetPlanes& other = scene->planes[u];
             const PlaneVerdict verdict = face_plane_pretest(planes, planes.vertex, other, other.vertex, false);
-            if (verdict == PlaneVerdict::separated) {
+            // Within a margin, a pair the planes separate is left to the narrow phase's distance.
+            if (verdict == PlaneVerdict::separated && scene->margin == 0.0f) {
                 ++rejected;
                 return;
             }

@@ -360,6 +360,8 @@ Detector::Detector(const DetectorOptions& options) : impl_(std::make_unique<Impl
     if (options.bucket_capacity > max_bucket_capacity)
         throw Error("bucket capacity " + std::to_string(options.bucket_capacity) + " out of range [0, " +
                     std::to_string(max_bucket_capacity) + "] (0 chooses it from the scene)");
+    if (!(options.margin >= 0.0f) || !std::isfinite(options.margin))
+        throw Error("margin " + std::to_string(options.margin) + ": expected a finite distance >= 0");
     if (options.cuda_stream && options.backend != Backend::cuda)
         throw Error("option cuda_stream is set, but the backend is '" + std::string(to_string(options.backend)) +
                     "': a CUDA stream needs backend 'cuda'");

@@ -16,6 +16,14 @@
 
 namespace kdet {
 
+/// @brief The bounds on a size grown by the margin: a tet's size is its sphere's diameter plus the
+/// margin, the extent of its grown box, so that the layers and cells keep their sizes' logic and a
+/// tet's grown box spans at most two cells per axis on its layer (rounded to nearest: monotone, so the
+/// bounds still bound the grown sphere).
+KDET_HD inline SphereDiameterBounds grown_bounds(SphereDiameterBounds bounds, float margin) {
+    return SphereDiameterBounds{bounds.lower + margin, bounds.upper + margin};
+}
+
 /// @brief Every how many tets TetSizeKernel samples the spacing.
 constexpr std::uint64_t spacing_sample = 8;
 
@@ -82,7 +90,7 @@ struct TetSizeKernel {
         scene.planes[t] = tet_planes(v);
         if (scene.slabs) scene.slabs[t] = tet_slabs(v, scene.planes[t].longest);
         const float longest = longest_edge(v);
-        const SphereDiameterBounds bounds = sphere_diameter_bounds(longest);
+        const SphereDiameterBounds bounds = grown_bounds(sphere_diameter_bounds(longest), scene.margin);
         const std::uint32_t lower = float_to_ordered(bounds.lower), upper = float_to_ordered(bounds.upper);
         atomic_lower_to(min_upper_size, upper);
         atomic_raise_to(max_lower_size, lower);
@@ -90,7 +98,7 @@ struct TetSizeKernel {
             info.diameter = -longest;
             return;
         }
-        info.diameter = enclosing_sphere_diameter(v);
+        info.diameter = enclosing_sphere_diameter(v) + scene.margin;
         atomic_lower_to(min_size, float_to_ordered(info.diameter));
         atomic_raise_to(max_size, float_to_ordered(info.diameter));
     }
@@ -132,17 +140,17 @@ struct GridParamsKernel {
     }
 };
 
-/// @brief The layer of relevant tet t, whose TetInfo::diameter is `size`: from its sphere where
+/// @brief The layer of relevant tet t, whose TetInfo::diameter is `size` (grown by the margin): from its sphere where
 /// TetSizeKernel computed it; else from its longest-edge bounds where both fall on one layer (layers
 /// grow with the size, so the sphere's does too, up to rounding); else from its sphere, computed now.
 KDET_HD inline int tet_layer(const SceneView& scene, const GridParams& params, std::uint32_t t, float size) {
     if (!(size < 0.0f)) return layer_of(params, size);
-    const SphereDiameterBounds bounds = sphere_diameter_bounds(-size);
+    const SphereDiameterBounds bounds = grown_bounds(sphere_diameter_bounds(-size), scene.margin);
     const int low = layer_of(params, bounds.lower), high = layer_of(params, bounds.upper);
     if (low == high) return low;
     vec3 v[4];
     load_tet(scene, t, v);
-    return layer_of(params, enclosing_sphere_diameter(v));
+    return layer_of(params, enclosing_sphere_diameter(v) + scene.margin);
 }
 
 /// @brief Cells in a range.

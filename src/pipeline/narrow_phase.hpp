@@ -23,7 +23,9 @@ namespace kdet {
 /// the test, after the face planes with FacePlanesHere (the search did not run them: rejections are
 /// counted in `rejected`). Work item i decides keys [i KeysPerItem, (i + 1) KeysPerItem) of the first
 /// min(*key_count, key_capacity): with more than one, its pairs are appended a batch at a time (one
-/// atomic per batch where every pair would take one, all on the same counter).
+/// atomic per batch where every pair would take one, all on the same counter). With a margin, `near`
+/// (parallel to the keys) gets each key's pair of stored tets that the test or the planes found apart,
+/// no_pair_key for every other key: NearPairsKernel decides those against the margin.
 template <NarrowPhase Test, std::uint32_t KeysPerItem, bool FacePlanesHere>
 struct NarrowPhaseKernel {
     SceneView scene;
@@ -35,11 +37,12 @@ struct NarrowPhaseKernel {
     KeyAppender out;
     unsigned long long* exact_stage_pairs;
     unsigned long long* rejected; ///< with FacePlanesHere: the pairs the face planes proved separated
+    std::uint64_t* near;          ///< [key_capacity] where the scene has a margin, else null
 
     /// @brief Decides key k; true, with the pair under the caller's ids, when it collides. Counts a
     /// pair the face planes proved separated in `planes_rejected`.
     KDET_HD bool decide(std::uint64_t k, std::uint64_t& pair, unsigned long long& planes_rejected) const {
-        if (keys[k] == no_pair_key) return false;
+        if (keys[k] == no_pair_key) return keep_near(k, no_pair_key);
         const std::uint32_t a = key_first(keys[k]), b = key_second(keys[k]);
         const std::uint32_t t = a < b ? a : b, u = a < b ? b : a;
         bool reached_exact = false;
@@ -56,11 +59,18 @@ struct NarrowPhaseKernel {
             }
         }
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
-        if (!collides) return false;
+        if (!collides) return keep_near(k, pair_key(t, u));
+        keep_near(k, no_pair_key);
         atomic_store_relaxed(&colliding[t], 1u);
         atomic_store_relaxed(&colliding[u], 1u);
         pair = pair_key(user_id[t], user_id[u]);
         return true;
+    }
+
+    /// @brief Writes key k's near pair where there is a near list; false (no pair to append).
+    KDET_HD bool keep_near(std::uint64_t k, std::uint64_t pair) const {
+        if (near) near[k] = pair;
+        return false;
     }
 
     KDET_HD void operator()(std::uint64_t item) const {
@@ -81,6 +91,13 @@ struct NarrowPhaseKernel {
     }
 };
 
+/// @brief The two tets of a pair key in the caller's ids: a the first (lower id), b the second.
+KDET_HD inline void load_key_tets(const SceneView& scene, const std::uint32_t* stored_id, std::uint64_t key, vec3 a[4],
+                                  vec3 b[4]) {
+    load_tet(scene, stored_id[key_first(key)], a);
+    load_tet(scene, stored_id[key_second(key)], b);
+}
+
 /// @brief Stage 6: contact of each colliding pair given in the caller's ids; tet b is the pair's second.
 /// Nothing when the pairs outgrew their window: a batch that did not fit left its slots unwritten
 /// (they hold no pair, maybe no valid id), and the narrow phase runs again with a larger window.
@@ -94,8 +111,7 @@ struct ContactKernel {
     KDET_HD void operator()(std::uint64_t k) const {
         if (*key_count > window) return;
         vec3 a[4], b[4];
-        load_tet(scene, stored_id[key_first(keys[k])], a);
-        load_tet(scene, stored_id[key_second(keys[k])], b);
+        load_key_tets(scene, stored_id, keys[k], a, b);
         float depth = 0.0f;
         vec3 direction{0.0f, 0.0f, 0.0f};
         tets_intersect_sat_mtv(a, b, depth, direction);

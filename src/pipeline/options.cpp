@@ -4,8 +4,11 @@
 
 #include <cctype>
 #include <cerrno>
+#include <cfloat>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 
 namespace kdet {
@@ -125,6 +128,20 @@ struct NumberField {
     static void put(DetectorOptions& o, long long v) { o.*member = static_cast<Number>(v); }
 };
 
+/// A real option's accessors: get and put carry the float's bits.
+template <float DetectorOptions::*member>
+struct RealField {
+    static long long get(const DetectorOptions& o) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &(o.*member), sizeof bits);
+        return bits;
+    }
+    static void put(DetectorOptions& o, long long v) {
+        const auto bits = static_cast<std::uint32_t>(v);
+        std::memcpy(&(o.*member), &bits, sizeof bits);
+    }
+};
+
 constexpr unsigned text_front_ends = front_end_cli | front_end_bench | front_end_view;
 constexpr unsigned every_front_end = text_front_ends | front_end_panel | front_end_python;
 constexpr long long no_limit = std::numeric_limits<long long>::max();
@@ -144,6 +161,26 @@ OptionInfo number(const char* name, const char* flag, const char* bench_flag, co
     return OptionInfo{name, name, flag, bench_flag, label, type == OptionType::integer ? "N" : "", help, type, min, max,
                       zero_means, front_ends, &F::get, &F::put, nullptr, nullptr};
 }
+
+template <float DetectorOptions::*member>
+OptionInfo real(const char* name, const char* flag, const char* label, const char* value_name, const char* help,
+                unsigned front_ends) {
+    using F = RealField<member>;
+    return OptionInfo{name, name, flag, flag, label, value_name, help, OptionType::real, 0, 0, nullptr,
+                      front_ends, &F::get, &F::put, nullptr, nullptr};
+}
+
+/// The shortest decimal text that reads back as the same float.
+std::string real_text(float value) {
+    char text[32];
+    for (int digits = 1; digits <= 9; ++digits) {
+        std::snprintf(text, sizeof text, "%.*g", digits, static_cast<double>(value));
+        if (std::strtof(text, nullptr) == value) break;
+    }
+    return text;
+}
+
+constexpr const char* real_expected = "a finite number >= 0";
 
 } // namespace
 
@@ -176,6 +213,12 @@ const std::vector<OptionInfo>& option_table() {
             OptionType::integer, 0, no_limit, "as much as the memory holds", text_front_ends | front_end_python),
         number<bool, &O::contacts>("contacts", "", "", "contacts", "depth and direction per colliding pair",
                                    OptionType::boolean, 0, 1, nullptr, front_end_python),
+        real<&O::margin>("margin", "--margin", "margin", "D",
+                         "report the pairs at most D apart (default 0: touching or intersecting)",
+                         every_front_end),
+        number<bool, &O::distances>("distances", "", "", "distances",
+                                    "distance and a closest point on each tet per pair", OptionType::boolean, 0, 1,
+                                    nullptr, front_end_python),
         number<bool, &O::results_to_host>("results_to_host", "", "", "results to host",
                                           "copy pairs, flags and contacts to the host after each frame",
                                           OptionType::boolean, 0, 1, nullptr, front_end_python),
@@ -236,6 +279,7 @@ std::string OptionInfo::text(const DetectorOptions& options) const {
     switch (type) {
     case OptionType::choice: return names()[static_cast<std::size_t>(value)];
     case OptionType::boolean: return value ? "true" : "false";
+    case OptionType::real: return real_text(static_cast<float>(real(options)));
     case OptionType::integer: break;
     }
     return std::to_string(value);
@@ -252,6 +296,7 @@ std::string OptionInfo::expected() const {
     switch (type) {
     case OptionType::choice: return join_names(names());
     case OptionType::boolean: return "true or false";
+    case OptionType::real: return real_expected;
     case OptionType::integer: break;
     }
     return "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
@@ -278,8 +323,35 @@ void OptionInfo::parse(const std::string& text, DetectorOptions& options, const 
         break;
     }
     case OptionType::integer: value = parse_integer(shown, text, min, max); break;
+    case OptionType::real: {
+        char* end = nullptr;
+        const double number = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !(number >= 0.0) || number > FLT_MAX)
+            throw Error(invalid_value_message(shown, text, expected()));
+        return set_real(options, number);
+    }
     }
     put(options, value);
+}
+
+double OptionInfo::real(const DetectorOptions& options) const {
+    const auto bits = static_cast<std::uint32_t>(get(options));
+    float value;
+    std::memcpy(&value, &bits, sizeof value);
+    return value;
+}
+
+void OptionInfo::set_real(DetectorOptions& options, double value) const {
+    if (!(value >= 0.0) || value > FLT_MAX)
+    {
+        char text[32];
+        std::snprintf(text, sizeof text, "%g", value);
+        throw Error(std::string(name) + ": expected " + real_expected + ", got " + text);
+    }
+    const float stored = static_cast<float>(value);
+    std::uint32_t bits;
+    std::memcpy(&bits, &stored, sizeof bits);
+    put(options, bits);
 }
 
 void OptionInfo::set_number(DetectorOptions& options, long long value) const {

@@ -1,7 +1,9 @@
 #pragma once
 /// @file pair_tests.hpp
 /// @brief The decisions on a pair of stored tets that the grid's search, the narrow phase and the
-/// baselines share: adjacency and boxes, the pre-test, the narrow phase's test.
+/// baselines share: adjacency and boxes, the pre-test, the narrow phase's test. None of them decides
+/// the margin: the pairs they find apart go to NearPairsKernel (near_pairs.hpp), which alone holds
+/// that decision, so that it is compiled once and not into every test's kernels.
 
 #include "geometry/face_planes.hpp"
 #include "geometry/slabs.hpp"
@@ -15,9 +17,9 @@
 
 namespace kdet {
 
-/// @brief The narrow-phase test alone on stored tets first < second: the lower stored id goes first, so
-/// every method sees the same floating-point computation. `exact_stage` is set when the pair reached
-/// the exact stage of NarrowPhase::exact. `after_pretest`: see tets_intersect_as.
+/// @brief The narrow-phase test alone on stored tets first < second: the lower stored
+/// id goes first, so every method sees the same floating-point computation. `exact_stage` is set when
+/// the pair reached the exact stage of NarrowPhase::exact. `after_pretest`: see tets_intersect_as.
 template <NarrowPhase Test>
 KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint32_t second, bool& exact_stage,
                               bool after_pretest = false) {

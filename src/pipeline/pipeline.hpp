@@ -86,6 +86,8 @@ void Pipeline<Exec>::enqueue_results() {
     keys_view_ = exec_.download_view_later(out_keys_.data(), window);
     flags_view_ = exec_.download_view_later(user_colliding_.data(), tets);
     contacts_view_ = exec_.download_view_later(out_contacts_.data(), options_.contacts ? window : 0);
+    distances_view_ = exec_.download_view_later(out_distances_.data(), options_.distances ? window : 0);
+    closest_view_ = exec_.download_view_later(out_closest_.data(), options_.distances ? window : 0);
 }
 
 /// @brief Runs an attempt again from `stage` (grow_for has grown what it needs): the counters of the
@@ -177,16 +179,23 @@ typename Pipeline<Exec>::Rerun Pipeline<Exec>::grow_for(const FrameCounters& c) 
 }
 
 /// @brief Makes the pairs' window hold `wanted` pairs, or, where the memory (or memory_limit) does not
-/// allow it, the `needed` pairs alone (resize_within_memory for both buffers that hold it), and sets
+/// allow it, the `needed` pairs alone (resize_within_memory for every buffer that holds it), and sets
 /// pairs_window_; false when not even the need fits. The sort's spare keys for the window are held
 /// with it (Exec::reserve_sort), so that a window the memory cannot sort fails here too.
 template <class Exec>
 bool Pipeline<Exec>::pairs_window_within_memory(std::size_t wanted, std::size_t needed) {
-    const std::size_t own = out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() + exec_.sort_spare_bytes();
+    const std::size_t own = out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() + out_distances_.capacity_bytes() +
+                            out_closest_.capacity_bytes() + exec_.sort_spare_bytes();
     const std::size_t pairs_room = room(own, pair_bytes());
     if (!resize_within_memory(out_keys_, wanted, needed, pairs_room)) return false;
-    if (options_.contacts && !resize_within_memory(out_contacts_, out_keys_.size(), needed, pairs_room)) return false;
-    std::size_t window = options_.contacts ? out_contacts_.size() : out_keys_.size();
+    std::size_t window = out_keys_.size();
+    const auto narrow_to = [&](auto& per_pair) {
+        if (!resize_within_memory(per_pair, window, needed, pairs_room)) return false;
+        window = per_pair.size();
+        return true;
+    };
+    if (options_.contacts && !narrow_to(out_contacts_)) return false;
+    if (options_.distances && !(narrow_to(out_distances_) && narrow_to(out_closest_))) return false;
     if (!exec_.reserve_sort(window)) {
         window = needed; // the headroom goes first
         if (!exec_.reserve_sort(window)) return false;
@@ -205,6 +214,10 @@ void Pipeline<Exec>::reserve_pairs_window(std::uint64_t candidates) {
     if (!pairs_window_within_memory(candidates, candidates)) refuse_first_frame(candidates);
     fill(out_keys_, no_pair_key);
     if (options_.contacts) fill(out_contacts_, Contact{});
+    if (options_.distances) {
+        fill(out_distances_, 0.0f);
+        fill(out_closest_, ClosestPoints{});
+    }
 }
 
 /// @brief Ends a frame whose pairs the memory (or memory_limit) cannot hold, before anything grows for
@@ -214,8 +227,11 @@ template <class Exec>
 void Pipeline<Exec>::refuse_frame(const std::string& need, std::uint64_t bytes) {
     buffer<std::uint64_t>().swap(candidates_);
     buffer<std::uint64_t>().swap(candidates_grown_);
+    buffer<std::uint64_t>().swap(near_);
     buffer<std::uint64_t>().swap(out_keys_);
     buffer<Contact>().swap(out_contacts_);
+    buffer<float>().swap(out_distances_);
+    buffer<ClosestPoints>().swap(out_closest_);
     exec_.release_sort();
     pairs_window_ = 0;
     colliding_count_ = 0;
@@ -275,6 +291,8 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
 
     result.pairs.clear();
     result.contacts.clear();
+    result.distances.clear();
+    result.closest_points.clear();
     result.counts = FrameCounts{};
     FrameCounts& counts = result.counts;
     count_candidates(c, counts);
@@ -304,6 +322,12 @@ std::uint32_t Pipeline<Exec>::finish(FrameResult& result) {
         }
         pairs_from_keys(begin, keys, colliding_count_, result.pairs.data(), options_.threads);
         if (options_.contacts) result.contacts.assign(contacts, contacts + colliding_count_);
+        if (options_.distances) {
+            const float* distances = exec_.template landed<float>(distances_view_);
+            const ClosestPoints* closest = exec_.template landed<ClosestPoints>(closest_view_);
+            result.distances.assign(distances, distances + colliding_count_);
+            result.closest_points.assign(closest, closest + colliding_count_);
+        }
         flags_by_object(begin, flags, result.colliding, options_.threads);
     }
     result.memory_bytes = memory_bytes();

@@ -18,6 +18,8 @@
 #include "pipeline/grid_populate.hpp"
 #include "pipeline/grid_sizing.hpp"
 #include "pipeline/narrow_phase.hpp"
+#include "pipeline/near_pairs.hpp"
+#include "pipeline/pair_distances.hpp"
 #include "pipeline/pipeline_base.hpp"
 #include "pipeline/positions_check.hpp"
 #include "pipeline/scene_view.hpp"
@@ -130,7 +132,9 @@ public:
 
     DeviceResults device_results() override {
         return DeviceResults{out_keys_.data(), colliding_count_, user_colliding_.data(), user_colliding_.size(),
-                             options_.contacts ? out_contacts_.data() : nullptr};
+                             options_.contacts ? out_contacts_.data() : nullptr,
+                             options_.distances ? out_distances_.data() : nullptr,
+                             options_.distances ? out_closest_.data() : nullptr};
     }
 
     void upload_positions(const std::vector<PositionUpload>& uploads) override {
@@ -153,8 +157,9 @@ public:
                run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
                exclusion_begin_.capacity_bytes() + excluded_.capacity_bytes() + grid_bytes() + statics_.bytes() + counters_.capacity_bytes() +
-               candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
-               resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() + exec_.scratch_bytes() +
+               candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() + near_.capacity_bytes() +
+               resume_points_[0].capacity_bytes() + resume_points_[1].capacity_bytes() + out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
+               out_distances_.capacity_bytes() + out_closest_.capacity_bytes() + exec_.scratch_bytes() +
                locator_.memory_bytes();
     }
 
@@ -195,12 +200,13 @@ protected:
     }
 
     SceneView scene_view() {
-        // sat_no_edges calls pairs intersecting that only an edge axis separates, however far apart.
-        TetSlabs* slabs = options_.narrow_phase == NarrowPhase::sat_no_edges ? nullptr : slabs_.data();
+        // sat_no_edges calls pairs intersecting that only an edge axis separates, however far apart; a
+        // margin reports pairs that the slabs separate.
+        TetSlabs* slabs = options_.narrow_phase == NarrowPhase::sat_no_edges || options_.margin > 0.0f ? nullptr : slabs_.data();
         return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), slabs, pair_active_.data(),
                          checked_objects_.data(), object_boxes_.data(), frame_tets_,
                          static_cast<std::uint32_t>(object_boxes_.size()),
-                         exclusion_begin_.size() ? exclusion_begin_.data() : nullptr, excluded_.data()};
+                         exclusion_begin_.size() ? exclusion_begin_.data() : nullptr, excluded_.data(), options_.margin};
     }
     template <class T>
     void fill(buffer<T>& b, const T& value) {
@@ -243,8 +249,12 @@ protected:
     void reserve_pairs_window(std::uint64_t candidates);
     [[noreturn]] void refuse_frame(const std::string& need, std::uint64_t bytes);
     [[noreturn]] void refuse_first_frame(std::uint64_t candidates);
-    /// Bytes of the pairs' window per pair: its key, its sort's spare key, its contact where asked for.
-    std::size_t pair_bytes() const { return 2 * sizeof(std::uint64_t) + (options_.contacts ? sizeof(Contact) : 0); }
+    /// Bytes of the pairs' window per pair: its key, its sort's spare key, its contact and its distance
+    /// and closest points where asked for.
+    std::size_t pair_bytes() const {
+        return 2 * sizeof(std::uint64_t) + (options_.contacts ? sizeof(Contact) : 0) +
+               (options_.distances ? sizeof(float) + sizeof(ClosestPoints) : 0);
+    }
     /// Elements of `bytes_each` bytes that buffers now holding `own_bytes` may grow to under
     /// DetectorOptions::memory_limit (room_for).
     std::size_t room(std::size_t own_bytes, std::size_t bytes_each) const {
@@ -298,9 +308,12 @@ protected:
     buffer<FrameCounters> counters_;
     buffer<std::uint64_t> candidates_;
     buffer<std::uint64_t> candidates_grown_; ///< the next candidate buffer while one grows keeping its contents
+    buffer<std::uint64_t> near_; ///< with a margin, parallel to candidates_: NarrowPhaseKernel::near
     buffer<ResumePoint> resume_points_[2];  ///< where search items stopped (one per tet), read by one run and written by the next
     buffer<std::uint64_t> out_keys_;  ///< the colliding pairs; its size is the window they are appended to
     buffer<Contact> out_contacts_;
+    buffer<float> out_distances_;       ///< DetectorOptions::distances, parallel to out_keys_
+    buffer<ClosestPoints> out_closest_;
     std::uint32_t slot_count_ = 0;
     std::uint32_t overflow_capacity_ = 0;
     std::uint32_t entry_capacity_ = 0;
@@ -320,7 +333,7 @@ protected:
     // finish(): the counters, and the results where they land (Exec::landed).
     std::vector<VertexRange> staged_;
     FrameCounters last_{};
-    std::size_t keys_view_ = 0, flags_view_ = 0, contacts_view_ = 0;
+    std::size_t keys_view_ = 0, flags_view_ = 0, contacts_view_ = 0, distances_view_ = 0, closest_view_ = 0;
     std::uint64_t waits_before_ = 0;
     std::uint32_t regrows_ = 0;
 };

@@ -221,10 +221,16 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
 /// @brief Stages 5 and 6: the narrow phase once per candidate (they are unique, see
 /// for_each_larger_neighbour), over the count the candidate stage left in the backend's memory; the
 /// colliding pairs, appended under the caller's ids into the window, sorted into the output order,
-/// and their contacts.
+/// and their contacts and distances. With a margin, the candidates found apart are then decided
+/// against it (NearPairsKernel), their pairs appended to the same window.
 template <class Exec>
 void Pipeline<Exec>::narrow_phase_and_results() {
     FrameCounters* c = counters_.data();
+    const bool margin = options_.margin > 0.0f;
+    if (margin && near_.size() != candidates_.size() &&
+        !resize_within_memory(near_, candidates_.size(), candidates_.size(), room(near_.capacity_bytes(), sizeof(std::uint64_t))))
+        refuse_frame("the margin's list of " + std::to_string(candidates_.size()) + " candidate pairs takes",
+                     candidates_.size() * sizeof(std::uint64_t));
     // The whole window is copied out (the count is not known when the copy is enqueued): a new one is
     // filled once, so that no byte copied is undefined.
     resize_filled(out_keys_, pairs_window_, no_pair_key);
@@ -235,7 +241,8 @@ void Pipeline<Exec>::narrow_phase_and_results() {
             exec_.for_each_counted(&c->candidates, candidates_.size(),
                                    NarrowPhaseKernel<decltype(test)::value, per_item, decltype(planes_here)::value>{
                                        scene_view(), candidates_.data(), &c->candidates, candidates_.size(), colliding_.data(),
-                                       user_id_.data(), out, &c->exact_stage_pairs, &c->rejected_after_search},
+                                       user_id_.data(), out, &c->exact_stage_pairs, &c->rejected_after_search,
+                                       margin ? near_.data() : nullptr},
                                    per_item);
         };
         // The search's candidates still need their face planes where it did not run them; brute force's
@@ -245,6 +252,9 @@ void Pipeline<Exec>::narrow_phase_and_results() {
         }
         decide(std::false_type{});
     });
+    if (margin)
+        exec_.for_each_counted(&c->candidates, near_.size(),
+                               NearPairsKernel{scene_view(), near_.data(), colliding_.data(), user_id_.data(), out});
     clock_.mark(narrow_phase_done);
     // The keys hold the caller's ids, which are below the tet count.
     const auto tet_count = static_cast<std::uint32_t>(tets_.size());
@@ -256,6 +266,13 @@ void Pipeline<Exec>::narrow_phase_and_results() {
         exec_.for_each_counted(&c->colliding_pairs, out_contacts_.size(),
                                ContactKernel{scene_view(), stored_id_.data(), out_keys_.data(), &c->colliding_pairs,
                                              out_keys_.size(), out_contacts_.data()});
+    }
+    if (options_.distances) {
+        resize_filled(out_distances_, pairs_window_, 0.0f);
+        resize_filled(out_closest_, pairs_window_, ClosestPoints{});
+        exec_.for_each_counted(&c->colliding_pairs, out_distances_.size(),
+                               DistanceKernel{scene_view(), stored_id_.data(), out_keys_.data(), &c->colliding_pairs,
+                                              out_keys_.size(), out_distances_.data(), out_closest_.data()});
     }
     clock_.mark(results_done);
 }

@@ -46,6 +46,8 @@ struct SceneView {
     /// null when no pair is excluded beyond shared vertices.
     const std::uint32_t* exclusion_begin;
     const std::uint32_t* excluded;
+    /// DetectorOptions::margin: boxes grown by half of it, sizes by all of it, pairs within it reported.
+    float margin = 0.0f;
 };
 
 KDET_HD inline void load_vertices(const SceneView& s, const TetIndices& tet, vec3 out[4]) {

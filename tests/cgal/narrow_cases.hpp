@@ -153,12 +153,14 @@ inline Tetrahedron to_tetrahedron(const d3 v[4]) {
     return CGAL::do_intersect(to_tetrahedron(a), to_tetrahedron(b));
 }
 
-/// @brief Exact oracle for any two sets of 4 points, degenerate ones included: the squared distance
-/// between their convex hulls, computed exactly (CGAL's polytope distance with Gmpzf arithmetic
-/// throughout: with double as its inner number type it returned an invalid non-zero distance for
-/// flat tets sharing a vertex, one coordinate 2^-65), is zero iff the hulls meet. The solution is
-/// checked (is_valid) every time.
-[[gnu::noinline]] inline bool cgal_hulls_meet(const d3 a[4], const d3 b[4]) {
+/// @brief The exact squared distance of two hulls, numerator / denominator.
+struct HullSquaredDistance {
+    CGAL::Gmpzf numerator, denominator;
+};
+
+/// @brief CGAL's polytope distance of two sets of 4 points with Gmpzf arithmetic throughout (exact,
+/// degenerate sets included), its solution checked (is_valid) every time.
+[[gnu::noinline]] inline HullSquaredDistance cgal_hull_distance(const d3 a[4], const d3 b[4]) {
     using HomogeneousKernel = CGAL::Homogeneous<double>;
     using Distance =
         CGAL::Polytope_distance_d<CGAL::Polytope_distance_d_traits_3<HomogeneousKernel, CGAL::Gmpzf, CGAL::Gmpzf>>;
@@ -169,8 +171,15 @@ inline Tetrahedron to_tetrahedron(const d3 v[4]) {
     }
     const Distance distance(p, p + 4, q, q + 4);
     if (!distance.is_valid()) throw std::runtime_error("CGAL's polytope distance found no valid solution");
-    return distance.is_zero();
+    return {distance.squared_distance_numerator(), distance.squared_distance_denominator()};
 }
+
+/// @brief Exact oracle for any two sets of 4 points, degenerate ones included: the squared distance
+/// between their convex hulls, computed exactly (CGAL's polytope distance with Gmpzf arithmetic
+/// throughout: with double as its inner number type it returned an invalid non-zero distance for
+/// flat tets sharing a vertex, one coordinate 2^-65), is zero iff the hulls meet. The solution is
+/// checked (is_valid) every time.
+[[gnu::noinline]] inline bool cgal_hulls_meet(const d3 a[4], const d3 b[4]) { return cgal_hull_distance(a, b).numerator == 0; }
 
 inline void widen(const vec3 v[4], d3 out[4]) {
     for (int i = 0; i < 4; ++i) out[i] = to_d3(v[i]);

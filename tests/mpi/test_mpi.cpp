@@ -229,6 +229,19 @@ TEST(Mpi, ContactsAsTheSingleDetectors) {
     expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), mpi::Partition::random, 3), options);
 }
 
+TEST(Mpi, PairsWithinAMarginAsTheSingleDetectors) {
+    // Two soups apart by more than their tets' size: only the margin brings pairs, and the exchange
+    // must send the tets that are near another rank's part by the margin, not only those overlapping it.
+    Scenario s = scenario({random_soup(800, 1.0, 1.0, 21), random_soup(800, 1.0, 1.0, 22)});
+    for (std::size_t i = 0; i < s.frames[0][1].size(); i += 3) s.frames[0][1][i] += 1.04;
+    s.self[0] = true;
+    DetectorOptions options = one_thread();
+    options.margin = 0.08f;
+    std::vector<const TetMesh*> meshes{&s.meshes[0], &s.meshes[1]};
+    for (mpi::Partition kind : {mpi::Partition::slabs, mpi::Partition::random})
+        expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), kind, 5), options);
+}
+
 TEST(Mpi, CudaBackendOnEveryRankAsTheCpu) {
     std::string reason;
     if (!cuda_available(&reason)) GTEST_SKIP() << "CUDA backend not tested: " << reason;

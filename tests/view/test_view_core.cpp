@@ -295,7 +295,9 @@ TEST(ViewArgs, EveryDetectorOptionOfTheTableIsReadAndRefusedAsTheLibraryDoes) {
         ++shown;
         const std::string good = o.unset_by_default() ? std::to_string(o.min) : o.default_text();
         EXPECT_EQ(o.text(parse({o.flag, good}).options), good);
-        const std::string bad = o.type == OptionType::choice ? "nope" : std::to_string(o.max + 1);
+        const std::string bad = o.type == OptionType::choice ? "nope"
+                                : o.type == OptionType::real ? "-1"
+                                                             : std::to_string(o.max + 1);
         std::string expected;
         try {
             DetectorOptions options;

@@ -8,6 +8,7 @@
 #include <imgui_stdlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
@@ -31,7 +32,7 @@ bool usable(const OptionInfo& option, long long index, std::string* reason) {
 }
 
 /// @brief The widget of one option of the library's table: a combo box of a choice's names (those this
-/// machine cannot run greyed out, the reason as a tooltip), an integer input, or a checkbox.
+/// machine cannot run greyed out, the reason as a tooltip), an integer or real input, or a checkbox.
 bool option_widget(const OptionInfo& option, DetectorOptions& options) {
     const long long current = option.get(options);
     switch (option.type) {
@@ -58,6 +59,13 @@ bool option_widget(const OptionInfo& option, DetectorOptions& options) {
         if (!ImGui::Checkbox(option.label, &on)) return false;
         option.put(options, on);
         return true;
+    }
+    case OptionType::real: {
+        float value = static_cast<float>(option.real(options));
+        if (!ImGui::InputFloat(option.label, &value, 0.0f, 0.0f, "%g", ImGuiInputTextFlags_EnterReturnsTrue)) return false;
+        if (!(value >= 0.0f) || !std::isfinite(value)) return false; // refused: the value stays
+        option.set_real(options, value);
+        return option.get(options) != current;
     }
     case OptionType::integer: break;
     }
