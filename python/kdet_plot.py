@@ -8,7 +8,8 @@ Figures ("_self" in the name: with self-collisions); times are device times in m
   stages_<method>[_self].png         stacked time per pipeline stage over the frames (6.14, 6.20)
   boxplot_<method>[_self].png        frame times per scene and resolution (6.17, 6.18)
   penetration_<scene>.png            time and unique candidates against the bounding-box overlap
-                                     along x, the thesis's penetration depth, with a cubic fit (6.13)
+                                     along x, the thesis's penetration depth, with a cubic fit (6.13);
+                                     cases whose overlap never changes are left out
   memory[_self].png                  peak detector memory per scene and resolution (6.22)
   run_spread_<method>[_self].png     mean, min-max range and standard deviation over the runs (6.2)
   host_vs_device_<method>[_self].png wall-clock time of detect() against its own total (6.4)
@@ -162,13 +163,14 @@ def boxplot_figure(files: list[BenchFile], title: str, path: str, written: list[
 
 
 def penetration_figure(scene: str, files: list[BenchFile], path: str, written: list[str]) -> None:
-    """Frames whose object boxes overlap along x; no figure when there are none."""
+    """Frames whose object boxes overlap along x; no figure when there are none, and no series for a
+    case whose overlap is the same in every frame (a single column says nothing about depth)."""
     fig, (time_ax, pairs_ax) = plt.subplots(1, 2, figsize=(11, 4.2))
     drawn = False
     for bench in sorted(files, key=lambda f: (f.resolution, f.algorithm)):
         points = [(d, t, c) for d, t, c in zip(bench.column("bbox overlap x"), bench.column("device time"),
                                                bench.column("unique candidates")) if d >= 0]
-        if not points:
+        if not points or np.ptp([d for d, _, _ in points]) == 0:
             continue
         drawn = True
         depth, time, candidates = (np.array(v) for v in zip(*points))
