@@ -56,6 +56,8 @@ class BenchFile:
 
     @property
     def total_tets(self) -> int:
+        if "#tets" in self.header:  # every object's; files from before it name only the first two
+            return int(self.header["#tets"])
         return int(self.header.get("#tetsA", "0")) + int(self.header.get("#tetsB", "0"))
 
 

@@ -320,7 +320,7 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
                                                   "overlap test",      "self collisions", "hashing algorithm",
                                                   "#frames",           "first frame", "total runs", "#tetsA",
                                                   "#tetsB",            "#verticesA", "#verticesB"};
-    const std::vector<std::string> more_keys = {"backend", "threads", "bucket capacity", "exclusion rings",
+    const std::vector<std::string> more_keys = {"#objects", "#tets", "backend", "threads", "bucket capacity", "exclusion rings",
                                                 "collision filters", "device", "compiler", "compiler flags",
                                                 "kdet version", "peak memory bytes", "time unit"};
     std::vector<std::string> keys;
@@ -382,6 +382,13 @@ TEST(BenchRunner, RingsAndFiltersFlags) {
     EXPECT_GT(pairs(off), pairs(on));
     EXPECT_NE(off.stem.find("_f119-119_filters-off"), std::string::npos) << off.stem;
     EXPECT_EQ(on.stem.find("filters"), std::string::npos) << on.stem;
+    // heap has more objects than the thesis's A and B: the header counts them all.
+    std::map<std::string, std::string> heap_header(on.header.begin(), on.header.end());
+    std::size_t heap_tets = 0;
+    for (std::size_t o = 0; o < heap->num_objects(); ++o) heap_tets += heap->rest_mesh(o).num_tets();
+    EXPECT_EQ(heap_header["#objects"], std::to_string(heap->num_objects()));
+    EXPECT_EQ(heap_header["#tets"], std::to_string(heap_tets));
+    EXPECT_NE(on.stem.find("_" + std::to_string(heap_tets) + "tets"), std::string::npos) << on.stem;
 
     // Rings leave out the self pairs of drape's folds that lie near each other in the mesh.
     config = BenchConfig{};

@@ -52,9 +52,11 @@ void print_report(const BenchConfig& config, const Scene& scene, const BenchOutc
             if (k == key) return v;
         return std::string();
     };
-    std::printf("scene %s (resolution %d): %s+%s tets, frames %d-%d, %d run(s); method %s, test %s, hash %s, self %s, "
+    const std::string tets = scene.num_objects() > 2 ? value("#tets") + " tets in " + value("#objects") + " objects"
+                                                     : value("#tetsA") + "+" + value("#tetsB") + " tets";
+    std::printf("scene %s (resolution %d): %s, frames %d-%d, %d run(s); method %s, test %s, hash %s, self %s, "
                 "backend %s on %s\n",
-                scene.name().c_str(), config.request.resolution, value("#tetsA").c_str(), value("#tetsB").c_str(),
+                scene.name().c_str(), config.request.resolution, tets.c_str(),
                 config.first_frame, last_frame_of(config, scene), config.runs, bench_method_name(config.options.method).c_str(),
                 to_string(config.options.narrow_phase), value("hashing algorithm").c_str(), config.self ? "yes" : "no",
                 to_string(config.options.backend), value("device").c_str());

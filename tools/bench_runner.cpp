@@ -39,9 +39,14 @@ std::size_t vertices_of(const Scene& scene, std::size_t object) {
     return object < scene.num_objects() ? scene.rest_mesh(object).num_vertices() : 0;
 }
 
-std::string stem_of(const BenchConfig& config, const Scene& scene, int last_frame) {
+std::size_t all_tets(const Scene& scene) {
     std::size_t tets = 0;
     for (std::size_t o = 0; o < scene.num_objects(); ++o) tets += tets_of(scene, o);
+    return tets;
+}
+
+std::string stem_of(const BenchConfig& config, const Scene& scene, int last_frame) {
+    const std::size_t tets = all_tets(scene);
     std::string stem = scene.name() + "_r" + std::to_string(config.request.resolution) + "_" +
                        bench_method_name(config.options.method) + "_" + to_string(config.options.narrow_phase) + "_" +
                        hash_label(config.options) + "_g" + std::to_string(config.options.block_size) + "_self-" +
@@ -72,6 +77,9 @@ std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene
             {"#tetsB", std::to_string(tets_of(scene, 1))},
             {"#verticesA", std::to_string(vertices_of(scene, 0))},
             {"#verticesB", std::to_string(vertices_of(scene, 1))},
+            // The thesis's A and B are its scenes' two objects; scenes of more objects need the totals.
+            {"#objects", std::to_string(scene.num_objects())},
+            {"#tets", std::to_string(all_tets(scene))},
             {"backend", to_string(o.backend)},
             {"threads", std::to_string(threads)},
             {"bucket capacity", o.bucket_capacity ? std::to_string(o.bucket_capacity) : "automatic"},
