@@ -403,6 +403,36 @@ float cell_size0_of_row(float edge, float pitch, std::uint32_t count, float cell
     return params.cell_size0;
 }
 
+TEST(ObjectCulling, AnObjectMeetsTheOthersItIsCheckedAgainstWhereTheirBoxesOverlapIt) {
+    // B and C overlap A near x = 10; D overlaps A near x = 0 but is not checked against it; E is apart;
+    // F overlaps A but holds no tets. A's meeting box holds the two overlaps with B and C only.
+    const std::vector<Aabb> boxes = {{{0, 0, 0}, {10, 10, 10}}, {{9, 0, 0}, {12, 2, 2}}, {{8, 1, 1}, {9.5f, 3, 2}},
+                                     {{-1, 4, 4}, {1, 6, 6}},   {{20, 0, 0}, {21, 1, 1}}, {{0, 0, 0}, {10, 10, 10}}};
+    const std::uint32_t n = 6;
+    const std::vector<std::uint32_t> tet_begin = {0, 5, 6, 7, 8, 9, 9};
+    std::vector<std::uint8_t> enabled(n * n, 1), active(n * n);
+    enabled[0 * n + 3] = enabled[3 * n + 0] = 0;
+    std::vector<std::uint32_t> checked(n);
+    std::vector<Aabb> meeting(n);
+    OrderedBox region{};
+    unsigned long long involved = 0;
+    const CpuExec exec(DetectorOptions{});
+    exec.for_each(n, ObjectCullingKernel{enabled.data(), active.data(), checked.data(), boxes.data(), meeting.data(),
+                                         tet_begin.data(), n, &region, &involved});
+    const auto same = [](const Aabb& a, const Aabb& b) {
+        return a.lo.x == b.lo.x && a.lo.y == b.lo.y && a.lo.z == b.lo.z && a.hi.x == b.hi.x && a.hi.y == b.hi.y &&
+               a.hi.z == b.hi.z;
+    };
+    EXPECT_TRUE(same(meeting[0], Aabb{{8, 0, 0}, {10, 3, 2}}));
+    EXPECT_TRUE(same(meeting[1], Aabb{{9, 0, 0}, {10, 2, 2}})); // A and C
+    EXPECT_FALSE(boxes_overlap(Aabb{{0, 4.5f, 4.5f}, {0.5f, 5, 5}}, meeting[0])) << "where only D reaches";
+    EXPECT_FALSE(boxes_overlap(meeting[4], meeting[4])) << "E meets nothing: its meeting box is empty";
+    EXPECT_FALSE(boxes_overlap(meeting[5], meeting[5])) << "F holds no tets";
+    EXPECT_EQ(active[0 * n + 3], 0);
+    EXPECT_EQ(active[0 * n + 5], 0);
+    EXPECT_EQ(active[0 * n + 1], 1);
+}
+
 TEST(GridParams, CellsSpanAFewOfTheTetsSpacings) {
     static_assert(CpuTuning::grid_cell_spacings == 4.0f, "the sizes below are four spacings");
     const float four = CpuTuning::grid_cell_spacings;

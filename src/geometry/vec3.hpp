@@ -128,6 +128,12 @@ KDET_HD inline bool boxes_overlap(const Aabb& a, const Aabb& b) {
            a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
 }
 
+/// @brief The smallest box holding both (an empty box, lo above hi, leaves the other as it is).
+KDET_HD inline Aabb box_union(const Aabb& a, const Aabb& b) { return {min_v(a.lo, b.lo), max_v(a.hi, b.hi)}; }
+
+/// @brief Where both boxes are; lo above hi on some axis when they are apart.
+KDET_HD inline Aabb box_intersection(const Aabb& a, const Aabb& b) { return {max_v(a.lo, b.lo), min_v(a.hi, b.hi)}; }
+
 KDET_HD inline Aabb tet_box(const vec3 v[4]) {
     Aabb b{min_v(min_v(v[0], v[1]), min_v(v[2], v[3])), max_v(max_v(v[0], v[1]), max_v(v[2], v[3]))};
     return b;

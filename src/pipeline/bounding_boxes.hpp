@@ -68,7 +68,8 @@ struct OrderedBox {
 };
 
 /// @brief Stage 1, one work item per object a: which pairs (a, b) are checked this frame (enabled,
-/// both objects hold tets, their boxes overlap; the diagonal is self-collision), and, when a is in
+/// both objects hold tets, their boxes overlap; the diagonal is self-collision), where a's box meets
+/// those of the other objects it is checked against (SceneView::meeting_boxes), and, when a is in
 /// one, its box merged into the region the grid covers and its tets counted. No tets counted: nothing
 /// can collide, and every later stage finds nothing to do.
 struct ObjectCullingKernel {
@@ -76,6 +77,7 @@ struct ObjectCullingKernel {
     std::uint8_t* pair_active;
     std::uint32_t* checked_objects; ///< [object_count] SceneView::checked_objects
     const Aabb* object_boxes;
+    Aabb* meeting_boxes; ///< [object_count] SceneView::meeting_boxes
     const std::uint32_t* object_tet_begin; ///< [object_count + 1]
     std::uint32_t object_count;
     OrderedBox* region;
@@ -85,14 +87,18 @@ struct ObjectCullingKernel {
         const std::uint32_t tets = object_tet_begin[a + 1] - object_tet_begin[a];
         bool involved = false;
         std::uint32_t checked = 0;
+        const float inf = INFINITY;
+        Aabb meeting{{inf, inf, inf}, {-inf, -inf, -inf}};
         for (std::uint32_t b = 0; b < object_count; ++b) {
             const std::uint64_t k = a * object_count + b;
             const bool on = tets && object_tet_begin[b + 1] != object_tet_begin[b] && pair_enabled[k] &&
                             (a == b || boxes_overlap(object_boxes[a], object_boxes[b]));
             pair_active[k] = on ? 1 : 0;
             if (on) checked |= object_bit(b);
+            if (on && a != b) meeting = box_union(meeting, box_intersection(object_boxes[a], object_boxes[b]));
             involved = involved || on;
         }
+        meeting_boxes[a] = meeting;
         // Checked against every object, a tet filters none: any_object spares its scans the blocks' objects.
         checked_objects[a] = checked == all_object_bits(object_count) ? any_object : checked;
         if (!involved) return;

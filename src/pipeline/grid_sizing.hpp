@@ -70,12 +70,9 @@ struct TetSizeKernel {
     std::uint32_t* max_lower_size;  ///< and of their lower bounds
     std::uint32_t* spacing_octaves; ///< [float_octaves] the sampled relevant tets by float_octave(tet_spacing)
 
+    /// Whether the tet may meet a tet it is checked against; one box test, whatever the objects' count.
     KDET_HD bool relevant(std::uint32_t object, const Aabb& box) const {
-        if (pair_is_active(scene, object, object)) return true;
-        for (std::uint32_t other = 0; other < scene.object_count; ++other)
-            if (other != object && pair_is_active(scene, object, other) && boxes_overlap(box, scene.object_boxes[other]))
-                return true;
-        return false;
+        return pair_is_active(scene, object, object) || boxes_overlap(box, scene.meeting_boxes[object]);
     }
 
     KDET_HD void operator()(std::uint64_t t) const {

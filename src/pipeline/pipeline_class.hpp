@@ -79,6 +79,7 @@ public:
         run_objects_.resize_discard(objects);
         run_boxes_.resize_discard(objects);
         object_boxes_.resize_discard(objects);
+        meeting_boxes_.resize_discard(objects);
         // An empty object has no run of tets, so the reduction never writes its box: empty once here.
         const float inf = std::numeric_limits<float>::infinity();
         fill(object_boxes_, Aabb{{inf, inf, inf}, {-inf, -inf, -inf}});
@@ -154,7 +155,7 @@ public:
                user_id_.capacity_bytes() + stored_id_.capacity_bytes() + positions_.capacity_bytes() + vertex_user_id_.capacity_bytes() +
                staged_positions_.capacity_bytes() +
                info_.capacity_bytes() + planes_.capacity_bytes() + slabs_.capacity_bytes() + colliding_.capacity_bytes() + user_colliding_.capacity_bytes() +
-               run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() +
+               run_objects_.capacity_bytes() + run_boxes_.capacity_bytes() + object_boxes_.capacity_bytes() + meeting_boxes_.capacity_bytes() +
                pair_enabled_.capacity_bytes() + pair_active_.capacity_bytes() + checked_objects_.capacity_bytes() +
                exclusion_begin_.capacity_bytes() + excluded_.capacity_bytes() + grid_bytes() + statics_.bytes() + counters_.capacity_bytes() +
                candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() + near_.capacity_bytes() +
@@ -204,7 +205,7 @@ protected:
         // margin reports pairs that the slabs separate.
         TetSlabs* slabs = options_.narrow_phase == NarrowPhase::sat_no_edges || options_.margin > 0.0f ? nullptr : slabs_.data();
         return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), slabs, pair_active_.data(),
-                         checked_objects_.data(), object_boxes_.data(), frame_tets_,
+                         checked_objects_.data(), meeting_boxes_.data(), frame_tets_,
                          static_cast<std::uint32_t>(object_boxes_.size()),
                          exclusion_begin_.size() ? exclusion_begin_.data() : nullptr, excluded_.data(), options_.margin};
     }
@@ -290,6 +291,7 @@ protected:
     buffer<std::uint32_t> run_objects_;    ///< per run of tets of one object (stage 1's reduction)
     buffer<Aabb> run_boxes_;
     buffer<Aabb> object_boxes_;
+    buffer<Aabb> meeting_boxes_;
     buffer<std::uint8_t> pair_enabled_; ///< the caller's switches, [objects * objects]
     buffer<std::uint8_t> pair_active_;  ///< enabled and the boxes overlap, this frame
     buffer<std::uint32_t> checked_objects_; ///< per object, the bits of the objects it is checked against this frame

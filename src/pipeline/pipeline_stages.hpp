@@ -27,7 +27,7 @@ void Pipeline<Exec>::bounds_and_culling() {
     exec_.for_each(objects, ObjectBoxesKernel{run_objects_.data(), run_boxes_.data(), &c->object_runs,
                                               object_boxes_.data()});
     exec_.for_each(objects, ObjectCullingKernel{pair_enabled_.data(), pair_active_.data(), checked_objects_.data(), object_boxes_.data(),
-                                                object_tet_begin_.data(), static_cast<std::uint32_t>(objects),
+                                                meeting_boxes_.data(), object_tet_begin_.data(), static_cast<std::uint32_t>(objects),
                                                 &c->region, &c->involved_tets});
 }
 

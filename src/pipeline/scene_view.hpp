@@ -39,7 +39,10 @@ struct SceneView {
     const std::uint8_t* pair_active; ///< [object_count * object_count]; diagonal = self-collision
     /// [object_count] object_bit of every object a is checked against; any_object when that is all of them
     const std::uint32_t* checked_objects;
-    const Aabb* object_boxes;
+    /// [object_count] the smallest box holding where an object's box meets the box of each other object
+    /// it is checked against (empty, lo above hi, when there is none): a tet whose box misses it
+    /// cannot meet another object's tet.
+    const Aabb* meeting_boxes;
     std::uint32_t tet_count;
     std::uint32_t object_count;
     /// [tet_count + 1] where each tet's excluded partners start in `excluded` (pair_exclusions.hpp), or
