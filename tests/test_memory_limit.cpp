@@ -21,12 +21,15 @@ using test::error_message;
 /// A few tets around the pile, some of them in it: a scene of a few pairs.
 TetMesh small_neighbour() { return test::random_soup(40, 1.0, 0.3, 7); }
 
-/// The pairs a refusal names: "the frame has N candidate pairs" or "N colliding pairs" (0 if none).
+/// The pairs a refusal names: "the frame has N candidate pairs", "at least N candidate pairs" (a lower
+/// bound refused it before the count) or "N colliding pairs" (0 if none).
 std::uint64_t pairs_named(const std::string& message) {
-    const std::string lead = "the frame has ";
-    const std::size_t at = message.find(lead);
+    const std::string lead = "the frame has ", bound = "at least ";
+    std::size_t at = message.find(lead);
     if (at == std::string::npos || message.find(" pairs", at) == std::string::npos) return 0;
-    return std::stoull(message.substr(at + lead.size()));
+    at += lead.size();
+    if (message.compare(at, bound.size(), bound) == 0) at += bound.size();
+    return std::stoull(message.substr(at));
 }
 
 constexpr std::uint32_t pile = 300;

@@ -207,17 +207,34 @@ bool Pipeline<Exec>::pairs_window_within_memory(std::size_t wanted, std::size_t 
 /// @brief A first frame's window for its colliding pairs, which are at most its `candidates`: room for
 /// all of them, filled once (every byte of it is copied out), or the frame is refused before the
 /// narrow phase runs. find_candidates reserves it as soon as it has counted a candidate buffer's
-/// overflow, before the search stores them.
+/// overflow, before the search stores them (`at_least`: a lower bound on them, refuse_first_frame).
 template <class Exec>
-void Pipeline<Exec>::reserve_pairs_window(std::uint64_t candidates) {
+void Pipeline<Exec>::reserve_pairs_window(std::uint64_t candidates, bool at_least) {
     if (candidates <= pairs_window_) return;
-    if (!pairs_window_within_memory(candidates, candidates)) refuse_first_frame(candidates);
+    if (!pairs_window_within_memory(candidates, candidates)) refuse_first_frame(candidates, at_least);
     fill(out_keys_, no_pair_key);
     if (options_.contacts) fill(out_contacts_, Contact{});
     if (options_.distances) {
         fill(out_distances_, 0.0f);
         fill(out_closest_, ClosestPoints{});
     }
+}
+
+/// @brief A first frame whose candidate buffer overflowed: refuses it at once (refuse_first_frame) where
+/// its candidates' lower bound (candidate_lower_bound, over the grid's `cells` lists) with room for as
+/// many colliding pairs already exceeds memory_limit beside what does not grow with the pairs, or the
+/// pairs' window for them cannot be allocated. Else the window is reserved for them (it holds at least
+/// that many anyway) and the frame counts its candidates.
+template <class Exec>
+void Pipeline<Exec>::refuse_beyond_candidate_bound(const GridView& grid, std::uint32_t cells) {
+    const std::uint64_t least = candidate_lower_bound(exec_, scene_view(), grid, cells,
+                                                      static_cast<std::uint32_t>(tets_.size()), positions_.size());
+    const std::size_t grows_with_pairs = candidates_.capacity_bytes() + candidates_grown_.capacity_bytes() +
+                                         out_keys_.capacity_bytes() + out_contacts_.capacity_bytes() +
+                                         out_distances_.capacity_bytes() + out_closest_.capacity_bytes() +
+                                         exec_.sort_spare_bytes();
+    if (least > room(grows_with_pairs, sizeof(std::uint64_t) + pair_bytes())) refuse_first_frame(least, true);
+    reserve_pairs_window(least, true);
 }
 
 /// @brief Ends a frame whose pairs the memory (or memory_limit) cannot hold, before anything grows for
@@ -238,11 +255,11 @@ void Pipeline<Exec>::refuse_frame(const std::string& need, std::uint64_t bytes) 
     throw_frame_too_large(need, bytes, memory_bytes(), options_.memory_limit);
 }
 
-/// @brief refuse_frame for a first frame of `candidates` candidate pairs, which needs room for them and
-/// for as many colliding pairs.
+/// @brief refuse_frame for a first frame of `candidates` candidate pairs (at least that many where
+/// `at_least`: a lower bound), which needs room for them and for as many colliding pairs.
 template <class Exec>
-void Pipeline<Exec>::refuse_first_frame(std::uint64_t candidates) {
-    refuse_frame("the frame has " + std::to_string(candidates) +
+void Pipeline<Exec>::refuse_first_frame(std::uint64_t candidates, bool at_least) {
+    refuse_frame("the frame has " + std::string(at_least ? "at least " : "") + std::to_string(candidates) +
                      " candidate pairs; with room for all of them to collide, as a first frame keeps, they take",
                  candidates * (sizeof(std::uint64_t) + pair_bytes()));
 }

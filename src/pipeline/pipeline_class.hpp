@@ -12,6 +12,7 @@
 
 #include "pipeline/bounding_boxes.hpp"
 #include "pipeline/capacity.hpp"
+#include "pipeline/candidate_bound.hpp"
 #include "pipeline/candidate_search.hpp"
 #include "pipeline/exclusion_rings.hpp"
 #include "pipeline/frame_counters.hpp"
@@ -247,9 +248,10 @@ protected:
     enum class Rerun { none, results, candidates, grid };
     Rerun grow_for(const FrameCounters& c);
     bool pairs_window_within_memory(std::size_t wanted, std::size_t needed);
-    void reserve_pairs_window(std::uint64_t candidates);
+    void reserve_pairs_window(std::uint64_t candidates, bool at_least = false);
+    void refuse_beyond_candidate_bound(const GridView& grid, std::uint32_t cells);
     [[noreturn]] void refuse_frame(const std::string& need, std::uint64_t bytes);
-    [[noreturn]] void refuse_first_frame(std::uint64_t candidates);
+    [[noreturn]] void refuse_first_frame(std::uint64_t candidates, bool at_least = false);
     /// Bytes of the pairs' window per pair: its key, its sort's spare key, its contact and its distance
     /// and closest points where asked for.
     std::size_t pair_bytes() const {

@@ -144,7 +144,8 @@ GridView Pipeline<Exec>::populate() {
 /// the keys it had stored. There is room to resume one item per tet; when more stop (a first buffer
 /// far too small for a split search), every item counts and then searches again into the grown
 /// buffer. A need that the memory (or memory_limit) cannot hold, with room for as many colliding
-/// pairs, throws at once, before the search stores it. Later frames read nothing here; an overflow
+/// pairs, throws at once, before the search stores it; before the count, where a lower bound on the
+/// candidates (candidate_bound.hpp) is already more than that. Later frames read nothing here; an overflow
 /// shows in the frame's counters, which count past the buffer's end, and the frame reruns (grow_for).
 /// Returns the counters when it read them.
 template <class Exec>
@@ -181,6 +182,7 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
         if (!after.stopped_items) return after;
+        if (run == 0) refuse_beyond_candidate_bound(grid, after.cells_claimed);
         // The count: the items to search again, into a buffer of no room, on counters of their own.
         const bool resume = after.stopped_items <= resume_room;
         items = resume ? after.stopped_items : all_items;
