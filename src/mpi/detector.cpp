@@ -57,6 +57,16 @@ std::string convert_positions(ObjectId object, const PositionsView& view, const 
     return {};
 }
 
+/// The errors of a ghost's vertex whose position disagrees with this rank's or with another ghost's.
+std::string moved_here(std::size_t object, std::uint32_t vertex, std::uint32_t tet) {
+    return "object " + std::to_string(object) + ": vertex " + std::to_string(vertex) +
+           " has different positions here and on the rank owning tet " + std::to_string(tet);
+}
+std::string arrives_twice(std::size_t object, std::uint32_t vertex) {
+    return "object " + std::to_string(object) + ": vertex " + std::to_string(vertex) +
+           " arrives with two different positions from other ranks";
+}
+
 } // namespace
 
 ObjectPart MeshPart::view() const {
@@ -143,6 +153,8 @@ struct Detector::Impl {
     std::string summarize(std::vector<unsigned char>& record);
     void exchange(const std::vector<PartSummary>& summaries, std::vector<TetRecord>& received);
     std::string build_local(std::vector<TetRecord>& received, bool& rebuilt);
+    std::string renumber(std::size_t o, const TetRecord* ghosts, std::size_t count, LocalObject& lo) const;
+    std::string refresh(std::size_t o, const TetRecord* ghosts, std::size_t count);
     void collect_pairs(const kdet::FrameResult& frame);
 };
 
@@ -351,9 +363,82 @@ void Detector::Impl::exchange(const std::vector<PartSummary>& summaries, std::ve
     result.exchange.bytes_received += total_recv * sizeof(TetRecord) + (n - 1) * sizeof(int);
 }
 
+/// Object @p o's local tets and positions from its owned tets and its ghosts @p ghosts (sorted by
+/// global id) into @p lo, the ghosts' vertices renumbered; returns an error found in their positions, or "".
+std::string Detector::Impl::renumber(std::size_t o, const TetRecord* ghosts, std::size_t count, LocalObject& lo) const {
+    const Object& object = objects[o];
+    for (std::size_t k = 0; k < count; ++k) lo.ghost_ids.push_back(ghosts[k].tet);
+    // Vertices only ghosts use, by global id; a vertex this rank holds, or that two ghosts share,
+    // must arrive with the one position every holder gives it.
+    struct Ghost {
+        std::uint32_t id;
+        const float* position;
+    };
+    std::vector<Ghost> extra;
+    for (std::size_t k = 0; k < count; ++k)
+        for (int c = 0; c < 4; ++c) {
+            const TetRecord& rec = ghosts[k];
+            const std::ptrdiff_t h = object.held(rec.vertex[c]);
+            if (h < 0) extra.push_back(Ghost{rec.vertex[c], &rec.position[3 * c]});
+            else if (std::memcmp(&object.positions[3 * static_cast<std::size_t>(h)], &rec.position[3 * c], 3 * sizeof(float)) != 0)
+                return moved_here(o, rec.vertex[c], rec.tet);
+        }
+    std::sort(extra.begin(), extra.end(), [](const Ghost& x, const Ghost& y) { return x.id < y.id; });
+    std::vector<std::uint32_t> extra_ids;
+    const std::size_t held = object.vertex_ids.size();
+    lo.positions = object.positions;
+    for (std::size_t k = 0; k < extra.size(); ++k) {
+        if (k > 0 && extra[k].id == extra[k - 1].id) {
+            if (std::memcmp(extra[k].position, extra[k - 1].position, 3 * sizeof(float)) != 0) return arrives_twice(o, extra[k].id);
+            continue;
+        }
+        extra_ids.push_back(extra[k].id);
+        lo.positions.insert(lo.positions.end(), extra[k].position, extra[k].position + 3);
+    }
+    lo.tets = object.tets;
+    for (std::size_t k = 0; k < count; ++k)
+        for (int c = 0; c < 4; ++c) {
+            const std::uint32_t g = ghosts[k].vertex[c];
+            const std::ptrdiff_t h = object.held(g);
+            lo.tets.push_back(h >= 0 ? static_cast<std::uint32_t>(h)
+                                     : static_cast<std::uint32_t>(held + static_cast<std::size_t>(
+                                                                             std::lower_bound(extra_ids.begin(), extra_ids.end(), g) -
+                                                                             extra_ids.begin())));
+        }
+    return {};
+}
+
+/// Object @p o's ghosts are the previous frame's: its local tets and numbering stay, and only the
+/// positions are refreshed in place, with the same checks as renumber(). Returns an error, or "".
+std::string Detector::Impl::refresh(std::size_t o, const TetRecord* ghosts, std::size_t count) {
+    const Object& object = objects[o];
+    LocalObject& lo = local_objects[o];
+    const std::size_t held = object.vertex_ids.size(), owned = object.tet_ids.size();
+    std::copy(object.positions.begin(), object.positions.end(), lo.positions.begin());
+    // First the held vertices are checked and the others written, then those compared with what
+    // every other record brings for them.
+    for (int pass = 0; pass < 2; ++pass)
+        for (std::size_t k = 0; k < count; ++k)
+            for (int c = 0; c < 4; ++c) {
+                const std::size_t v = lo.tets[4 * (owned + k) + static_cast<std::size_t>(c)];
+                float* here = &lo.positions[3 * v];
+                const float* brought = &ghosts[k].position[3 * c];
+                const bool differs = std::memcmp(here, brought, 3 * sizeof(float)) != 0;
+                if (v < held) {
+                    if (pass == 0 && differs) return moved_here(o, ghosts[k].vertex[c], ghosts[k].tet);
+                } else if (pass == 0) {
+                    std::memcpy(here, brought, 3 * sizeof(float));
+                } else if (differs) {
+                    return arrives_twice(o, ghosts[k].vertex[c]);
+                }
+            }
+    return {};
+}
+
 /// Builds the local detector from the owned tets and @p received, or updates it: set_tets() for the
-/// objects whose local tets changed, set_positions() for the others. Returns an error found in the
-/// received positions, or "".
+/// objects whose ghosts changed, set_positions() for the others, whose local tets stay as they were.
+/// Returns an error found in the received positions, or "" (on an error the caller drops the local
+/// detector, so that a half-refreshed object is never used).
 std::string Detector::Impl::build_local(std::vector<TetRecord>& received, bool& rebuilt) {
     std::sort(received.begin(), received.end(),
               [](const TetRecord& x, const TetRecord& y) { return std::tie(x.object, x.tet) < std::tie(y.object, y.tet); });
@@ -363,56 +448,21 @@ std::string Detector::Impl::build_local(std::vector<TetRecord>& received, bool& 
     std::vector<LocalObject> next(objects.size());
     std::size_t at = 0;
     for (std::size_t o = 0; o < objects.size(); ++o) {
-        const Object& object = objects[o];
-        LocalObject& lo = next[o];
         const std::size_t begin = at;
-        while (at < received.size() && received[at].object == o) lo.ghost_ids.push_back(received[at++].tet);
-        // Vertices only ghosts use, by global id; a vertex this rank holds, or that two ghosts share,
-        // must arrive with the one position every holder gives it.
-        struct Ghost {
-            std::uint32_t id;
-            const float* position;
-        };
-        std::vector<Ghost> extra;
-        for (std::size_t k = begin; k < at; ++k)
-            for (int c = 0; c < 4; ++c) {
-                const TetRecord& rec = received[k];
-                const std::ptrdiff_t h = object.held(rec.vertex[c]);
-                if (h < 0) {
-                    extra.push_back(Ghost{rec.vertex[c], &rec.position[3 * c]});
-                } else if (std::memcmp(&object.positions[3 * static_cast<std::size_t>(h)], &rec.position[3 * c], 3 * sizeof(float)) != 0) {
-                    return "object " + std::to_string(o) + ": vertex " + std::to_string(rec.vertex[c]) +
-                           " has different positions here and on the rank owning tet " + std::to_string(rec.tet);
-                }
-            }
-        std::sort(extra.begin(), extra.end(), [](const Ghost& x, const Ghost& y) { return x.id < y.id; });
-        std::vector<std::uint32_t> extra_ids;
-        const std::size_t held = object.vertex_ids.size();
-        lo.positions = object.positions;
-        for (std::size_t k = 0; k < extra.size(); ++k) {
-            if (k > 0 && extra[k].id == extra[k - 1].id) {
-                if (std::memcmp(extra[k].position, extra[k - 1].position, 3 * sizeof(float)) != 0)
-                    return "object " + std::to_string(o) + ": vertex " + std::to_string(extra[k].id) +
-                           " arrives with two different positions from other ranks";
-                continue;
-            }
-            extra_ids.push_back(extra[k].id);
-            lo.positions.insert(lo.positions.end(), extra[k].position, extra[k].position + 3);
-        }
-        lo.tets = object.tets;
-        for (std::size_t k = begin; k < at; ++k)
-            for (int c = 0; c < 4; ++c) {
-                const std::uint32_t g = received[k].vertex[c];
-                const std::ptrdiff_t h = object.held(g);
-                lo.tets.push_back(h >= 0 ? static_cast<std::uint32_t>(h)
-                                         : static_cast<std::uint32_t>(held + static_cast<std::size_t>(
-                                                                                 std::lower_bound(extra_ids.begin(), extra_ids.end(), g) -
-                                                                                 extra_ids.begin())));
-            }
-        changed[o] = !anew && (lo.ghost_ids != local_objects[o].ghost_ids || lo.tets != local_objects[o].tets);
+        while (at < received.size() && received[at].object == o) ++at;
+        const std::vector<std::uint32_t>* before = anew ? nullptr : &local_objects[o].ghost_ids;
+        const bool same = before && before->size() == at - begin &&
+                          std::equal(before->begin(), before->end(), received.begin() + static_cast<std::ptrdiff_t>(begin),
+                                     [](std::uint32_t id, const TetRecord& rec) { return id == rec.tet; });
+        const std::string error = same ? refresh(o, received.data() + begin, at - begin)
+                                       : renumber(o, received.data() + begin, at - begin, next[o]);
+        if (!error.empty()) return error;
+        changed[o] = !anew && !same;
         rebuilt = rebuilt || changed[o];
     }
-    local_objects = std::move(next);
+    local_objects.resize(objects.size());
+    for (std::size_t o = 0; o < objects.size(); ++o)
+        if (anew || changed[o]) local_objects[o] = std::move(next[o]);
     if (anew) {
         local.reset();
         auto fresh = std::make_unique<kdet::Detector>(options);
