@@ -107,7 +107,8 @@ struct ChunkBoxes {
     }
 };
 
-/// Marks the coarse cells owned tet t's box overlaps in its part's summary.
+/// Marks the coarse cells owned tet t's box overlaps in its part's summary. Neighbouring tets share
+/// most cells: a bit already set is only read, not written again by a locked instruction.
 struct MarkCells {
     const Aabb* boxes;
     CoarseGrid grid;
@@ -115,7 +116,8 @@ struct MarkCells {
     KDET_HD void operator()(std::uint64_t t) const {
         for_each_cell(coarse_cells(grid, boxes[t]), [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
             const std::uint32_t bit = coarse_cell_bit(x, y, z);
-            atomic_fetch_or(&cells[bit / 64], std::uint64_t{1} << (bit % 64));
+            const std::uint64_t mask = std::uint64_t{1} << (bit % 64);
+            if (!(atomic_load_acquire(&cells[bit / 64]) & mask)) atomic_fetch_or(&cells[bit / 64], mask);
             return true;
         });
     }
