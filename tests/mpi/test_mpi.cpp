@@ -155,6 +155,20 @@ TEST(Mpi, RandomSoupsOverFrames) {
     expect_same_with_both_partitions(s);
 }
 
+TEST(Mpi, TwoThreadsPerRankAsOne) {
+    // The layer's per-tet functors share a rank's tets among its threads (above 512 tets): the records
+    // must come out as with one thread.
+    Scenario s = scenario({random_soup(1500, 1.0, 1.5, 71), random_soup(1500, 1.0, 1.5, 72)});
+    s.self[1] = true;
+    s.frames.push_back(s.frames[0]);
+    for (std::size_t i = 0; i < s.frames.back()[0].size(); i += 3) s.frames.back()[0][i] += 0.1;
+    DetectorOptions options;
+    options.threads = 2;
+    std::vector<const TetMesh*> meshes{&s.meshes[0], &s.meshes[1]};
+    for (mpi::Partition kind : {mpi::Partition::slabs, mpi::Partition::random})
+        expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), kind, 17), options);
+}
+
 TEST(Mpi, RealMeshes) {
     const TetMesh bunny = load_model("bunny.mesh");
     const TetMesh octopus = load_model("octopus-low.mesh");
