@@ -3,6 +3,8 @@
 
 #include "agree.hpp"
 #include "exchange.hpp"
+#include "exchange_kernels.hpp"
+#include "exec/cpu_exec.hpp"
 
 #include <kdet/error.hpp>
 #include <kdet/mpi.hpp>
@@ -11,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <set>
 #include <string>
 #include <tuple>
@@ -20,81 +23,11 @@ namespace kdet::mpi {
 
 namespace {
 
-/// Cells per axis of the coarse grid over each rank's part of each object: which of them the part
-/// occupies travels with its bounds, so that a tet goes only where it may meet a tet (a slab of a
-/// curved object fills little of its box). 16^3 cells are 512 bytes per object and rank.
-constexpr int grid_cells = 16;
-constexpr int cell_words = grid_cells * grid_cells * grid_cells / 64;
-
 /// The local detector's limit on tets, checked on owned tets before they are exchanged.
 constexpr std::size_t max_local_tets = (std::size_t{1} << 29) - 1;
 
-struct Box {
-    float lo[3] = {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
-                   std::numeric_limits<float>::infinity()};
-    float hi[3] = {-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-                   -std::numeric_limits<float>::infinity()};
-    bool empty() const { return !(lo[0] <= hi[0]); }
-    void add(const float* p) {
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = std::min(lo[k], p[k]);
-            hi[k] = std::max(hi[k], p[k]);
-        }
-    }
-    bool overlaps(const Box& o) const {
-        for (int k = 0; k < 3; ++k)
-            if (o.hi[k] < lo[k] || hi[k] < o.lo[k]) return false;
-        return true;
-    }
-    /// Grows the box by `half_margin` per side, rounded outward, so that the boxes of two tets at most
-    /// DetectorOptions::margin apart overlap and the pair travels.
-    void grow(float half_margin) {
-        if (!(half_margin > 0.0f)) return;
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = std::nextafter(lo[k] - half_margin, -std::numeric_limits<float>::infinity());
-            hi[k] = std::nextafter(hi[k] + half_margin, std::numeric_limits<float>::infinity());
-        }
-    }
-};
-
-/// What every rank gathers about every other rank's part of one object.
-struct PartSummary {
-    Box box;
-    std::uint64_t cells[cell_words];
-};
-
-/// The coarse cell of coordinate @p x along axis @p k of @p box's grid. Monotone in x, and computed
-/// alike by the rank that marks a cell and the one that tests it, so two boxes sharing a point share a
-/// cell: a tet meeting a tet of the part overlaps one of the part's marked cells.
-int cell_of(const Box& box, int k, float x) {
-    const double extent = static_cast<double>(box.hi[k]) - static_cast<double>(box.lo[k]);
-    if (!(extent > 0)) return 0;
-    const double c = std::floor((static_cast<double>(x) - static_cast<double>(box.lo[k])) * (grid_cells / extent));
-    return static_cast<int>(std::clamp(c, 0.0, static_cast<double>(grid_cells - 1)));
-}
-
-struct CellRange {
-    int lo[3], hi[3];
-};
-
-CellRange cell_range(const Box& grid, const Box& box) {
-    CellRange r{};
-    for (int k = 0; k < 3; ++k) {
-        r.lo[k] = cell_of(grid, k, box.lo[k]);
-        r.hi[k] = cell_of(grid, k, box.hi[k]);
-    }
-    return r;
-}
-
-int cell_index(int x, int y, int z) { return (z * grid_cells + y) * grid_cells + x; }
-
-/// One tet on its way to another rank: its object, global id, global vertex ids and positions.
-struct TetRecord {
-    std::uint32_t object, tet;
-    std::uint32_t vertex[4];
-    float position[12];
-};
-static_assert(sizeof(TetRecord) == 72, "tet records travel as raw bytes");
+using detail::PartSummary;
+using detail::TetRecord;
 
 /// A position of a caller's view as the float32 kdet stores (the conversion kdet::Detector makes).
 void read_position(const PositionsView& view, std::size_t v, float* out) {
@@ -122,6 +55,16 @@ std::string convert_positions(ObjectId object, const PositionsView& view, const 
                        " has a non-finite coordinate (or one beyond float range)";
     }
     return {};
+}
+
+/// The errors of a ghost's vertex whose position disagrees with this rank's or with another ghost's.
+std::string moved_here(std::size_t object, std::uint32_t vertex, std::uint32_t tet) {
+    return "object " + std::to_string(object) + ": vertex " + std::to_string(vertex) +
+           " has different positions here and on the rank owning tet " + std::to_string(tet);
+}
+std::string arrives_twice(std::size_t object, std::uint32_t vertex) {
+    return "object " + std::to_string(object) + ": vertex " + std::to_string(vertex) +
+           " arrives with two different positions from other ranks";
 }
 
 } // namespace
@@ -166,9 +109,13 @@ struct Detector::Impl {
         std::vector<float> positions;
     };
 
+    explicit Impl(const DetectorOptions& detector_options) : options(detector_options), exec(detector_options) {}
+
     MPI_Comm comm = MPI_COMM_NULL;
     int rank = 0, size = 1;
     DetectorOptions options;
+    CpuExec exec; ///< runs the layer's per-tet functors on the host's threads
+    std::vector<std::vector<Aabb>> tet_boxes; ///< [object][owned tet]: this frame's boxes
     std::vector<Object> objects;
     std::set<std::pair<ObjectId, ObjectId>> pairs_off;
     std::string pending_error; ///< from set_positions, reported by the next detect()
@@ -203,9 +150,11 @@ struct Detector::Impl {
     std::string check_directory(const Object& object) const;
 
     const FrameResult& detect();
-    std::string summarize(std::vector<unsigned char>& record) const;
+    std::string summarize(std::vector<unsigned char>& record);
     void exchange(const std::vector<PartSummary>& summaries, std::vector<TetRecord>& received);
     std::string build_local(std::vector<TetRecord>& received, bool& rebuilt);
+    std::string renumber(std::size_t o, const TetRecord* ghosts, std::size_t count, LocalObject& lo) const;
+    std::string refresh(std::size_t o, const TetRecord* ghosts, std::size_t count);
     void collect_pairs(const kdet::FrameResult& frame);
 };
 
@@ -323,34 +272,27 @@ ObjectId Detector::Impl::add(const ObjectPart& part) {
 }
 
 /// This rank's record for the frame's gather: its status, the switches' hash, and per object the
-/// box and occupied cells of its part. Returns this rank's pending error, if any.
-std::string Detector::Impl::summarize(std::vector<unsigned char>& record) const {
+/// box and occupied cells of its part (its tets' boxes kept for exchange()). Returns this rank's
+/// pending error, if any.
+std::string Detector::Impl::summarize(std::vector<unsigned char>& record) {
     const std::uint32_t status = pending_error.empty() ? 0u : 1u;
     const std::uint64_t hash = switches_hash();
     std::memcpy(record.data(), &status, 4);
     std::memcpy(record.data() + 8, &hash, 8);
+    tet_boxes.resize(objects.size());
     for (std::size_t o = 0; o < objects.size(); ++o) {
         const Object& object = objects[o];
+        const std::uint64_t n = object.tet_ids.size();
+        std::vector<Aabb>& boxes = tet_boxes[o];
+        boxes.resize(n);
+        exec.for_each(n, detail::OwnedTetBoxes{object.positions.data(), object.tets.data(), options.margin, boxes.data()});
+        constexpr std::uint32_t chunk = 4096;
+        std::vector<Aabb> chunk_boxes((n + chunk - 1) / chunk);
+        exec.for_each(chunk_boxes.size(), detail::ChunkBoxes{boxes.data(), n, chunk, chunk_boxes.data()}, chunk);
         PartSummary s{};
-        s.box = Box{};
-        std::vector<Box> boxes(object.tet_ids.size());
-        for (std::size_t t = 0; t < boxes.size(); ++t) {
-            for (int c = 0; c < 4; ++c) boxes[t].add(&object.positions[3 * object.tets[4 * t + c]]);
-            boxes[t].grow(options.margin / 2);
-            for (int k = 0; k < 3; ++k) {
-                s.box.lo[k] = std::min(s.box.lo[k], boxes[t].lo[k]);
-                s.box.hi[k] = std::max(s.box.hi[k], boxes[t].hi[k]);
-            }
-        }
-        for (const Box& b : boxes) {
-            const CellRange r = cell_range(s.box, b);
-            for (int z = r.lo[2]; z <= r.hi[2]; ++z)
-                for (int y = r.lo[1]; y <= r.hi[1]; ++y)
-                    for (int x = r.lo[0]; x <= r.hi[0]; ++x) {
-                        const int c = cell_index(x, y, z);
-                        s.cells[c / 64] |= std::uint64_t{1} << (c % 64);
-                    }
-        }
+        s.box = detail::empty_box();
+        for (const Aabb& box : chunk_boxes) s.box = BoxUnion{}(s.box, box);
+        exec.for_each(n, detail::MarkCells{boxes.data(), detail::coarse_grid(s.box), s.cells});
         std::memcpy(record.data() + 16 + o * sizeof(PartSummary), &s, sizeof s);
     }
     return pending_error;
@@ -367,43 +309,45 @@ void Detector::Impl::exchange(const std::vector<PartSummary>& summaries, std::ve
         bool any = false;
         for (std::size_t a = 0; a < n_objects && !any; ++a)
             for (std::size_t b = 0; b < n_objects && !any; ++b)
-                any = checks(static_cast<ObjectId>(a), static_cast<ObjectId>(b)) && !summary(rank, a).box.empty() &&
-                      !summary(r, b).box.empty() && summary(rank, a).box.overlaps(summary(r, b).box);
+                any = checks(static_cast<ObjectId>(a), static_cast<ObjectId>(b)) && !detail::box_is_empty(summary(rank, a).box) &&
+                      !detail::box_is_empty(summary(r, b).box) && boxes_overlap(summary(rank, a).box, summary(r, b).box);
         if (any) near.push_back(r);
     }
-    std::vector<std::vector<TetRecord>> out(static_cast<std::size_t>(size));
-    for (std::size_t a = 0; a < n_objects; ++a) {
-        const Object& object = objects[a];
-        for (std::size_t t = 0; t < object.tet_ids.size(); ++t) {
-            Box box;
-            for (int c = 0; c < 4; ++c) box.add(&object.positions[3 * object.tets[4 * t + c]]);
-            box.grow(options.margin / 2);
-            for (int r : near) {
-                bool send = false;
-                for (std::size_t b = 0; b < n_objects && !send; ++b) {
-                    const PartSummary& s = summary(r, b);
-                    if (!checks(static_cast<ObjectId>(a), static_cast<ObjectId>(b)) || s.box.empty() || !s.box.overlaps(box))
-                        continue;
-                    const CellRange range = cell_range(s.box, box);
-                    for (int z = range.lo[2]; z <= range.hi[2] && !send; ++z)
-                        for (int y = range.lo[1]; y <= range.hi[1] && !send; ++y)
-                            for (int x = range.lo[0]; x <= range.hi[0] && !send; ++x) {
-                                const int cell = cell_index(x, y, z);
-                                send = (s.cells[cell / 64] >> (cell % 64)) & 1u;
-                            }
-                }
-                if (!send) continue;
-                TetRecord rec;
-                rec.object = static_cast<std::uint32_t>(a);
-                rec.tet = object.tet_ids[t];
-                for (int c = 0; c < 4; ++c) {
-                    const std::uint32_t h = object.tets[4 * t + c];
-                    rec.vertex[c] = object.vertex_ids[h];
-                    std::memcpy(&rec.position[3 * c], &object.positions[3 * h], 3 * sizeof(float));
-                }
-                out[static_cast<std::size_t>(r)].push_back(rec);
-            }
+    // The near ranks' summaries and their coarse grids, [j * objects + b].
+    std::vector<PartSummary> near_summaries;
+    std::vector<detail::CoarseGrid> grids;
+    for (int r : near)
+        for (std::size_t b = 0; b < n_objects; ++b) {
+            near_summaries.push_back(summary(r, b));
+            grids.push_back(detail::coarse_grid(summary(r, b).box));
         }
+    const auto ranks = static_cast<std::uint32_t>(near.size());
+    std::vector<std::vector<TetRecord>> out(static_cast<std::size_t>(size));
+    std::vector<std::uint8_t> checked(n_objects);
+    std::vector<std::uint32_t> places;
+    std::vector<TetRecord*> records(near.size());
+    for (std::size_t a = 0; a < n_objects && ranks > 0; ++a) {
+        const Object& object = objects[a];
+        const std::uint64_t n = object.tet_ids.size();
+        for (std::size_t b = 0; b < n_objects; ++b) checked[b] = checks(static_cast<ObjectId>(a), static_cast<ObjectId>(b));
+        places.resize(ranks * (n + 1));
+        exec.for_each(n, detail::ChooseRanks{tet_boxes[a].data(), n, near_summaries.data(), grids.data(), checked.data(),
+                                             static_cast<std::uint32_t>(n_objects), ranks, places.data()},
+                      ranks);
+        // Each rank's flags become the places of the tets going there.
+        for (std::uint32_t j = 0; j < ranks; ++j) {
+            std::uint32_t* first = places.data() + j * (n + 1);
+            first[n] = 0;
+            std::exclusive_scan(first, first + n + 1, first, 0u);
+            std::vector<TetRecord>& list = out[static_cast<std::size_t>(near[j])];
+            const std::size_t before = list.size();
+            list.resize(before + first[n]);
+            records[j] = list.data() + before;
+        }
+        exec.for_each(n, detail::PackRecords{static_cast<std::uint32_t>(a), n, object.tet_ids.data(), object.tets.data(),
+                                             object.vertex_ids.data(), object.positions.data(), places.data(), ranks,
+                                             records.data()},
+                      ranks);
     }
     const std::size_t n = static_cast<std::size_t>(size);
     std::size_t total_send = 0;
@@ -419,9 +363,82 @@ void Detector::Impl::exchange(const std::vector<PartSummary>& summaries, std::ve
     result.exchange.bytes_received += total_recv * sizeof(TetRecord) + (n - 1) * sizeof(int);
 }
 
+/// Object @p o's local tets and positions from its owned tets and its ghosts @p ghosts (sorted by
+/// global id) into @p lo, the ghosts' vertices renumbered; returns an error found in their positions, or "".
+std::string Detector::Impl::renumber(std::size_t o, const TetRecord* ghosts, std::size_t count, LocalObject& lo) const {
+    const Object& object = objects[o];
+    for (std::size_t k = 0; k < count; ++k) lo.ghost_ids.push_back(ghosts[k].tet);
+    // Vertices only ghosts use, by global id; a vertex this rank holds, or that two ghosts share,
+    // must arrive with the one position every holder gives it.
+    struct Ghost {
+        std::uint32_t id;
+        const float* position;
+    };
+    std::vector<Ghost> extra;
+    for (std::size_t k = 0; k < count; ++k)
+        for (int c = 0; c < 4; ++c) {
+            const TetRecord& rec = ghosts[k];
+            const std::ptrdiff_t h = object.held(rec.vertex[c]);
+            if (h < 0) extra.push_back(Ghost{rec.vertex[c], &rec.position[3 * c]});
+            else if (std::memcmp(&object.positions[3 * static_cast<std::size_t>(h)], &rec.position[3 * c], 3 * sizeof(float)) != 0)
+                return moved_here(o, rec.vertex[c], rec.tet);
+        }
+    std::sort(extra.begin(), extra.end(), [](const Ghost& x, const Ghost& y) { return x.id < y.id; });
+    std::vector<std::uint32_t> extra_ids;
+    const std::size_t held = object.vertex_ids.size();
+    lo.positions = object.positions;
+    for (std::size_t k = 0; k < extra.size(); ++k) {
+        if (k > 0 && extra[k].id == extra[k - 1].id) {
+            if (std::memcmp(extra[k].position, extra[k - 1].position, 3 * sizeof(float)) != 0) return arrives_twice(o, extra[k].id);
+            continue;
+        }
+        extra_ids.push_back(extra[k].id);
+        lo.positions.insert(lo.positions.end(), extra[k].position, extra[k].position + 3);
+    }
+    lo.tets = object.tets;
+    for (std::size_t k = 0; k < count; ++k)
+        for (int c = 0; c < 4; ++c) {
+            const std::uint32_t g = ghosts[k].vertex[c];
+            const std::ptrdiff_t h = object.held(g);
+            lo.tets.push_back(h >= 0 ? static_cast<std::uint32_t>(h)
+                                     : static_cast<std::uint32_t>(held + static_cast<std::size_t>(
+                                                                             std::lower_bound(extra_ids.begin(), extra_ids.end(), g) -
+                                                                             extra_ids.begin())));
+        }
+    return {};
+}
+
+/// Object @p o's ghosts are the previous frame's: its local tets and numbering stay, and only the
+/// positions are refreshed in place, with the same checks as renumber(). Returns an error, or "".
+std::string Detector::Impl::refresh(std::size_t o, const TetRecord* ghosts, std::size_t count) {
+    const Object& object = objects[o];
+    LocalObject& lo = local_objects[o];
+    const std::size_t held = object.vertex_ids.size(), owned = object.tet_ids.size();
+    std::copy(object.positions.begin(), object.positions.end(), lo.positions.begin());
+    // First the held vertices are checked and the others written, then those compared with what
+    // every other record brings for them.
+    for (int pass = 0; pass < 2; ++pass)
+        for (std::size_t k = 0; k < count; ++k)
+            for (int c = 0; c < 4; ++c) {
+                const std::size_t v = lo.tets[4 * (owned + k) + static_cast<std::size_t>(c)];
+                float* here = &lo.positions[3 * v];
+                const float* brought = &ghosts[k].position[3 * c];
+                const bool differs = std::memcmp(here, brought, 3 * sizeof(float)) != 0;
+                if (v < held) {
+                    if (pass == 0 && differs) return moved_here(o, ghosts[k].vertex[c], ghosts[k].tet);
+                } else if (pass == 0) {
+                    std::memcpy(here, brought, 3 * sizeof(float));
+                } else if (differs) {
+                    return arrives_twice(o, ghosts[k].vertex[c]);
+                }
+            }
+    return {};
+}
+
 /// Builds the local detector from the owned tets and @p received, or updates it: set_tets() for the
-/// objects whose local tets changed, set_positions() for the others. Returns an error found in the
-/// received positions, or "".
+/// objects whose ghosts changed, set_positions() for the others, whose local tets stay as they were.
+/// Returns an error found in the received positions, or "" (on an error the caller drops the local
+/// detector, so that a half-refreshed object is never used).
 std::string Detector::Impl::build_local(std::vector<TetRecord>& received, bool& rebuilt) {
     std::sort(received.begin(), received.end(),
               [](const TetRecord& x, const TetRecord& y) { return std::tie(x.object, x.tet) < std::tie(y.object, y.tet); });
@@ -431,56 +448,21 @@ std::string Detector::Impl::build_local(std::vector<TetRecord>& received, bool& 
     std::vector<LocalObject> next(objects.size());
     std::size_t at = 0;
     for (std::size_t o = 0; o < objects.size(); ++o) {
-        const Object& object = objects[o];
-        LocalObject& lo = next[o];
         const std::size_t begin = at;
-        while (at < received.size() && received[at].object == o) lo.ghost_ids.push_back(received[at++].tet);
-        // Vertices only ghosts use, by global id; a vertex this rank holds, or that two ghosts share,
-        // must arrive with the one position every holder gives it.
-        struct Ghost {
-            std::uint32_t id;
-            const float* position;
-        };
-        std::vector<Ghost> extra;
-        for (std::size_t k = begin; k < at; ++k)
-            for (int c = 0; c < 4; ++c) {
-                const TetRecord& rec = received[k];
-                const std::ptrdiff_t h = object.held(rec.vertex[c]);
-                if (h < 0) {
-                    extra.push_back(Ghost{rec.vertex[c], &rec.position[3 * c]});
-                } else if (std::memcmp(&object.positions[3 * static_cast<std::size_t>(h)], &rec.position[3 * c], 3 * sizeof(float)) != 0) {
-                    return "object " + std::to_string(o) + ": vertex " + std::to_string(rec.vertex[c]) +
-                           " has different positions here and on the rank owning tet " + std::to_string(rec.tet);
-                }
-            }
-        std::sort(extra.begin(), extra.end(), [](const Ghost& x, const Ghost& y) { return x.id < y.id; });
-        std::vector<std::uint32_t> extra_ids;
-        const std::size_t held = object.vertex_ids.size();
-        lo.positions = object.positions;
-        for (std::size_t k = 0; k < extra.size(); ++k) {
-            if (k > 0 && extra[k].id == extra[k - 1].id) {
-                if (std::memcmp(extra[k].position, extra[k - 1].position, 3 * sizeof(float)) != 0)
-                    return "object " + std::to_string(o) + ": vertex " + std::to_string(extra[k].id) +
-                           " arrives with two different positions from other ranks";
-                continue;
-            }
-            extra_ids.push_back(extra[k].id);
-            lo.positions.insert(lo.positions.end(), extra[k].position, extra[k].position + 3);
-        }
-        lo.tets = object.tets;
-        for (std::size_t k = begin; k < at; ++k)
-            for (int c = 0; c < 4; ++c) {
-                const std::uint32_t g = received[k].vertex[c];
-                const std::ptrdiff_t h = object.held(g);
-                lo.tets.push_back(h >= 0 ? static_cast<std::uint32_t>(h)
-                                         : static_cast<std::uint32_t>(held + static_cast<std::size_t>(
-                                                                                 std::lower_bound(extra_ids.begin(), extra_ids.end(), g) -
-                                                                                 extra_ids.begin())));
-            }
-        changed[o] = !anew && (lo.ghost_ids != local_objects[o].ghost_ids || lo.tets != local_objects[o].tets);
+        while (at < received.size() && received[at].object == o) ++at;
+        const std::vector<std::uint32_t>* before = anew ? nullptr : &local_objects[o].ghost_ids;
+        const bool same = before && before->size() == at - begin &&
+                          std::equal(before->begin(), before->end(), received.begin() + static_cast<std::ptrdiff_t>(begin),
+                                     [](std::uint32_t id, const TetRecord& rec) { return id == rec.tet; });
+        const std::string error = same ? refresh(o, received.data() + begin, at - begin)
+                                       : renumber(o, received.data() + begin, at - begin, next[o]);
+        if (!error.empty()) return error;
+        changed[o] = !anew && !same;
         rebuilt = rebuilt || changed[o];
     }
-    local_objects = std::move(next);
+    local_objects.resize(objects.size());
+    for (std::size_t o = 0; o < objects.size(); ++o)
+        if (anew || changed[o]) local_objects[o] = std::move(next[o]);
     if (anew) {
         local.reset();
         auto fresh = std::make_unique<kdet::Detector>(options);
@@ -610,13 +592,12 @@ const FrameResult& Detector::Impl::detect() {
     return result;
 }
 
-Detector::Detector(MPI_Comm comm, const DetectorOptions& options) : impl_(std::make_unique<Impl>()) {
+Detector::Detector(MPI_Comm comm, const DetectorOptions& options) : impl_(std::make_unique<Impl>(options)) {
     if (!options.results_to_host)
         throw Error("kdet::mpi::Detector needs results_to_host: it filters the local pairs on the host");
     MPI_Comm_dup(comm, &impl_->comm);
     MPI_Comm_rank(impl_->comm, &impl_->rank);
     MPI_Comm_size(impl_->comm, &impl_->size);
-    impl_->options = options;
 }
 
 Detector::~Detector() {

@@ -61,9 +61,10 @@ std::vector<double> held_positions(const mpi::MeshPart& part, const std::vector<
     return out;
 }
 
-/// Runs @p s split as @p owners on every rank and on one CPU Detector, frame by frame, and compares.
+/// Runs @p s split as @p owners on every rank and on one CPU Detector, frame by frame, and compares;
+/// @p rebuilt, when given, gets per frame whether any rank's local detector changed its set of tets.
 void expect_same_as_single(const Scenario& s, const std::vector<std::vector<int>>& owners,
-                           const DetectorOptions& options = one_thread()) {
+                           const DetectorOptions& options = one_thread(), std::vector<int>* rebuilt = nullptr) {
     const int rank = world_rank();
     mpi::Detector distributed(MPI_COMM_WORLD, options);
     DetectorOptions reference = options; // one process on the CPU: the answer every backend must give
@@ -112,6 +113,11 @@ void expect_same_as_single(const Scenario& s, const std::vector<std::vector<int>
             EXPECT_TRUE(gathered == expected.pairs) << "frame " << f << ": the ranks' pairs differ from the single detector's";
         }
         EXPECT_EQ(mine.exchange.local_tets, mine.exchange.owned_tets + mine.exchange.tets_received);
+        if (rebuilt) {
+            int here = mine.exchange.rebuilt ? 1 : 0, any = 0;
+            MPI_Allreduce(&here, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+            rebuilt->push_back(any);
+        }
     }
 }
 
@@ -147,6 +153,20 @@ TEST(Mpi, RandomSoupsOverFrames) {
         for (std::size_t i = 0; i < s.frames.back()[1].size(); i += 3) s.frames.back()[1][i] += dx;
     }
     expect_same_with_both_partitions(s);
+}
+
+TEST(Mpi, TwoThreadsPerRankAsOne) {
+    // The layer's per-tet functors share a rank's tets among its threads (above 512 tets): the records
+    // must come out as with one thread.
+    Scenario s = scenario({random_soup(1500, 1.0, 1.5, 71), random_soup(1500, 1.0, 1.5, 72)});
+    s.self[1] = true;
+    s.frames.push_back(s.frames[0]);
+    for (std::size_t i = 0; i < s.frames.back()[0].size(); i += 3) s.frames.back()[0][i] += 0.1;
+    DetectorOptions options;
+    options.threads = 2;
+    std::vector<const TetMesh*> meshes{&s.meshes[0], &s.meshes[1]};
+    for (mpi::Partition kind : {mpi::Partition::slabs, mpi::Partition::random})
+        expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), kind, 17), options);
 }
 
 TEST(Mpi, RealMeshes) {
@@ -242,6 +262,43 @@ TEST(Mpi, PairsWithinAMarginAsTheSingleDetectors) {
         expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), kind, 5), options);
 }
 
+TEST(Mpi, GhostsKeptOrChangedAsTheSingleDetectors) {
+    // Scaling every coordinate by a power of two (per axis) scales every box and cell bound exactly:
+    // the tets exchanged stay the same while the positions change, so the local detectors keep their
+    // tets and only take the new positions (contacts, which scale, show stale ones). A slide of one
+    // object changes the tets exchanged.
+    Scenario s = scenario({random_soup(1200, 1.0, 1.5, 61), random_soup(1200, 1.0, 1.5, 62)});
+    s.self[0] = true;
+    const auto scaled = [](std::vector<std::vector<double>> frame) {
+        for (auto& xyz : frame)
+            for (std::size_t i = 0; i < xyz.size(); i += 3) {
+                xyz[i] *= 2.0;
+                xyz[i + 1] *= 4.0;
+            }
+        return frame;
+    };
+    std::vector<std::vector<double>> slid = s.frames[0];
+    for (std::size_t i = 0; i < slid[1].size(); i += 3) slid[1][i] += 0.3;
+    s.frames = {s.frames[0], s.frames[0], scaled(s.frames[0]), slid, scaled(slid)};
+    DetectorOptions options = one_thread();
+    options.contacts = true;
+    options.narrow_phase = NarrowPhase::sat;
+    std::vector<const TetMesh*> meshes{&s.meshes[0], &s.meshes[1]};
+    for (mpi::Partition kind : {mpi::Partition::slabs, mpi::Partition::random}) {
+        SCOPED_TRACE(kind == mpi::Partition::slabs ? "slabs" : "random");
+        std::vector<int> rebuilt;
+        expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), kind, 13), options, &rebuilt);
+        ASSERT_EQ(rebuilt.size(), 5u);
+        EXPECT_EQ(rebuilt[0], 1) << "the first frame builds the local detectors";
+        EXPECT_EQ(rebuilt[1], 0) << "nothing moved";
+        EXPECT_EQ(rebuilt[2], 0) << "scaled: the same tets exchanged";
+        if (world_size() > 1 && kind == mpi::Partition::slabs) {
+            EXPECT_EQ(rebuilt[3], 1) << "slid: other tets exchanged";
+        }
+        EXPECT_EQ(rebuilt[4], 0) << "scaled after the slide: the same tets exchanged";
+    }
+}
+
 TEST(Mpi, CudaBackendOnEveryRankAsTheCpu) {
     std::string reason;
     if (!cuda_available(&reason)) GTEST_SKIP() << "CUDA backend not tested: " << reason;
@@ -277,17 +334,26 @@ TEST(Mpi, SharedVertexMovedOnOneRankFailsOnEveryRank) {
     mpi::Detector detector(MPI_COMM_WORLD, one_thread());
     const ObjectId id = detector.add_object(part);
     detector.set_self_collision(id, true);
-    std::vector<double> positions = part.positions;
-    if (rank == 1) {
-        const std::size_t k = static_cast<std::size_t>(
-            std::lower_bound(part.vertex_ids.begin(), part.vertex_ids.end(), shared) - part.vertex_ids.begin());
-        positions[3 * k] += 0.25;
+    // Moved on a fresh detector (the ghosts numbered anew), then by one float step after a good frame
+    // (the same ghosts as before, only their positions refreshed): the same error either way.
+    for (const bool after_a_frame : {false, true}) {
+        SCOPED_TRACE(after_a_frame ? "after a frame" : "first frame");
+        std::vector<double> positions = part.positions;
+        if (after_a_frame) {
+            detector.set_positions(id, positions.data(), positions.size() / 3);
+            detector.detect();
+        }
+        if (rank == 1) {
+            const std::size_t k = static_cast<std::size_t>(
+                std::lower_bound(part.vertex_ids.begin(), part.vertex_ids.end(), shared) - part.vertex_ids.begin());
+            positions[3 * k] = after_a_frame ? std::nextafter(static_cast<float>(positions[3 * k]), 1e30f) : positions[3 * k] + 0.25;
+        }
+        detector.set_positions(id, positions.data(), positions.size() / 3);
+        const std::string message = same_error_everywhere([&] { detector.detect(); });
+        EXPECT_NE(message.find("object 0: vertex " + std::to_string(shared) + " has different positions here and on the rank owning tet"),
+                  std::string::npos)
+            << message;
     }
-    detector.set_positions(id, positions.data(), positions.size() / 3);
-    const std::string message = same_error_everywhere([&] { detector.detect(); });
-    EXPECT_NE(message.find("object 0: vertex " + std::to_string(shared) + " has different positions here and on the rank owning tet"),
-              std::string::npos)
-        << message;
 }
 
 TEST(Mpi, ScatterMeshGivesEachRankItsPart) {
