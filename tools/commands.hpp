@@ -13,6 +13,9 @@ namespace kdet::cli {
 /// @brief Exit codes: 0 success, 1 bad input or failure, 2 command-line mistake.
 enum ExitCode { exit_ok = 0, exit_failure = 1, exit_usage = 2 };
 
+/// @brief Writes "kdet: error: MESSAGE" on stderr and flushes it: how every command reports a failure.
+void print_error(const char* message);
+
 int run_collide(int argc, char** argv);
 int run_bench(int argc, char** argv);
 int run_locate(int argc, char** argv);

@@ -10,6 +10,8 @@
 #include <iostream>
 #include <new>
 
+void kdet::cli::print_error(const char* message) { std::cerr << "kdet: error: " << message << std::endl; }
+
 namespace {
 
 const char* usage = R"(usage: kdet <command> [arguments]
@@ -61,13 +63,13 @@ int main(int argc, char** argv) {
         std::cerr << "kdet " << e.what() << "\n";
         return exit_usage;
     } catch (const kdet::Error& e) {
-        std::cerr << "kdet: error: " << e.what() << "\n";
+        print_error(e.what());
         return exit_failure;
     } catch (const std::bad_alloc&) {
-        std::cerr << "kdet: error: out of memory\n";
+        print_error("out of memory");
         return exit_failure;
     } catch (const std::exception& e) {
-        std::cerr << "kdet: error: " << e.what() << "\n";
+        print_error(e.what());
         return exit_failure;
     }
 }

@@ -143,8 +143,10 @@ int run_bench_mpi(const BenchConfig& config) {
                     sent / static_cast<double>(rows.size()), sent / static_cast<double>(rows.size()) / static_cast<double>(tets),
                     worst_balance, path.c_str());
         return exit_ok;
-    } catch (const Error&) {
-        if (rank == 0) throw; // every rank has the same message: rank 0 prints it
+    } catch (const Error& e) {
+        // Every rank has the same message: rank 0 prints it here, before MPI is finalised, since once a
+        // rank has exited with an error mpirun may stop the others before they print anything.
+        if (rank == 0) print_error(e.what());
         return exit_failure;
     }
 }

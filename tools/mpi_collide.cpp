@@ -119,8 +119,10 @@ int run_collide_mpi(const MpiCollide& request) {
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     try {
         return run(request, rank, size);
-    } catch (const Error&) {
-        if (rank == 0) throw; // every rank has the same message: rank 0 prints it
+    } catch (const Error& e) {
+        // Every rank has the same message: rank 0 prints it here, before MPI is finalised, since once a
+        // rank has exited with an error mpirun may stop the others before they print anything.
+        if (rank == 0) print_error(e.what());
         return exit_failure;
     }
 }
