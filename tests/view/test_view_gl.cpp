@@ -572,6 +572,40 @@ TEST(ViewRenderer, QueryPointsAndTheirTetsAreDrawn) {
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
+/// @brief Pixels of the tets within the margin only: yellow, red and green well above blue.
+std::size_t count_margin(const std::vector<std::uint8_t>& rgb) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < rgb.size(); i += 3) n += rgb[i] > rgb[i + 2] + 80 && rgb[i + 1] > rgb[i + 2] + 70;
+    return n;
+}
+
+TEST(ViewRenderer, TheTetsWithinTheMarginOnlyHaveTheirOwnColour) {
+    REQUIRE_GL();
+    DetectorOptions options;
+    options.margin = 0.02f;
+    ViewSession session(test::procedural(4000, 21), options, false);
+    session.set_frame(9);
+    session.update();
+    Renderer renderer;
+    renderer.update(session);
+    OffscreenTarget target(320, 240, 1);
+    const auto picture = [&] {
+        target.bind();
+        renderer.draw(camera_for(session.positions(), 320, 240), 0, 0, 320, 240, DisplaySettings{}, Bounds{});
+        return target.read_rgb();
+    };
+    const std::vector<std::uint8_t> with_margin = picture();
+    session.set_options(DetectorOptions{});
+    session.update();
+    renderer.update(session);
+    const std::vector<std::uint8_t> without = picture();
+    const Picture shown{320, 240, with_margin};
+    EXPECT_GT(count_margin(with_margin), 100u);
+    EXPECT_GT(count(shown, is_highlight), 100u) << "the overlapping tets stay red";
+    EXPECT_EQ(count_margin(without), 0u);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
 TEST(ViewCommand, PointsInAScreenshotAndBadPointsFiles) {
     REQUIRE_GL();
     const test::BoxAndPoints b = test::box_and_points();
