@@ -36,7 +36,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <exception>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -137,14 +136,6 @@ CaseResult run_cpu_case(const PeerConfig& config, const Scene& scene, CaseResult
             outcome.kdet_keys.push_back(pair_key(layout.tet_begin[p.object_a] + p.tet_a, layout.tet_begin[p.object_b] + p.tet_b));
         return outcome;
     });
-}
-
-/// The processor's name from /proc/cpuinfo ("unknown" without it).
-std::string cpu_name() {
-    std::ifstream in("/proc/cpuinfo");
-    for (std::string line; std::getline(in, line);)
-        if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) return line.substr(line.find(':') + 2);
-    return "unknown";
 }
 
 } // namespace

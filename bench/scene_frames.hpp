@@ -263,13 +263,11 @@ inline std::string count_label(std::size_t n) {
     return std::to_string(n);
 }
 
-/// Every case of the configuration: each scene (the procedural one at each --tets), without and with
-/// self-collision (without only for the scenes in config.without_self). `run_case(scene, result)`
-/// returns the case's result (see run_frames). Progress goes to stderr. Throws kdet::Error for a
-/// scene that cannot be opened.
-inline std::vector<CaseResult> run_cases(const PeerConfig& config, const char* peer,
-                                         const std::function<CaseResult(const Scene&, CaseResult)>& run_case) {
-    std::vector<CaseResult> results;
+/// Calls `each(scene, c)` for every case of the configuration: each scene (the procedural one at each
+/// --tets), without and with self-collision (without only for the scenes in config.without_self), `c`
+/// with its scene, label, resolution, self and tets set. Throws kdet::Error for a scene that cannot be
+/// opened.
+inline void for_each_case(const PeerConfig& config, const std::function<void(const Scene&, const CaseResult&)>& each) {
     for (const std::string& name : config.scenes) {
         const bool procedural = name == "procedural";
         for (const std::size_t tets : procedural ? config.procedural_tets : std::vector<std::size_t>{0}) {
@@ -290,13 +288,23 @@ inline std::vector<CaseResult> run_cases(const PeerConfig& config, const char* p
                 c.resolution = resolution;
                 c.self = self;
                 for (std::size_t o = 0; o < scene->num_objects(); ++o) c.tets += scene->rest_mesh(o).num_tets();
-                results.push_back(run_case(*scene, c));
-                const CaseResult& r = results.back();
-                std::fprintf(stderr, "%s self %s: kdet %.3f ms, %s %.3f ms%s\n", r.label.c_str(), r.self ? "yes" : "no",
-                             r.kdet_ms, peer, r.peer_ms, r.mismatching_frames ? ", MISMATCHING FRAMES" : "");
+                each(*scene, c);
             }
         }
     }
+}
+
+/// Every case of the configuration (for_each_case): `run_case(scene, result)` returns the case's
+/// result (see run_frames). Progress goes to stderr.
+inline std::vector<CaseResult> run_cases(const PeerConfig& config, const char* peer,
+                                         const std::function<CaseResult(const Scene&, CaseResult)>& run_case) {
+    std::vector<CaseResult> results;
+    for_each_case(config, [&](const Scene& scene, const CaseResult& c) {
+        results.push_back(run_case(scene, c));
+        const CaseResult& r = results.back();
+        std::fprintf(stderr, "%s self %s: kdet %.3f ms, %s %.3f ms%s\n", r.label.c_str(), r.self ? "yes" : "no", r.kdet_ms,
+                     peer, r.peer_ms, r.mismatching_frames ? ", MISMATCHING FRAMES" : "");
+    });
     return results;
 }
 
@@ -326,6 +334,14 @@ inline std::string ratio_csv(const std::vector<CaseResult>& results, const std::
         out += line;
     }
     return out;
+}
+
+/// The processor's name from /proc/cpuinfo ("unknown" without it).
+inline std::string cpu_name() {
+    std::ifstream in("/proc/cpuinfo");
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) return line.substr(line.find(':') + 2);
+    return "unknown";
 }
 
 /// Writes `text` to `path`; false (with a message naming the program) when it cannot.

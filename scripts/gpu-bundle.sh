@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Packs what the GPU checks of the CUDA backend need on the `device` machine, which has the CUDA
 # toolkit and CMake but none of kdet's other dependencies and no network: the CUDA build for sm_90
-# (made here: kdet, the tests, the sort-and-sweep peer and, where ../shared/third_party/cuBQL lies beside
-# the repository, the cuBQL peer), the shared libraries they need beyond the
+# (made here: kdet, the tests, the sort-and-sweep peer, the margin benchmark where CGAL is found and,
+# where ../shared/third_party/cuBQL lies beside the repository, the cuBQL peer), the shared libraries they need beyond the
 # C/C++ runtimes, the models and the prepared meshes of the thesis scenes. The bundle is a git-ignored
 # folder that the device tool carries.
 #
@@ -29,6 +29,7 @@ grep -qx '/.gpu-bundle/' "$exclude" 2>/dev/null || echo '/.gpu-bundle/' >>"$excl
 targets=(kdet_cli kdet_tests kdet_gpu_vs_sweep static_environment)
 # (grep reads the whole list: with -q it would stop early, and make would fail on the broken pipe.)
 cmake --build "$build" --target help | grep ' kdet_gpu_vs_cubql$' >/dev/null && targets+=(kdet_gpu_vs_cubql)
+cmake --build "$build" --target help | grep ' kdet_margin_vs_cgal$' >/dev/null && targets+=(kdet_margin_vs_cgal)
 cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
 
 # The thesis scenes read their models and prepared meshes; prepare any that are missing.
@@ -38,6 +39,7 @@ rm -rf "$bundle"
 mkdir -p "$bundle/lib"
 cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bundle/"
 [[ ! " ${targets[*]} " == *" kdet_gpu_vs_cubql "* ]] || cp "$build/bench/kdet_gpu_vs_cubql" "$bundle/"
+[[ ! " ${targets[*]} " == *" kdet_margin_vs_cgal "* ]] || cp "$build/bench/kdet_margin_vs_cgal" "$bundle/"
 cp "$build/bench/static_environment" "$bundle/kdet_static_environment"
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"

@@ -13,6 +13,10 @@
 #   scenes   issue 46's scenes (heap, drape, graded at resolution 1 and 4, pass_through_deep, tearing),
 #            self-collision off and on, heap r4 without its collision filters, and a body on a 1M-tet
 #            static floor against a 20k-tet one (bench/static_environment.cpp)
+#   margin   pairs within a margin (bench/margin_vs_cgal.cpp --backend cuda): the thesis scenes at
+#            resolution 4, self-collision off and on, kdet at margin 0, 1 % and 10 % of the median edge
+#            side by side, frames 60-64; the CGAL peer checks every frame's pairs once (untimed); its CSV
+#            also comes back as $OUT/margin.csv (for bench/results/gpu-DEVICE/margin-COMMIT.csv)
 #   profile  each kernel's GPU time in two frames of five cases (Nsight Compute), the heaviest case's
 #            occupancy, divergence and cache hits, and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
@@ -28,11 +32,11 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="${KDET_GPU_BUNDLE:-$repo/.gpu-bundle}"
 out="${OUT:-$repo/exports/gpu-session}"
 deadline="${KDET_GPU_DEADLINE:-500}"
-(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|scenes|profile|compare|matrix ..." >&2; exit 2; }
+(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|scenes|margin|profile|compare|matrix ..." >&2; exit 2; }
 for part in "$@"; do
   case "$part" in
-  tests | sanitizers | r4 | scaling | peer | cubql | scenes | profile | compare | matrix) ;;
-  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, scenes, profile, compare, matrix)" >&2; exit 2 ;;
+  tests | sanitizers | r4 | scaling | peer | cubql | scenes | margin | profile | compare | matrix) ;;
+  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, scenes, margin, profile, compare, matrix)" >&2; exit 2 ;;
   esac
 done
 work="$(mktemp -d)"
@@ -134,6 +138,10 @@ for part in "$@"; do
     step cubql 400 "$bin/kdet_gpu_vs_cubql" --csv "$work/cubql.csv"
     [[ ! -f "$work/cubql.csv" ]] || cp "$work/cubql.csv" "$out/cubql.csv"
     ;;
+  margin)
+    step margin 300 "$bin/kdet_margin_vs_cgal" --backend cuda --peer-runs 0 --frames 60:64 --runs 3 --csv "$work/margin.csv"
+    [[ ! -f "$work/margin.csv" ]] || cp "$work/margin.csv" "$out/margin.csv"
+    ;;
   profile)
     for case in "armadillos-r4-self-yes armadillos -r 4 -s yes --frames 80:81" \
       "armadillos-r4-self-no armadillos -r 4 -s no --frames 80:81" \
@@ -191,6 +199,7 @@ ls "$work/bench"/*.csv >/dev/null 2>&1 && python3 "$repo/python/kdet_summary.py"
 tar -C "$work" --exclude=models --exclude=cache --exclude=bin -czf "$out/gpu-session.tar.gz" .
 [[ -f "$work/peer.log" ]] && tail -15 "$work/peer.log"
 [[ -f "$work/cubql.log" ]] && tail -15 "$work/cubql.log"
+[[ -f "$work/margin.log" ]] && grep '^|' "$work/margin.log"
 grep -h "FAILED\|PASSED\|ERROR SUMMARY\|RACECHECK SUMMARY" "$work"/*.log 2>/dev/null | sort | uniq -c | head -40
 cat "$out/steps.txt"
 [[ -f "$work/bench/summary.md" ]] && grep '^|' "$work/bench/summary.md"

@@ -53,13 +53,38 @@ double largest_slab_gap(const vec3 a[4], const vec3 b[4]) {
     return gap;
 }
 
-TetSlabs slabs_of(const vec3 v[4]) { return tet_slabs(v, static_cast<float>(longest_edge(v))); }
+TetSlabs slabs_of(const vec3 v[4], float margin = 0.0f) {
+    return tet_slabs(v, static_cast<float>(longest_edge(v)), margin);
+}
 
 /// The first direction along which the widened slabs are disjoint, or -1.
 int separating_direction(const TetSlabs& a, const TetSlabs& b) {
     for (int d = 0; d < slab_directions; ++d)
         if (a.hi[d] < b.lo[d] || b.hi[d] < a.lo[d]) return d;
     return -1;
+}
+
+/// Two random tets of `size` about a centre up to `offset` sizes from the origin, b moved along slab
+/// direction d so that its lowest projection lies `gap` (in units of the direction's length) above a's
+/// highest.
+void place_pair(std::mt19937& rng, int d, double offset, double size, double gap, vec3 a[4], vec3 b[4]) {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const double length = direction_length(d);
+    Point centre{offset * size * unit(rng), offset * size * unit(rng), offset * size * unit(rng)};
+    std::array<Point, 4> pa, pb;
+    for (auto* tet : {&pa, &pb})
+        for (Point& p : *tet)
+            for (int c = 0; c < 3; ++c) p[c] = centre[c] + size * (unit(rng) - 0.5);
+    auto project = [&](const Point& p) { return (k_directions[d][0] * p[0] + k_directions[d][1] * p[1] + k_directions[d][2] * p[2]) / length; };
+    double hi_a = -INFINITY, lo_b = INFINITY;
+    for (const Point& p : pa) hi_a = std::max(hi_a, project(p));
+    for (const Point& p : pb) lo_b = std::min(lo_b, project(p));
+    const double shift = hi_a + gap - lo_b;
+    for (int k = 0; k < 4; ++k) {
+        a[k] = vec3{float(pa[k][0]), float(pa[k][1]), float(pa[k][2])};
+        b[k] = vec3{float(pb[k][0] + shift * k_directions[d][0] / length), float(pb[k][1] + shift * k_directions[d][1] / length),
+                    float(pb[k][2] + shift * k_directions[d][2] / length)};
+    }
 }
 
 TEST(Slabs, SeparateOnlyPairsFartherApartThanTheMarginAtAnyDistanceFromTheOrigin) {
@@ -74,26 +99,9 @@ TEST(Slabs, SeparateOnlyPairsFartherApartThanTheMarginAtAnyDistanceFromTheOrigin
         for (int n = 0; n < 20000; ++n) {
             const double size = std::exp2(20.0 * unit(rng) - 10.0);
             const int d = n % slab_directions;
-            const double length = direction_length(d);
-            Point centre{offset * size * unit(rng), offset * size * unit(rng), offset * size * unit(rng)};
-            std::array<Point, 4> pa, pb;
-            for (auto* tet : {&pa, &pb})
-                for (Point& p : *tet)
-                    for (int c = 0; c < 3; ++c) p[c] = centre[c] + size * (unit(rng) - 0.5);
-            // Move b along the direction so that its lowest projection lies `gap` (in units of the
-            // direction's length) above a's highest.
-            auto project = [&](const Point& p) { return (k_directions[d][0] * p[0] + k_directions[d][1] * p[1] + k_directions[d][2] * p[2]) / length; };
-            double hi_a = -INFINITY, lo_b = INFINITY;
-            for (const Point& p : pa) hi_a = std::max(hi_a, project(p));
-            for (const Point& p : pb) lo_b = std::min(lo_b, project(p));
             const double gap = (unit(rng) < 0.25 ? -0.5 : 1.0) * size * std::exp2(-20.0 * unit(rng));
-            const double shift = hi_a + gap - lo_b;
             vec3 a[4], b[4];
-            for (int k = 0; k < 4; ++k) {
-                a[k] = vec3{float(pa[k][0]), float(pa[k][1]), float(pa[k][2])};
-                b[k] = vec3{float(pb[k][0] + shift * k_directions[d][0] / length), float(pb[k][1] + shift * k_directions[d][1] / length),
-                            float(pb[k][2] + shift * k_directions[d][2] / length)};
-            }
+            place_pair(rng, d, offset, size, gap, a, b);
             ++pairs;
             const int by = separating_direction(slabs_of(a), slabs_of(b));
             EXPECT_EQ(by >= 0, slabs_separate(slabs_of(a), slabs_of(b)));
@@ -107,6 +115,33 @@ TEST(Slabs, SeparateOnlyPairsFartherApartThanTheMarginAtAnyDistanceFromTheOrigin
     EXPECT_EQ(below_margin, 0);
     // Every lane separates some pairs: a direction computed wrongly, or never compared, would not.
     for (int d = 0; d < slab_directions; ++d) EXPECT_GT(separated_along[d], pairs / 40) << "direction " << d;
+    EXPECT_LT(separated, pairs);
+}
+
+TEST(Slabs, WithAMarginSeparateOnlyPairsFartherApartThanIt) {
+    // DetectorOptions::margin widens the slabs: a pair they separate lies more than the margin apart
+    // along a direction, so farther than the margin. Margins from 2^-12 to 4 of the tets' size, gaps
+    // (along the direction's length, a lower bound of the distance) log-uniform from a quarter to four
+    // times the margin, which the slabs see scaled by up to sqrt(3).
+    std::mt19937 rng(45);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    long long pairs = 0, separated = 0, within = 0;
+    for (double offset : {0.0, 1e3})
+        for (int n = 0; n < 20000; ++n) {
+            const double size = std::exp2(20.0 * unit(rng) - 10.0);
+            const float margin = static_cast<float>(size * std::exp2(14.0 * unit(rng) - 12.0));
+            const double gap = margin * std::exp2(4.0 * unit(rng) - 2.0);
+            vec3 a[4], b[4];
+            place_pair(rng, n % slab_directions, offset, size, gap, a, b);
+            ++pairs;
+            if (!slabs_separate(slabs_of(a, margin), slabs_of(b, margin))) continue;
+            ++separated;
+            if (largest_slab_gap(a, b) <= margin && ++within <= 5)
+                ADD_FAILURE() << "separated at a gap of " << largest_slab_gap(a, b) / margin << " margins, offset " << offset;
+        }
+    EXPECT_EQ(within, 0);
+    // Pairs farther than sqrt(3) margins along a face or space diagonal are separated.
+    EXPECT_GT(separated, pairs / 10);
     EXPECT_LT(separated, pairs);
 }
 

@@ -185,8 +185,8 @@ KDET_HD inline void plane_distances(const TetPlanes& p, vec3 w, float distance[4
 }
 
 /// @brief What the four face planes of p show about the four vertices w of a tet paired with p's:
-/// whether all of w lies beyond one face plane by more than its separation margin, for a pair whose
-/// longest edge is `longest` (`separated`), and whether some vertex lies inside each of the four by
+/// whether all of w lies beyond one face plane by more than its separation margin plus `reach`, for a
+/// pair whose longest edge is `longest` (`separated`), and whether some vertex lies inside each of the four by
 /// more than its inside margin (`inside`). The four faces are evaluated side by side (vector
 /// instructions on the CPU).
 struct PlaneSides {
@@ -202,7 +202,7 @@ KDET_HD inline void inside_margins(const TetPlanes& p, float longest, float marg
     for (int k = 0; k < 4; ++k) margin[k] = k_plane_inside_share * p.separation_scale[k] * scale;
 }
 
-KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float longest) {
+KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float longest, float reach) {
     const float longest2 = longest * longest;
     float nearest[4] = {3.4e38f, 3.4e38f, 3.4e38f, 3.4e38f};
     float inside_margin[4];
@@ -221,7 +221,7 @@ KDET_HD inline PlaneSides plane_sides(const TetPlanes& p, const vec3 w[4], float
     }
     std::uint32_t beyond[4];
     KDET_VECTOR_LOOP
-    for (int k = 0; k < 4; ++k) beyond[k] = nearest[k] > p.separation_scale[k] * longest2 ? ~0u : 0u;
+    for (int k = 0; k < 4; ++k) beyond[k] = nearest[k] > p.separation_scale[k] * longest2 + reach ? ~0u : 0u;
     return PlaneSides{lane_bits(beyond) != 0, inside && p.solid != 0};
 }
 
@@ -280,6 +280,15 @@ KDET_HD inline bool edges_pass_inside(const TetPlanes& p, const vec3 w[4], float
     return found != 0;
 }
 
+/// @brief What a separation must add to a face's separation margin to prove two tets more than
+/// `margin` apart: the margin and 2^-20 of it. The distance to a plane bounds the distance between the
+/// tets from below along its (unit within 2u) normal, and with a margin the pair's boxes overlap only
+/// once grown by it, so the other tet's vertices lie up to sqrt(3) margin farther from the plane's
+/// origin than the file comment allows: the rounding of a distance grows by under 8u margin and that of
+/// the threshold's sum by u of it, both below the 16u margin added; the separation margin still covers
+/// the rest, as without a margin. 0 for no margin, which leaves every threshold as it was.
+KDET_HD inline float face_plane_reach(float margin) { return margin + margin * 0x1p-20f; }
+
 /// @brief What the face planes prove about two tets whose boxes overlap.
 enum class PlaneVerdict { unsure, separated, intersecting };
 
@@ -289,16 +298,19 @@ enum class PlaneVerdict { unsure, separated, intersecting };
 /// faces separate more pairs than a's, and the smaller a's edges are the likelier to pass through it,
 /// so they are tried first (the narrow phase, where the GPU runs the pre-test, takes a pair's tets in
 /// id order). With `separation_only`, an intersection is not looked for (the caller only rejects).
+/// With a `margin` (DetectorOptions::margin), `separated` proves the tets more than the margin apart
+/// (face_plane_reach); at 0 the verdicts are those without one, bit for bit.
 KDET_HD inline PlaneVerdict face_plane_pretest(const TetPlanes& pa, const vec3 a[4], const TetPlanes& pb,
-                                               const vec3 b[4], bool separation_only) {
+                                               const vec3 b[4], bool separation_only, float margin) {
     // The margins bound the rounding only while the pair's longest edge, and so every distance, is a
     // normal float far from overflow; a tet whose edges overflow has a NaN longest edge, which max_f
     // could drop in favour of the other tet's.
     if (!(pa.longest <= k_plane_longest_limit && pb.longest <= k_plane_longest_limit)) return PlaneVerdict::unsure;
     const float longest = max_f(pa.longest, pb.longest);
-    const PlaneSides a_by_b = plane_sides(pb, a, longest);
+    const float reach = face_plane_reach(margin);
+    const PlaneSides a_by_b = plane_sides(pb, a, longest, reach);
     if (a_by_b.separated) return PlaneVerdict::separated;
-    const PlaneSides b_by_a = plane_sides(pa, b, longest);
+    const PlaneSides b_by_a = plane_sides(pa, b, longest, reach);
     if (b_by_a.separated) return PlaneVerdict::separated;
     if (separation_only) return PlaneVerdict::unsure;
     if (b_by_a.inside || a_by_b.inside) return PlaneVerdict::intersecting;

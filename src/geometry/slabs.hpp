@@ -22,6 +22,11 @@
 /// fast on needles (tests/cgal/test_narrow_phase_cgal.cpp), and exact agrees on every pair. Only
 /// sat_no_edges, which reports pairs that only an edge axis separates however far apart, must not use
 /// it. Non-finite sums give infinite or NaN bounds, which separate nothing.
+///
+/// With a margin m (DetectorOptions::margin) each bound is widened by m more: two tets at most m apart
+/// project at most |d| m <= sqrt(3) m apart along d, less than the 2 m the two widenings add, and the
+/// rest, over 0.26 m, covers the rounding that m adds (u m per bound). So disjoint extents prove the
+/// tets more than m apart, and at m = 0 the bounds are those without a margin.
 
 #include "geometry/vec3.hpp"
 
@@ -39,11 +44,11 @@ struct alignas(32) TetSlabs {
     float hi[slab_directions];
 };
 
-/// @brief The widened slabs of tet v, whose longest edge is `longest`.
-KDET_HD inline TetSlabs tet_slabs(const vec3 v[4], float longest) {
+/// @brief The widened slabs of tet v, whose longest edge is `longest`, for pairs within `margin`.
+KDET_HD inline TetSlabs tet_slabs(const vec3 v[4], float longest, float margin) {
     float largest_sum = 0.0f;
     for (int k = 0; k < 4; ++k) largest_sum = max_f(largest_sum, fabsf(v[k].x) + fabsf(v[k].y) + fabsf(v[k].z));
-    const float widen = 0x1p-21f * largest_sum + 0x1p-10f * longest;
+    const float widen = 0x1p-21f * largest_sum + 0x1p-10f * longest + margin;
     TetSlabs s;
     for (int d = 0; d < slab_directions; ++d) {
         s.lo[d] = INFINITY;

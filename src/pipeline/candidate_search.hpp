@@ -190,9 +190,9 @@ struct FindCandidatesKernel {
         /// The face-plane pre-test of (t, u); writes the pair unless it is proven separated.
         KDET_HD void pretest(std::uint32_t u) {
             const TetPlanes& other = scene->planes[u];
-            const PlaneVerdict verdict = face_plane_pretest(planes, planes.vertex, other, other.vertex, false);
-            // Within a margin, a pair the planes separate is left to the narrow phase's distance.
-            if (verdict == PlaneVerdict::separated && scene->margin == 0.0f) {
+            // With a margin, separated means farther apart than the margin.
+            const PlaneVerdict verdict = face_plane_pretest(planes, planes.vertex, other, other.vertex, false, scene->margin);
+            if (verdict == PlaneVerdict::separated) {
                 ++rejected;
                 return;
             }

@@ -85,7 +85,7 @@ struct TetSizeKernel {
         if (t % spacing_sample == 1 && scene.tet_object[t - 1] == scene.tet_object[t])
             atomic_fetch_add_gathered(&spacing_octaves[float_octave(tet_spacing(info.box, scene.info[t - 1].box))], 1u);
         scene.planes[t] = tet_planes(v);
-        if (scene.slabs) scene.slabs[t] = tet_slabs(v, scene.planes[t].longest);
+        if (scene.slabs) scene.slabs[t] = tet_slabs(v, scene.planes[t].longest, scene.margin);
         const float longest = longest_edge(v);
         const SphereDiameterBounds bounds = grown_bounds(sphere_diameter_bounds(longest), scene.margin);
         const std::uint32_t lower = float_to_ordered(bounds.lower), upper = float_to_ordered(bounds.upper);

@@ -24,8 +24,8 @@ namespace kdet {
 /// counted in `rejected`). Work item i decides keys [i KeysPerItem, (i + 1) KeysPerItem) of the first
 /// min(*key_count, key_capacity): with more than one, its pairs are appended a batch at a time (one
 /// atomic per batch where every pair would take one, all on the same counter). With a margin, `near`
-/// (parallel to the keys) gets each key's pair of stored tets that the test or the planes found apart,
-/// no_pair_key for every other key: NearPairsKernel decides those against the margin.
+/// (parallel to the keys) gets each key's pair of stored tets that the test found apart, no_pair_key
+/// for every other key (the planes' separations lie beyond the margin): NearPairsKernel decides those against the margin.
 template <NarrowPhase Test, std::uint32_t KeysPerItem, bool FacePlanesHere>
 struct NarrowPhaseKernel {
     SceneView scene;
@@ -46,12 +46,11 @@ struct NarrowPhaseKernel {
         const std::uint32_t a = key_first(keys[k]), b = key_second(keys[k]);
         const std::uint32_t t = a < b ? a : b, u = a < b ? b : a;
         bool reached_exact = false;
-        bool collides = a > b;
+        bool collides = a > b, planes_separate = false;
         if (!collides) {
             // Edge axes first: the pre-test left this pair undecided, or brute force found it colliding
             // (every axis runs then anyway).
             if constexpr (FacePlanesHere) {
-                bool planes_separate = false;
                 collides = planes_or_test_collide<Test>(scene, t, u, reached_exact, planes_separate);
                 planes_rejected += planes_separate ? 1u : 0u;
             } else {
@@ -59,7 +58,8 @@ struct NarrowPhaseKernel {
             }
         }
         if (reached_exact) atomic_fetch_add(exact_stage_pairs, 1ull); // rare: one atomic per such pair
-        if (!collides) return keep_near(k, pair_key(t, u));
+        // A pair the planes separate lies farther apart than the margin: nothing to decide.
+        if (!collides) return keep_near(k, planes_separate ? no_pair_key : pair_key(t, u));
         keep_near(k, no_pair_key);
         atomic_store_relaxed(&colliding[t], 1u);
         atomic_store_relaxed(&colliding[u], 1u);

@@ -32,13 +32,13 @@ KDET_HD inline bool test_pair(const SceneView& s, std::uint32_t first, std::uint
 /// @brief The decision for a grid method's pair (first < second) whose boxes overlap, that is not
 /// adjacent and that the slabs did not separate: the face planes' verdict where they are sure (the
 /// answer the test gives, see face_planes.hpp), else the test. `planes_separate` is set when the
-/// planes proved the pair apart.
+/// planes proved the pair apart, farther than the scene's margin.
 template <NarrowPhase Test>
 KDET_HD inline bool planes_or_test_collide(const SceneView& s, std::uint32_t first, std::uint32_t second,
                                            bool& exact_stage, bool& planes_separate) {
     // Both tets' planes and the vertices beside them are this frame's.
     const TetPlanes &pa = s.planes[first], &pb = s.planes[second];
-    const PlaneVerdict verdict = face_plane_pretest(pa, pa.vertex, pb, pb.vertex, false);
+    const PlaneVerdict verdict = face_plane_pretest(pa, pa.vertex, pb, pb.vertex, false, s.margin);
     planes_separate = verdict == PlaneVerdict::separated;
     if (verdict != PlaneVerdict::unsure) return verdict == PlaneVerdict::intersecting;
     return tets_intersect_as<Test>(pa.vertex, pb.vertex, exact_stage, true);

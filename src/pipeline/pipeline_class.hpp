@@ -202,9 +202,8 @@ protected:
     }
 
     SceneView scene_view() {
-        // sat_no_edges calls pairs intersecting that only an edge axis separates, however far apart; a
-        // margin reports pairs that the slabs separate.
-        TetSlabs* slabs = options_.narrow_phase == NarrowPhase::sat_no_edges || options_.margin > 0.0f ? nullptr : slabs_.data();
+        // sat_no_edges calls pairs intersecting that only an edge axis separates, however far apart.
+        TetSlabs* slabs = options_.narrow_phase == NarrowPhase::sat_no_edges ? nullptr : slabs_.data();
         return SceneView{positions_.data(), tets_.data(), tet_object_.data(), info_.data(), planes_.data(), slabs, pair_active_.data(),
                          checked_objects_.data(), meeting_boxes_.data(), frame_tets_,
                          static_cast<std::uint32_t>(object_boxes_.size()),

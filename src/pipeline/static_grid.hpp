@@ -56,7 +56,7 @@ struct StaticSizeKernel {
         if (t % spacing_sample == 1 && i > 0 && scene.tet_object[t - 1] == scene.tet_object[t])
             atomic_fetch_add_gathered(&spacing_octaves[float_octave(tet_spacing(info.box, scene.info[t - 1].box))], 1u);
         scene.planes[t] = tet_planes(v);
-        if (scene.slabs) scene.slabs[t] = tet_slabs(v, scene.planes[t].longest);
+        if (scene.slabs) scene.slabs[t] = tet_slabs(v, scene.planes[t].longest, scene.margin);
         info.diameter = enclosing_sphere_diameter(v) + scene.margin; // as TetSizeKernel's, grown by the margin
         atomic_lower_to(min_size, float_to_ordered(info.diameter));
         atomic_raise_to(max_size, float_to_ordered(info.diameter));

@@ -31,8 +31,8 @@ struct VerdictCheck {
     void check(const kdet::vec3 a[4], const kdet::vec3 b[4], bool truth, const char* what) {
         ++pairs;
         const kdet::TetPlanes pa = kdet::tet_planes(a), pb = kdet::tet_planes(b);
-        const PlaneVerdict verdict = kdet::face_plane_pretest(pa, a, pb, b, false);
-        EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, true) == PlaneVerdict::separated,
+        const PlaneVerdict verdict = kdet::face_plane_pretest(pa, a, pb, b, false, 0.0f);
+        EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, true, 0.0f) == PlaneVerdict::separated,
                   verdict == PlaneVerdict::separated);
         if (verdict == PlaneVerdict::unsure) return;
         const bool said = verdict == PlaneVerdict::intersecting;
@@ -173,7 +173,7 @@ TEST(FacePlanesCgal, EachFaceSeparatesByItsOwnMargin) {
             widen(b, bd);
             ASSERT_FALSE(cgal_intersect(a.wide, bd)) << "face " << k << ", gap " << gap;
             const kdet::TetPlanes pa = kdet::tet_planes(a.v), pb = kdet::tet_planes(b);
-            const bool separated = kdet::face_plane_pretest(pa, a.v, pb, b, false) == PlaneVerdict::separated;
+            const bool separated = kdet::face_plane_pretest(pa, a.v, pb, b, false, 0.0f) == PlaneVerdict::separated;
             EXPECT_EQ(separated, gap > face.margin) << "face " << k << ", gap " << gap << ", margin " << face.margin;
             check.check(a.v, b, false, "mirror image");
         }
@@ -217,7 +217,7 @@ TEST(FacePlanesCgal, EachFaceProvesAnIntersectionByItsInsideMargin) {
                 ASSERT_TRUE(cgal_intersect(a.wide, bd)) << "face " << k << ", depth " << depth;
                 const kdet::TetPlanes pa = kdet::tet_planes(a.v), pb = kdet::tet_planes(b);
                 ASSERT_NEAR(pb.longest, b_longest, 1e-5 * b_longest);
-                const bool proven = kdet::face_plane_pretest(pa, a.v, pb, b, false) == PlaneVerdict::intersecting;
+                const bool proven = kdet::face_plane_pretest(pa, a.v, pb, b, false, 0.0f) == PlaneVerdict::intersecting;
                 EXPECT_EQ(proven, depth > 2.0 * face.margin) << "size " << size << ", face " << k << ", depth " << depth;
                 check.check(a.v, b, true, "vertex through a face");
             }
@@ -279,8 +279,8 @@ TEST(FacePlanesCgal, GradedPairsNearTheInsideMarginAreDecidedOnlyWhereEveryTestA
                 // Far enough in for the vertex alone to prove it, whichever tet goes first.
                 ++pushed_in;
                 const kdet::TetPlanes pa = kdet::tet_planes(a), pb = kdet::tet_planes(b);
-                EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, false), PlaneVerdict::intersecting) << what;
-                EXPECT_EQ(kdet::face_plane_pretest(pb, b, pa, a, false), PlaneVerdict::intersecting) << what;
+                EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, false, 0.0f), PlaneVerdict::intersecting) << what;
+                EXPECT_EQ(kdet::face_plane_pretest(pb, b, pa, a, false, 0.0f), PlaneVerdict::intersecting) << what;
             }
         }
     std::printf("graded pairs %lld: pre-test separated %lld, intersecting %lld; %d pushed in beyond 1.5 margins\n",
@@ -319,8 +319,8 @@ TEST(FacePlanesCgal, AFlatTetWhoseFacesClearTheirOwnMarginsIsSolid) {
     ASSERT_TRUE(cgal_intersect(ad, bd));
     const kdet::TetPlanes pa = kdet::tet_planes(a), pb = kdet::tet_planes(b);
     EXPECT_EQ(pa.solid, 1u);
-    EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, false), PlaneVerdict::intersecting);
-    EXPECT_EQ(kdet::face_plane_pretest(pb, b, pa, a, false), PlaneVerdict::intersecting);
+    EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, false, 0.0f), PlaneVerdict::intersecting);
+    EXPECT_EQ(kdet::face_plane_pretest(pb, b, pa, a, false, 0.0f), PlaneVerdict::intersecting);
     VerdictCheck check;
     check.check(a, b, true, "vertex inside a flat tet");
     EXPECT_EQ(check.wrong, 0);
@@ -349,8 +349,8 @@ TEST(FacePlanesCgal, AnEdgeThroughTheOtherTetProvesAnIntersection) {
             EXPECT_GT(std::max({distance_a[0], distance_a[1], distance_a[2], distance_a[3]}), 0.0f);
             EXPECT_GT(std::max({distance_b[0], distance_b[1], distance_b[2], distance_b[3]}), 0.0f);
         }
-        EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, false) == PlaneVerdict::intersecting, truth) << "lift " << lift;
-        EXPECT_EQ(kdet::face_plane_pretest(pb, b, pa, a, false) == PlaneVerdict::intersecting, truth) << "lift " << lift;
+        EXPECT_EQ(kdet::face_plane_pretest(pa, a, pb, b, false, 0.0f) == PlaneVerdict::intersecting, truth) << "lift " << lift;
+        EXPECT_EQ(kdet::face_plane_pretest(pb, b, pa, a, false, 0.0f) == PlaneVerdict::intersecting, truth) << "lift " << lift;
     }
 }
 

@@ -18,8 +18,11 @@
 #include <set>
 #include <vector>
 
+#include "geometry/face_planes.hpp"
+#include "geometry/slabs.hpp"
 #include "geometry/tet_distance.hpp"
 #include "geometry/tet_intersect.hpp"
+#include "pipeline/bounding_boxes.hpp"
 #include "narrow_cases.hpp"
 
 namespace kdet {
@@ -117,6 +120,48 @@ TEST(MarginCgal, RandomPairsNearTheirDistanceAreDecidedAsTheOracleDoes) {
         expect_exact_around(a, b, "random", checked);
     }
     EXPECT_GT(checked, 1000);
+}
+
+TEST(MarginCgal, ThePreTestsSeparateOnlyPairsFartherApartThanTheMargin) {
+    // With a margin the face planes and the slabs reject the candidates they prove farther apart than
+    // it (face_plane_reach, slabs.hpp): random pairs of sizes 1e-6..1e6, at margins from half their
+    // distance to one float beyond it, wherever their boxes grown by the margin overlap (the only pairs
+    // the pipeline pre-tests).
+    std::mt19937 rng(4545);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    long long tried = 0, planes_separated = 0, slabs_separated = 0;
+    for (int n = 0; n < 400; ++n) {
+        const float size = std::pow(10.0f, static_cast<float>(n % 13) - 6.0f);
+        vec3 a[4], b[4];
+        const vec3 offset{(2.2f + 0.5f * unit(rng)) * size, unit(rng) * size, unit(rng) * size};
+        for (int k = 0; k < 4; ++k) {
+            a[k] = {unit(rng) * size, unit(rng) * size, unit(rng) * size};
+            b[k] = {unit(rng) * size + offset.x, unit(rng) * size + offset.y, unit(rng) * size + offset.z};
+        }
+        const HullSquaredDistance d = cgal_squared_distance(a, b);
+        const float distance = static_cast<float>(oracle_distance(d));
+        const TetPlanes pa = tet_planes(a), pb = tet_planes(b);
+        for (float m : {0.5f * distance, 0.9f * distance, 0.99f * distance, std::nextafter(distance, 0.0f), distance,
+                        std::nextafter(distance, INFINITY)}) {
+            if (!(m > 0.0f) || !boxes_overlap(grown_box(tet_box(a), half_margin(m)), grown_box(tet_box(b), half_margin(m))))
+                continue;
+            ++tried;
+            const bool within = oracle_within(d, m);
+            for (const bool a_first : {true, false}) {
+                const bool separated = a_first ? face_plane_pretest(pa, a, pb, b, false, m) == PlaneVerdict::separated
+                                               : face_plane_pretest(pb, b, pa, a, false, m) == PlaneVerdict::separated;
+                EXPECT_FALSE(separated && within) << "planes, size " << size << " margin " << m << " distance " << distance;
+                planes_separated += separated;
+            }
+            const bool slabs = slabs_separate(tet_slabs(a, pa.longest, m), tet_slabs(b, pb.longest, m));
+            EXPECT_FALSE(slabs && within) << "slabs, size " << size << " margin " << m << " distance " << distance;
+            slabs_separated += slabs;
+        }
+    }
+    // Both pre-tests still reject pairs well beyond the margin (the assertions above are not empty).
+    EXPECT_GT(tried, 800);
+    EXPECT_GT(planes_separated, tried / 10);
+    EXPECT_GT(slabs_separated, tried / 50);
 }
 
 TEST(MarginCgal, ARealMeshsPairsAndDistancesAreTheOracles) {

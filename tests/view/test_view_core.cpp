@@ -385,6 +385,54 @@ TEST(ViewSession, ShowsTheDetectorsPairsForTheFrame) {
     EXPECT_EQ(session.frame(), 20) << "clamped";
 }
 
+/// Each object's tets in the pairs of a fresh detector with `options` at `frame`.
+std::vector<std::vector<std::uint8_t>> tets_in_pairs(const Scene& scene, int frame, const DetectorOptions& options) {
+    Detector detector(options);
+    add_scene_objects(detector, scene, false);
+    std::vector<float> xyz;
+    std::vector<std::vector<std::uint8_t>> tets(scene.num_objects());
+    for (std::size_t o = 0; o < scene.num_objects(); ++o) {
+        scene.positions(o, frame, xyz);
+        detector.set_positions(static_cast<ObjectId>(o), xyz.data(), xyz.size() / 3);
+        tets[o].assign(scene.rest_mesh(o).num_tets(), 0);
+    }
+    for (const TetPair& p : detector.detect().pairs) tets[p.object_a][p.tet_a] = tets[p.object_b][p.tet_b] = 1;
+    return tets;
+}
+
+TEST(ViewSession, TheTetsWithinTheMarginOnlyAreThoseOfAFreshDetector) {
+    // With a margin the viewer colours the tets of pairs within it that do not overlap, unless they
+    // overlap another tet: a margin detector's tets minus a margin-0 detector's.
+    DetectorOptions options;
+    options.margin = 0.02f;
+    ViewSession session(procedural(4000, 21), options, false);
+    session.set_frame(9);
+    session.update();
+    EXPECT_FALSE(session.options().distances) << "the user's options are shown as set";
+    const auto within = tets_in_pairs(session.scene(), 9, options);
+    const auto overlapping = tets_in_pairs(session.scene(), 9, DetectorOptions{});
+    ASSERT_EQ(session.margin_tets().size(), 2u);
+    std::size_t margin_only = 0, overlap = 0;
+    for (std::size_t o = 0; o < 2; ++o) {
+        ASSERT_EQ(session.margin_tets()[o].size(), within[o].size());
+        for (std::size_t t = 0; t < within[o].size(); ++t) {
+            const bool expected = within[o][t] && !overlapping[o][t];
+            EXPECT_EQ(session.margin_tets()[o][t] != 0, expected) << "object " << o << " tet " << t;
+            margin_only += expected;
+            overlap += overlapping[o][t];
+        }
+    }
+    EXPECT_GT(margin_only, 20u);
+    EXPECT_GT(overlap, 20u);
+    EXPECT_GT(session.margin_pairs(), 0u);
+    EXPECT_LT(session.margin_pairs(), session.result().pairs.size());
+    // Without a margin there is nothing to colour.
+    session.set_options(DetectorOptions{});
+    session.update();
+    EXPECT_TRUE(session.margin_tets().empty());
+    EXPECT_EQ(session.margin_pairs(), 0u);
+}
+
 TEST(ViewSession, EveryOptionChangesBeforeTheFirstDetection) {
     // The thesis's demo failed when the hash changed before anything was detected.
     const ViewSource source = procedural(3000, 11);

@@ -537,6 +537,14 @@ std::size_t count_located(const std::vector<std::uint8_t>& rgb) {
     return n;
 }
 
+/// @brief @p session drawn by @p renderer into all of @p target with the default display.
+std::vector<std::uint8_t> draw_session(const Renderer& renderer, const OffscreenTarget& target, const ViewSession& session) {
+    target.bind();
+    renderer.draw(camera_for(session.positions(), target.width(), target.height()), 0, 0, target.width(), target.height(),
+                  DisplaySettings{}, Bounds{});
+    return target.read_rgb();
+}
+
 TEST(ViewRenderer, QueryPointsAndTheirTetsAreDrawn) {
     REQUIRE_GL();
     const test::BoxAndPoints b = test::box_and_points();
@@ -545,11 +553,7 @@ TEST(ViewRenderer, QueryPointsAndTheirTetsAreDrawn) {
     Renderer renderer;
     renderer.update(session);
     OffscreenTarget target(240, 180, 1);
-    const auto picture = [&] {
-        target.bind();
-        renderer.draw(camera_for(session.positions(), 240, 180), 0, 0, 240, 180, DisplaySettings{}, Bounds{});
-        return target.read_rgb();
-    };
+    const auto picture = [&] { return draw_session(renderer, target, session); };
     const std::vector<std::uint8_t> before = picture();
     session.set_points(b.points, 0.5);
     session.update();
@@ -569,6 +573,35 @@ TEST(ViewRenderer, QueryPointsAndTheirTetsAreDrawn) {
     session.update();
     renderer.update(session);
     EXPECT_EQ(picture(), before);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+/// @brief Pixels of the tets within the margin only: yellow, red and green well above blue.
+std::size_t count_margin(const std::vector<std::uint8_t>& rgb) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < rgb.size(); i += 3) n += rgb[i] > rgb[i + 2] + 80 && rgb[i + 1] > rgb[i + 2] + 70;
+    return n;
+}
+
+TEST(ViewRenderer, TheTetsWithinTheMarginOnlyHaveTheirOwnColour) {
+    REQUIRE_GL();
+    DetectorOptions options;
+    options.margin = 0.02f;
+    ViewSession session(test::procedural(4000, 21), options, false);
+    session.set_frame(9);
+    session.update();
+    Renderer renderer;
+    renderer.update(session);
+    OffscreenTarget target(320, 240, 1);
+    const std::vector<std::uint8_t> with_margin = draw_session(renderer, target, session);
+    session.set_options(DetectorOptions{});
+    session.update();
+    renderer.update(session);
+    const std::vector<std::uint8_t> without = draw_session(renderer, target, session);
+    const Picture shown{320, 240, with_margin};
+    EXPECT_GT(count_margin(with_margin), 100u);
+    EXPECT_GT(count(shown, is_highlight), 100u) << "the overlapping tets stay red";
+    EXPECT_EQ(count_margin(without), 0u);
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 

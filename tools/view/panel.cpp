@@ -303,6 +303,10 @@ void Viewer::panel_results() {
         row("colliding pairs", session_.options().method == Method::kdet_no_pairs ? std::string("(tets only)")
                                                                                    : std::to_string(c.colliding_pairs));
         row("colliding tets", c.colliding_tets);
+        if (session_.options().margin > 0.0f) {
+            row("  overlapping pairs (red)", c.colliding_pairs - session_.margin_pairs());
+            row("  within the margin only (yellow)", session_.margin_pairs());
+        }
         row("buffer regrows", c.buffer_regrows);
         row("host waits", c.host_waits);
         if (!session_.points().empty()) {

@@ -124,6 +124,8 @@ Color object_color(std::size_t object) {
 
 Color highlight_color() { return {0.96f, 0.20f, 0.12f}; }
 
+Color margin_color() { return {0.98f, 0.86f, 0.10f}; }
+
 Color point_color(int status) {
     // None of them red or of the objects' cool colours.
     static constexpr Color colors[] = {{1.0f, 1.0f, 1.0f}, {1.0f, 0.62f, 0.05f}, {0.95f, 0.15f, 0.95f}};
@@ -176,7 +178,7 @@ void Renderer::release_scene() {
         release_buffer(o.positions, o.vertex_bytes);
         release_buffer(o.surface_indices, o.surface_capacity * sizeof(std::uint32_t));
         glDeleteVertexArrays(1, &o.surface_array);
-        for (Region* region : {&o.highlight, &o.located}) {
+        for (Region* region : {&o.highlight, &o.margin, &o.located}) {
             release_buffer(region->indices, region->capacity * sizeof(std::uint32_t));
             glDeleteVertexArrays(1, &region->array);
         }
@@ -201,7 +203,7 @@ void Renderer::load_scene(const ViewSession& session) {
         glEnableVertexAttribArray(0);
         b.surface_indices = make_buffer(GL_ELEMENT_ARRAY_BUFFER, surface.size() * sizeof(std::uint32_t),
                                         surface.data(), GL_STATIC_DRAW);
-        for (Region* region : {&b.highlight, &b.located}) {
+        for (Region* region : {&b.highlight, &b.margin, &b.located}) {
             glGenVertexArrays(1, &region->array);
             glBindVertexArray(region->array);
             glBindBuffer(GL_ARRAY_BUFFER, b.positions);
@@ -266,8 +268,15 @@ void Renderer::upload_surfaces(const ViewSession& session) {
 
 void Renderer::upload_highlights(const ViewSession& session) {
     const FrameResult& result = session.result();
-    for (std::size_t o = 0; o < objects_.size(); ++o)
-        upload_region(session, o, objects_[o].highlight, o < result.colliding.size() ? result.colliding[o] : std::vector<std::uint8_t>{});
+    const std::vector<std::vector<std::uint8_t>>& margin = session.margin_tets();
+    for (std::size_t o = 0; o < objects_.size(); ++o) {
+        // A tet within the margin only is drawn in its own colour, not as colliding.
+        std::vector<std::uint8_t> colliding = o < result.colliding.size() ? result.colliding[o] : std::vector<std::uint8_t>{};
+        if (o < margin.size())
+            for (std::size_t t = 0; t < colliding.size(); ++t) colliding[t] = colliding[t] && !margin[o][t];
+        upload_region(session, o, objects_[o].highlight, colliding);
+        upload_region(session, o, objects_[o].margin, o < margin.size() ? margin[o] : std::vector<std::uint8_t>{});
+    }
 }
 
 void Renderer::upload_region(const ViewSession& session, std::size_t object, Region& region,
@@ -460,6 +469,8 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
     glPolygonOffset(display.wireframe ? 0.0f : -1.0f, display.wireframe ? 0.0f : -2.0f);
     set_color(mesh_program_, highlight_color(), 1.0f);
     draw_objects(false, &ObjectBuffers::highlight);
+    set_color(mesh_program_, margin_color(), 1.0f);
+    draw_objects(false, &ObjectBuffers::margin);
     set_color(mesh_program_, located_color(), 1.0f);
     draw_objects(false, &ObjectBuffers::located);
     glDisable(GL_POLYGON_OFFSET_FILL);
@@ -480,6 +491,8 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
         }
         set_color(mesh_program_, scaled(highlight_color(), 0.4f), 1.0f);
         draw_objects(false, &ObjectBuffers::highlight);
+        set_color(mesh_program_, scaled(margin_color(), 0.4f), 1.0f);
+        draw_objects(false, &ObjectBuffers::margin);
         glDisable(GL_BLEND);
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
         glUniform1i(lit, 1);

@@ -1,7 +1,7 @@
 #pragma once
 /// @file renderer.hpp
-/// @brief Draws a ViewSession with OpenGL 3.3 core: boundary surfaces, colliding tets, wireframe,
-/// clipping plane and contact normals. It only reads the session's positions and results.
+/// @brief Draws a ViewSession with OpenGL 3.3 core: boundary surfaces, colliding tets (those within
+/// the margin only in a colour of their own), wireframe, clipping plane and contact normals. It only reads the session's positions and results.
 
 #include "camera.hpp"
 #include "picking.hpp"
@@ -24,6 +24,8 @@ struct Color {
 Color object_color(std::size_t object);
 /// @brief The colour of colliding tets: the only red in the picture.
 Color highlight_color();
+/// @brief With a margin, the colour of the tets within it only (ViewSession::margin_tets).
+Color margin_color();
 
 /// @brief Query points: held by a tet, given the nearest tet within the distance, or without a tet.
 Color point_color(int status);
@@ -86,6 +88,7 @@ private:
         std::size_t surface_count = 0;   ///< indices drawn
         std::size_t surface_capacity = 0;
         Region highlight; ///< the colliding tets
+        Region margin;    ///< the tets within the margin only
         Region located;   ///< the tets that hold query points
         std::size_t vertex_bytes = 0;
     };

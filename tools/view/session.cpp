@@ -153,7 +153,9 @@ void ViewSession::set_points(std::vector<double> xyz, double within) {
 void ViewSession::set_frame(int frame) { frame_ = std::clamp(frame, 0, scene_->num_frames() - 1); }
 
 void ViewSession::build_detector() {
-    auto detector = std::make_unique<Detector>(options_);
+    DetectorOptions options = options_;
+    options.distances = options.distances || options.margin > 0.0f;
+    auto detector = std::make_unique<Detector>(options);
     add_scene_objects(*detector, *scene_, self_);
     if (self_)
         for (std::size_t o = 0; o < scene_->num_objects(); ++o)
@@ -203,6 +205,7 @@ bool ViewSession::update() {
         result_ = detector_->detect();
         detect_cpu_ms_ = process_cpu_ms() - cpu_start;
         detect_ms_ = milliseconds_since(start);
+        find_margin_tets();
         has_result_ = true;
         results_stale_ = false;
         points_stale_ = !points_.empty();
@@ -221,6 +224,24 @@ bool ViewSession::update() {
         changed = true;
     }
     return changed;
+}
+
+void ViewSession::find_margin_tets() {
+    margin_tets_.clear();
+    margin_pairs_ = 0;
+    if (!(options_.margin > 0.0f)) return;
+    // 0: in no pair within the margin only, 1: in one, 2: in an overlapping pair (which wins).
+    margin_tets_.resize(scene_->num_objects());
+    for (std::size_t o = 0; o < margin_tets_.size(); ++o) margin_tets_[o].assign(mesh(o).num_tets(), 0);
+    for (std::size_t p = 0; p < result_.pairs.size(); ++p) {
+        const TetPair& pair = result_.pairs[p];
+        const bool overlaps = result_.distances[p] == 0.0f;
+        margin_pairs_ += overlaps ? 0 : 1;
+        for (std::uint8_t* flag : {&margin_tets_[pair.object_a][pair.tet_a], &margin_tets_[pair.object_b][pair.tet_b]})
+            *flag = overlaps ? 2 : std::max<std::uint8_t>(*flag, 1);
+    }
+    for (std::vector<std::uint8_t>& flags : margin_tets_)
+        for (std::uint8_t& flag : flags) flag = flag == 1 ? 1 : 0;
 }
 
 std::size_t ViewSession::detector_memory() const { return detector_ ? detector_->memory_bytes() : 0; }

@@ -96,8 +96,14 @@ public:
     const std::vector<MeshFaces>& faces() const { return faces_; }
     /// @brief Positions (x y z per vertex) of each object at frame() as of the last update().
     const std::vector<std::vector<float>>& positions() const { return positions_; }
-    /// @brief The last detection; empty before the first update().
+    /// @brief The last detection; empty before the first update(). With a margin its distances are
+    /// on, whatever options() says: they tell the pairs that overlap (distance 0) from the others.
     const FrameResult& result() const { return result_; }
+    /// @brief With a margin, per object and tet: 1 for a tet of a reported pair that does not overlap
+    /// and of no pair that does (the tets within the margin only); empty without a margin.
+    const std::vector<std::vector<std::uint8_t>>& margin_tets() const { return margin_tets_; }
+    /// @brief Reported pairs that do not overlap (0 without a margin).
+    std::size_t margin_pairs() const { return margin_pairs_; }
     bool has_result() const { return has_result_; }
     const std::vector<double>& points() const { return points_; }
     /// @brief Where the points lie at frame() as of the last update() (empty without points); it
@@ -124,6 +130,8 @@ public:
 
 private:
     void build_detector();
+    /// @brief margin_tets_ and margin_pairs_ from result_.
+    void find_margin_tets();
     /// @brief Takes the tets of frame_ from a scene whose tets change; true when any changed.
     bool read_tets();
 
@@ -143,6 +151,8 @@ private:
     std::vector<std::vector<float>> positions_;
     FrameResult result_;
     bool has_result_ = false;
+    std::vector<std::vector<std::uint8_t>> margin_tets_;
+    std::size_t margin_pairs_ = 0;
     std::vector<double> points_;
     LocateOptions locate_options_;
     LocateResult located_;
