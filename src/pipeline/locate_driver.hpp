@@ -69,28 +69,23 @@ public:
         result.barycentrics.resize(4 * hit_count_);
         result.closest_points.resize(3 * hit_count_);
         result.distances.resize(hit_count_);
-        exec.download(result.objects.data(), placed_.objects.data(), hit_count_);
-        exec.download(result.tets.data(), placed_.tets.data(), hit_count_);
-        exec.download(result.barycentrics.data(), placed_.barycentrics.data(), 4 * hit_count_);
-        exec.download(result.closest_points.data(), placed_.closest_points.data(), 3 * hit_count_);
-        exec.download(result.distances.data(), placed_.distances.data(), hit_count_);
+        exec.download(result.objects.data(), objects_.data(), hit_count_);
+        exec.download(result.tets.data(), tets_.data(), hit_count_);
+        exec.download(result.barycentrics.data(), barycentrics_.data(), 4 * hit_count_);
+        exec.download(result.closest_points.data(), closest_points_.data(), 3 * hit_count_);
+        exec.download(result.distances.data(), distances_.data(), hit_count_);
     }
 
     DeviceLocateResults device_results() const {
-        return DeviceLocateResults{offsets_.data(),
-                                   placed_.objects.data(),
-                                   placed_.tets.data(),
-                                   placed_.barycentrics.data(),
-                                   placed_.closest_points.data(),
-                                   placed_.distances.data(),
-                                   point_count_,
-                                   hit_count_};
+        return DeviceLocateResults{offsets_.data(),        objects_.data(),   tets_.data(), barycentrics_.data(),
+                                   closest_points_.data(), distances_.data(), point_count_, hit_count_};
     }
 
     std::size_t memory_bytes() const {
         return points_.capacity_bytes() + sorted_points_.capacity_bytes() + order_.capacity_bytes() + held_.capacity_bytes() + boxes_.capacity_bytes() + orientation_.capacity_bytes() + entry_boxes_.capacity_bytes() + keys_.capacity_bytes() +
                slot_begin_.capacity_bytes() + slot_end_.capacity_bytes() + big_.capacity_bytes() + hits_.capacity_bytes() + hits_grown_.capacity_bytes() +
-               offsets_.capacity_bytes() + described_.capacity_bytes() + placed_.capacity_bytes() + counters_.capacity_bytes();
+               offsets_.capacity_bytes() + objects_.capacity_bytes() + tets_.capacity_bytes() + barycentrics_.capacity_bytes() +
+               closest_points_.capacity_bytes() + distances_.capacity_bytes() + counters_.capacity_bytes();
     }
 
 private:
@@ -224,14 +219,14 @@ private:
         exec.for_each(n, LocateSortedPointsKernel{points_.data(), order_.data(), sorted_points_.data()});
     }
 
-    /// The hits' keys, sorted by (query, tet): the tets that hold each point, then, for `within`, the
-    /// nearest tet of each point that none holds.
+    /// The hits' keys, sorted: the tets that hold each point, then, for `within`, the nearest tet of
+    /// each point that none holds.
     void find_hits(Exec& exec, const LocateGridView& grid, double within, std::size_t n, std::uint32_t total_tets) {
         LocateCounters* c = counters_.data();
         if (hits_.size() < n + 1024) hits_.resize_discard(n + 1024);
         for (;;) {
             const KeyAppender out{hits_.data(), hits_.size(), &c->hits, nullptr};
-            exec.for_each(n, LocateContainingKernel{grid, sorted_points_.data(), out, held_.data()});
+            exec.for_each(n, LocateContainingKernel{grid, sorted_points_.data(), order_.data(), out, held_.data()});
             const LocateCounters found = read_counters(exec);
             hit_count_ = found.hits;
             if (found.hits <= hits_.size()) break;
@@ -248,7 +243,7 @@ private:
                 hits_.swap(hits_grown_);
             }
             const KeyAppender out{hits_.data(), hits_.size(), &c->hits, nullptr};
-            exec.for_each(n, LocateNearestKernel{grid, sorted_points_.data(), held_.data(), within, out});
+            exec.for_each(n, LocateNearestKernel{grid, sorted_points_.data(), order_.data(), held_.data(), within, out});
             hit_count_ = read_counters(exec).hits;
         }
         const auto points = static_cast<std::uint32_t>(n);
@@ -256,40 +251,20 @@ private:
                   high_word_key_bits(std::max<std::uint32_t>(total_tets, 1)) - 32);
     }
 
-    /// Each hit's object, tet, barycentric coordinates, closest point and distance, described in the
-    /// queries' order and then placed in the points' order; each point's offset.
+    /// Each hit's object, tet, barycentric coordinates, closest point and distance; each point's offset.
     void describe(Exec& exec, const LocateScene& scene, std::uint32_t n) {
-        if (hit_count_ > 0xffffffffull) throw Error("locate: too many hits (" + std::to_string(hit_count_) + "), at most 2^32 - 1");
         const std::size_t hits = std::max<std::size_t>(hit_count_, 1);
-        for (HitBuffers* b : {&described_, &placed_}) {
-            b->objects.resize_discard(hits);
-            b->tets.resize_discard(hits);
-            b->barycentrics.resize_discard(4 * hits);
-            b->closest_points.resize_discard(3 * hits);
-            b->distances.resize_discard(hits);
-        }
+        objects_.resize_discard(hits);
+        tets_.resize_discard(hits);
+        barycentrics_.resize_discard(4 * hits);
+        closest_points_.resize_discard(3 * hits);
+        distances_.resize_discard(hits);
         offsets_.resize_discard(std::size_t{n} + 1);
-        const LocateHitsView view{scene.positions, scene.tets, scene.stored_id, scene.tet_object, scene.object_tet_begin,
-                                  sorted_points_.data(), order_.data()};
-        exec.for_each(hit_count_, LocateDescribeKernel{view, hits_.data(), described_.arrays()});
-        exec.sort(hits_.data(), hits_.size(), &counters_.data()->hits, high_word_key_bits(std::max<std::uint32_t>(n, 1)),
-                  high_word_key_bits(std::max<std::uint64_t>(hit_count_, 1)) - 32);
-        exec.for_each(hit_count_, LocatePlaceHitsKernel{hits_.data(), described_.arrays(), placed_.arrays()});
+        const LocateHitsView view{scene.positions, scene.tets, scene.stored_id, scene.tet_object, scene.object_tet_begin, points_.data()};
+        exec.for_each(hit_count_, LocateDescribeKernel{view, hits_.data(), objects_.data(), tets_.data(), barycentrics_.data(),
+                                                       closest_points_.data(), distances_.data()});
         exec.for_each(std::uint64_t{n} + 1, LocateOffsetsKernel{hits_.data(), hit_count_, offsets_.data()});
     }
-
-    /// What is said of the hits: in the queries' order (described_), then in the points' (placed_).
-    struct HitBuffers {
-        buffer<std::uint32_t> objects, tets;
-        buffer<double> barycentrics, closest_points, distances;
-        LocateHitArrays arrays() {
-            return LocateHitArrays{objects.data(), tets.data(), barycentrics.data(), closest_points.data(), distances.data()};
-        }
-        std::size_t capacity_bytes() const {
-            return objects.capacity_bytes() + tets.capacity_bytes() + barycentrics.capacity_bytes() +
-                   closest_points.capacity_bytes() + distances.capacity_bytes();
-        }
-    };
 
     buffer<vec3> points_;
     buffer<vec3> sorted_points_; ///< per query
@@ -303,7 +278,8 @@ private:
     buffer<std::uint32_t> big_;
     buffer<std::uint64_t> hits_, hits_grown_;
     buffer<std::uint64_t> offsets_;
-    HitBuffers described_, placed_;
+    buffer<std::uint32_t> objects_, tets_;
+    buffer<double> barycentrics_, closest_points_, distances_;
     buffer<LocateCounters> counters_;
     std::uint64_t entries_ = 0, hit_count_ = 0;
     std::size_t point_count_ = 0;

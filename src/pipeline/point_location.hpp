@@ -199,9 +199,8 @@ KDET_HD inline void locate_candidates(const LocateGridView& g, const Aabb& box, 
     for (std::uint32_t k = 0; k < g.big_count; ++k) try_tet(g.big[k], g.boxes[g.big[k]], -1);
 }
 
-/// @brief A hit's key as the search finds it: the query (the point's place in the queries' order) in the
-/// high word, the tet's global id (the caller's) in the low one.
-KDET_HD inline std::uint64_t hit_key(std::uint64_t query, std::uint32_t user_tet) { return query << 32 | user_tet; }
+/// @brief A hit's key: the point in the high word, the tet's global id (the caller's) in the low one.
+KDET_HD inline std::uint64_t hit_key(std::uint64_t point, std::uint32_t user_tet) { return point << 32 | user_tet; }
 
 KDET_HD inline void load_located(const LocateGridView& g, std::uint32_t stored, vec3 v[4]) {
     for (int k = 0; k < 4; ++k) v[k] = g.positions[g.tets[stored].v[k]];
@@ -241,13 +240,14 @@ struct LocateSortedPointsKernel {
 /// @brief Per query: a hit for every tet that holds its point (exactly), and whether it has one.
 struct LocateContainingKernel {
     LocateGridView grid;
-    const vec3* points; ///< per query (LocateSortedPointsKernel)
+    const vec3* points;         ///< per query (LocateSortedPointsKernel)
+    const std::uint64_t* order; ///< LocatePointOrderKernel's keys, sorted: item i queries point key_second(order[i])
     KeyAppender out;
     std::uint8_t* held; ///< per query
     struct Visit {
         const LocateGridView* grid;
         vec3 p;
-        std::uint64_t query;
+        std::uint64_t point;
         KeyBatch* batch;
         std::uint32_t hits;
         KDET_HD void operator()(std::uint32_t t) {
@@ -256,14 +256,15 @@ struct LocateContainingKernel {
             load_located(*grid, stored, v);
             point_query::PointTetSigns signs;
             if (!point_query::tet_holds_point(v, p, grid->orientation[t], signs)) return;
-            batch->push(hit_key(query, grid->user_id[stored]));
+            batch->push(hit_key(point, grid->user_id[stored]));
             ++hits;
         }
     };
     KDET_HD void operator()(std::uint64_t item) const {
+        const std::uint32_t i = key_second(order[item]);
         const vec3 p = points[item];
         KeyBatch batch(&out);
-        Visit visit{&grid, p, item, &batch, 0};
+        Visit visit{&grid, p, i, &batch, 0};
         locate_candidates(grid, Aabb{p, p}, visit);
         batch.flush();
         held[item] = visit.hits > 0 ? 1 : 0;
@@ -289,8 +290,9 @@ KDET_HD inline float grown_up(float x, double d) {
 /// smaller global id on a tie), if any.
 struct LocateNearestKernel {
     LocateGridView grid;
-    const vec3* points;       ///< as LocateContainingKernel's
-    const std::uint8_t* held; ///< per query
+    const vec3* points;         ///< as LocateContainingKernel's
+    const std::uint64_t* order; ///< as LocateContainingKernel's
+    const std::uint8_t* held;   ///< per query
     double within;
     KeyAppender out;
     struct Visit {
@@ -312,12 +314,13 @@ struct LocateNearestKernel {
     };
     KDET_HD void operator()(std::uint64_t item) const {
         if (held[item]) return;
+        const std::uint32_t i = key_second(order[item]);
         const vec3 p = points[item];
         const Aabb box{{grown_down(p.x, within), grown_down(p.y, within), grown_down(p.z, within)},
                        {grown_up(p.x, within), grown_up(p.y, within), grown_up(p.z, within)}};
         Visit visit{&grid, p, within, 0xffffffffu};
         locate_candidates(grid, box, visit);
-        if (visit.best != 0xffffffffu) out.push(hit_key(item, visit.best));
+        if (visit.best != 0xffffffffu) out.push(hit_key(i, visit.best));
     }
 };
 
@@ -328,27 +331,18 @@ struct LocateHitsView {
     const std::uint32_t* stored_id;        ///< the caller's global id -> stored tet
     const std::uint32_t* tet_object;       ///< per stored tet
     const std::uint32_t* object_tet_begin; ///< the caller's global id of each object's first tet
-    const vec3* points;                    ///< per query (LocateSortedPointsKernel)
-    const std::uint64_t* order;            ///< LocatePointOrderKernel's keys, sorted: query i is point key_second(order[i])
+    const vec3* points;
 };
 
-/// @brief What is said of each hit, at its place in the results.
-struct LocateHitArrays {
+/// @brief Per sorted hit: its object, tet, barycentric coordinates, closest point and distance.
+struct LocateDescribeKernel {
+    LocateHitsView scene;
+    const std::uint64_t* keys;
     std::uint32_t* objects;
     std::uint32_t* tets;
     double* barycentrics;
     double* closest_points;
     double* distances;
-};
-
-/// @brief Per hit h, sorted by (query, tet): its object, tet, barycentric coordinates, closest point and
-/// distance into `out` at h, and its key replaced by (point, h) for the sort into the points' order.
-/// Hits in the queries' order describe neighbouring tets one after the other, where the points'
-/// order (at random, say) fetched each tet's vertices and positions from memory anew.
-struct LocateDescribeKernel {
-    LocateHitsView scene;
-    std::uint64_t* keys;
-    LocateHitArrays out;
     KDET_HD void operator()(std::uint64_t h) const {
         const std::uint64_t key = keys[h];
         const vec3 p = scene.points[key_first(key)];
@@ -359,30 +353,13 @@ struct LocateDescribeKernel {
         const bool holds = point_query::tet_holds_point(v, p, signs);
         const point_query::PointInTet where = point_query::locate_in_tet(v, p, holds, signs);
         const std::uint32_t object = scene.tet_object[stored];
-        out.objects[h] = object;
-        out.tets[h] = user - scene.object_tet_begin[object];
-        for (int k = 0; k < 4; ++k) out.barycentrics[4 * h + k] = where.barycentric[k];
-        out.closest_points[3 * h] = where.closest.x;
-        out.closest_points[3 * h + 1] = where.closest.y;
-        out.closest_points[3 * h + 2] = where.closest.z;
-        out.distances[h] = where.distance;
-        keys[h] = static_cast<std::uint64_t>(key_second(scene.order[key_first(key)])) << 32 | h;
-    }
-};
-
-/// @brief Per hit j in the points' order (keys (point, h) sorted): what LocateDescribeKernel said of
-/// hit h, copied to j.
-struct LocatePlaceHitsKernel {
-    const std::uint64_t* keys;
-    LocateHitArrays from;
-    LocateHitArrays to;
-    KDET_HD void operator()(std::uint64_t j) const {
-        const std::uint64_t h = key_second(keys[j]);
-        to.objects[j] = from.objects[h];
-        to.tets[j] = from.tets[h];
-        for (int k = 0; k < 4; ++k) to.barycentrics[4 * j + k] = from.barycentrics[4 * h + k];
-        for (int k = 0; k < 3; ++k) to.closest_points[3 * j + k] = from.closest_points[3 * h + k];
-        to.distances[j] = from.distances[h];
+        objects[h] = object;
+        tets[h] = user - scene.object_tet_begin[object];
+        for (int k = 0; k < 4; ++k) barycentrics[4 * h + k] = where.barycentric[k];
+        closest_points[3 * h] = where.closest.x;
+        closest_points[3 * h + 1] = where.closest.y;
+        closest_points[3 * h + 2] = where.closest.z;
+        distances[h] = where.distance;
     }
 };
 
