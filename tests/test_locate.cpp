@@ -11,9 +11,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <set>
 #include <string>
 #include <utility>
@@ -120,6 +122,37 @@ TEST(Locate, BoxMeshSharedFeatures) {
     }
     EXPECT_GE(most, 12u); // an inner vertex of the Kuhn split
     expect_matches_brute_force(mesh, xyz, "box mesh");
+}
+
+TEST(Locate, AnswersFollowThePointsWhateverTheirOrder) {
+    // The hits are described in the queries' (Morton) order and then placed in the points' order: the
+    // same points shuffled, some twice, and with a distance get each point's own answer.
+    const TetMesh mesh = make_box_mesh(3, 3, 2, 0.5);
+    const std::vector<double> xyz = test::locate_query_points(mesh, mesh.num_tets(), 400, 4);
+    const std::size_t n = xyz.size() / 3;
+    std::vector<std::size_t> from(n);
+    for (std::size_t i = 0; i < n; ++i) from[i] = i;
+    std::shuffle(from.begin(), from.end(), std::mt19937(5));
+    for (std::size_t i = 0; i < n; i += 7) from.push_back(from[i]);
+    std::vector<double> shuffled;
+    for (const std::size_t i : from) shuffled.insert(shuffled.end(), {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]});
+    for (const double within : {0.0, 0.2}) {
+        LocateOptions options;
+        options.within = within;
+        const LocateResult r = locate(mesh, xyz, options), s = locate(mesh, shuffled, options);
+        expect_consistent(mesh, shuffled, s);
+        ASSERT_EQ(s.point_count, from.size());
+        for (std::size_t j = 0; j < from.size(); ++j) {
+            const std::size_t i = from[j];
+            ASSERT_EQ(s.offsets[j + 1] - s.offsets[j], r.offsets[i + 1] - r.offsets[i]) << j;
+            for (std::uint64_t k = 0; k < r.offsets[i + 1] - r.offsets[i]; ++k) {
+                const std::uint64_t hs = s.offsets[j] + k, hr = r.offsets[i] + k;
+                EXPECT_EQ(s.tets[hs], r.tets[hr]);
+                EXPECT_EQ(s.distances[hs], r.distances[hr]);
+                for (int c = 0; c < 4; ++c) EXPECT_EQ(s.barycentrics[4 * hs + c], r.barycentrics[4 * hr + c]);
+            }
+        }
+    }
 }
 
 TEST(Locate, RandomSoupOfManySizes) {

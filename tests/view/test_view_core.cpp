@@ -779,6 +779,32 @@ TEST(ViewPoints, TheSessionLocatesAsKdetLocate) {
     EXPECT_EQ(session.located().point_count, 0u);
 }
 
+TEST(ViewPoints, LocatedAgainOnlyWhenTheTetsOrPointsMove) {
+    const test::BoxAndPoints b = test::box_and_points();
+    ViewSession session(b.source, DetectorOptions{}, false);
+    session.set_points(b.points, 0.5);
+    session.update();
+    const std::uint64_t located = session.located_version();
+    const std::vector<std::uint64_t> offsets = session.located().offsets;
+    EXPECT_GT(located, 0u);
+    // Detecting again with other settings at the same positions keeps the points' answer.
+    DetectorOptions options;
+    options.margin = 0.01f;
+    session.set_options(options);
+    EXPECT_TRUE(session.update());
+    EXPECT_EQ(session.located_version(), located);
+    EXPECT_EQ(session.located().offsets, offsets);
+    EXPECT_FALSE(session.update());
+    // New points are located, and so is everything when another scene opens.
+    session.set_points(b.points, 0.0);
+    session.update();
+    EXPECT_EQ(session.located_version(), located + 1);
+    session.open(b.source);
+    session.update();
+    EXPECT_EQ(session.located_version(), located + 2);
+    EXPECT_EQ(session.located().point_count, b.points.size() / 3);
+}
+
 TEST(ViewPoints, PointsFlags) {
     std::vector<std::string> args = {"kdet", "view", "box.mesh", "--points", "p.txt", "--within", "0.25"};
     std::vector<char*> argv;

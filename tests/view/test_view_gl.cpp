@@ -4,6 +4,7 @@
 // appear is computed here from the same camera and the library's own detection.
 
 #include "camera.hpp"
+#include "png_file.hpp"
 #include "png_reader.hpp"
 #include "renderer.hpp"
 #include "run_command.hpp"
@@ -602,6 +603,58 @@ TEST(ViewRenderer, TheTetsWithinTheMarginOnlyHaveTheirOwnColour) {
     EXPECT_GT(count_margin(with_margin), 100u);
     EXPECT_GT(count(shown, is_highlight), 100u) << "the overlapping tets stay red";
     EXPECT_EQ(count_margin(without), 0u);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+TEST(ViewRenderer, ASelectedPointShowsOnlyItsTets) {
+    REQUIRE_GL();
+    const test::BoxAndPoints b = test::box_and_points();
+    ViewSession session(b.source, DetectorOptions{}, false);
+    session.set_points(b.points, 0.5);
+    session.update();
+    Renderer renderer;
+    renderer.update(session);
+    OffscreenTarget target(240, 180, 1);
+    const OrbitCamera camera = camera_for(session.positions(), 240, 180);
+    const auto picture = [&](const std::string& name) {
+        target.bind();
+        renderer.draw(camera, 0, 0, 240, 180, DisplaySettings{}, Bounds{});
+        std::vector<std::uint8_t> rgb = target.read_rgb();
+        write_png((picture_dir() / (name + ".png")).string(), 240, 180, rgb);
+        return rgb;
+    };
+    const std::vector<std::uint8_t> every = picture("points_every");
+    // A random point inside the box that one tet holds, picked where it is drawn.
+    const LocateResult& located = session.located();
+    std::size_t chosen = located.point_count;
+    for (std::size_t p = b.box.num_vertices(); p < located.point_count && chosen == located.point_count; ++p)
+        if (located.offsets[p + 1] - located.offsets[p] == 1 && located.distances[located.offsets[p]] == 0) chosen = p;
+    ASSERT_LT(chosen, located.point_count);
+    const Vec3 at{static_cast<float>(b.points[3 * chosen]), static_cast<float>(b.points[3 * chosen + 1]),
+                  static_cast<float>(b.points[3 * chosen + 2])};
+    const auto pixel = camera.project(at, 240, 180);
+    ASSERT_TRUE(pixel.has_value());
+    const auto picked = pick_point(session, camera, (*pixel)[0], (*pixel)[1], 240, 180, 0.5f);
+    ASSERT_TRUE(picked.has_value());
+    EXPECT_EQ(*picked, chosen) << "no other point projects within half a pixel of it";
+    EXPECT_FALSE(pick_point(session, camera, -50, -50, 240, 180, 6).has_value());
+
+    renderer.select_point(session, chosen);
+    EXPECT_EQ(renderer.point_counts()[0], 1u) << "the chosen point alone";
+    EXPECT_EQ(renderer.point_counts()[1] + renderer.point_counts()[2], 0u);
+    const std::vector<std::uint8_t> one = picture("points_one");
+    EXPECT_GT(count_located(one), 0u) << "the chosen point's tet";
+    EXPECT_LT(count_located(one) * 4, count_located(every)) << "one tet among many";
+    // A point no tet holds but one within the distance: its nearest tet.
+    std::size_t near = located.point_count;
+    for (std::size_t p = 0; p < located.point_count && near == located.point_count; ++p)
+        if (point_status(located, p) == 1) near = p;
+    ASSERT_LT(near, located.point_count);
+    renderer.select_point(session, near);
+    EXPECT_EQ(renderer.point_counts()[1], 1u);
+    EXPECT_GT(count_located(picture("points_near")), 0u);
+    renderer.select_point(session, std::nullopt);
+    EXPECT_EQ(picture("points_every_again"), every);
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 

@@ -84,6 +84,24 @@ std::optional<TetRef> pick_tet(const ViewSession& session, const OrbitCamera& ca
     return std::nullopt;
 }
 
+std::optional<std::size_t> pick_point(const ViewSession& session, const OrbitCamera& camera, float x, float y, int width,
+                                      int height, float radius) {
+    const std::vector<double>& xyz = session.points();
+    std::optional<std::size_t> best;
+    float best_d2 = radius * radius;
+    for (std::size_t p = 0; 3 * p < xyz.size(); ++p) {
+        const Vec3 at{static_cast<float>(xyz[3 * p]), static_cast<float>(xyz[3 * p + 1]), static_cast<float>(xyz[3 * p + 2])};
+        const auto pixel = camera.project(at, width, height);
+        if (!pixel) continue;
+        const float dx = (*pixel)[0] - x, dy = (*pixel)[1] - y, d2 = dx * dx + dy * dy;
+        if (d2 < best_d2 || (!best && d2 <= best_d2)) {
+            best_d2 = d2;
+            best = p;
+        }
+    }
+    return best;
+}
+
 std::vector<float> vertices_of(const ViewSession& session, const std::vector<TetRef>& tets) {
     std::vector<float> points;
     points.reserve(12 * tets.size());

@@ -26,6 +26,11 @@ struct TetRef {
 std::optional<TetRef> pick_tet(const ViewSession& session, const OrbitCamera& camera, float x, float y, int width,
                                int height, const DisplaySettings& display, const Bounds& scene_box);
 
+/// @brief The query point (ViewSession::points) drawn nearest pixel (x, y) of a width x height view,
+/// within @p radius pixels (the first on a tie); nothing when none is that close.
+std::optional<std::size_t> pick_point(const ViewSession& session, const OrbitCamera& camera, float x, float y, int width,
+                                      int height, float radius);
+
 /// @brief The four vertices of each of @p tets at the session's positions, x y z each.
 std::vector<float> vertices_of(const ViewSession& session, const std::vector<TetRef>& tets);
 

@@ -300,13 +300,22 @@ void Renderer::upload_region(const ViewSession& session, std::size_t object, Reg
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
 }
 
+void Renderer::select_point(const ViewSession& session, std::optional<std::size_t> point) {
+    selected_point_ = point;
+    upload_points(session);
+}
+
 void Renderer::upload_points(const ViewSession& session) {
     const LocateResult& located = session.located();
+    // A selected point is drawn alone with its tets: among many points they would be hidden.
+    const bool one = selected_point_ && *selected_point_ < located.point_count;
     std::vector<std::vector<std::uint8_t>> holding(objects_.size());
     for (std::size_t o = 0; o < objects_.size(); ++o)
         if (located.point_count > 0) holding[o].assign(session.mesh(o).num_tets(), 0);
-    for (std::size_t h = 0; h < located.hit_count; ++h)
-        if (located.distances[h] == 0) holding[located.objects[h]][located.tets[h]] = 1;
+    const std::uint64_t first = one ? located.offsets[*selected_point_] : 0;
+    const std::uint64_t last = one ? located.offsets[*selected_point_ + 1] : located.hit_count;
+    for (std::uint64_t h = first; h < last; ++h)
+        if (one || located.distances[h] == 0) holding[located.objects[h]][located.tets[h]] = 1;
     for (std::size_t o = 0; o < objects_.size(); ++o) upload_region(session, o, objects_[o].located, holding[o]);
     // Grouped by status, so that each group is one draw call in its colour; the held points last,
     // over the others.
@@ -314,7 +323,7 @@ void Renderer::upload_points(const ViewSession& session) {
     const std::vector<double>& xyz = session.points();
     for (int status = 2; status >= 0; --status) {
         const std::size_t before = scratch_vertices_.size();
-        for (std::size_t p = 0; p < located.point_count; ++p)
+        for (std::size_t p = one ? *selected_point_ : 0; p < (one ? *selected_point_ + 1 : located.point_count); ++p)
             if (point_status(located, p) == status)
                 scratch_vertices_.insert(scratch_vertices_.end(), {static_cast<float>(xyz[3 * p]), static_cast<float>(xyz[3 * p + 1]),
                                                                    static_cast<float>(xyz[3 * p + 2]), 0, 0, 0});

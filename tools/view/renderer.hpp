@@ -11,6 +11,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace kdet::view {
@@ -64,6 +65,9 @@ public:
     /// @brief Shows @p tets (the selected tet first, then its partners) over everything else, at the
     /// session's current positions; an empty list clears the selection.
     void select(const ViewSession& session, const std::vector<TetRef>& tets);
+    /// @brief Shows only query point @p point and its tets (those that hold it, or its nearest within
+    /// the distance) in the located colour; nothing: every point and the tets of those a tet holds.
+    void select_point(const ViewSession& session, std::optional<std::size_t> point);
 
     const BufferStats& stats() const { return stats_; }
     /// @brief Boundary triangles of @p object the surface buffers hold: those of the session's
@@ -111,6 +115,8 @@ private:
     void upload_highlights(const ViewSession& session);
     /// @brief Refills @p region from @p flags (one per tet; empty flags clear it).
     void upload_region(const ViewSession& session, std::size_t object, Region& region, const std::vector<std::uint8_t>& flags);
+    /// @brief Refills the points' stream and each object's located region, for selected_point_ alone
+    /// when there is one.
     void upload_points(const ViewSession& session);
     void upload_contacts(const ViewSession& session);
     void draw_objects(bool surfaces, Region ObjectBuffers::*region) const;
@@ -118,6 +124,7 @@ private:
     unsigned mesh_program_ = 0, background_program_ = 0, empty_array_ = 0;
     Stream contacts_, selection_, points_;
     std::array<std::size_t, 3> point_counts_{}; ///< points_ holds the missed, then the near, then the held
+    std::optional<std::size_t> selected_point_;
     std::vector<ObjectBuffers> objects_;
     std::uint64_t scene_version_ = 0, positions_version_ = 0, result_version_ = 0, topology_version_ = 0;
     float scene_radius_ = 1.0f;

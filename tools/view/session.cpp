@@ -184,8 +184,17 @@ bool ViewSession::update() {
     bool changed = false;
     if (positions_frame_ != frame_) {
         const auto start = std::chrono::steady_clock::now();
-        for (std::size_t o = 0; o < scene_->num_objects(); ++o) scene_->positions(o, frame_, positions_[o]);
-        if (read_tets()) ++topology_version_;
+        // The points' tets move only with a scene's first positions, new tets or a moving object.
+        bool moved = positions_frame_ < 0;
+        for (std::size_t o = 0; o < scene_->num_objects(); ++o) {
+            scene_->positions(o, frame_, positions_[o]);
+            moved = moved || !scene_->is_static(o);
+        }
+        if (read_tets()) {
+            ++topology_version_;
+            moved = true;
+        }
+        tets_moved_ = tets_moved_ || moved;
         positions_ms_ = milliseconds_since(start);
         positions_frame_ = frame_;
         ++positions_version_;
@@ -208,7 +217,10 @@ bool ViewSession::update() {
         find_margin_tets();
         has_result_ = true;
         results_stale_ = false;
-        points_stale_ = !points_.empty();
+        // Another detection at the same positions (settings changed, a static scene's next frame)
+        // leaves the points where they were.
+        if (tets_moved_) points_stale_ = !points_.empty();
+        tets_moved_ = false;
         ++result_version_;
         changed = true;
     }
@@ -220,6 +232,7 @@ bool ViewSession::update() {
             located_ = detector_->locate(PositionsView{points_.data(), true, points_.size() / 3}, all_objects, locate_options_);
         }
         points_stale_ = false;
+        ++located_version_;
         ++result_version_;
         changed = true;
     }

@@ -68,8 +68,9 @@ public:
     /// (Detector::set_static: placed once), or moving, given its positions every frame.
     void set_static(std::size_t object, bool is_static);
     bool is_static(std::size_t object) const { return static_[object] != 0; }
-    /// @brief Query points (x y z each) located in every object's tets after each detection, with
-    /// LocateOptions::within = @p within (`kdet view --points FILE --within D`).
+    /// @brief Query points (x y z each) located in every object's tets after a detection whose tets
+    /// moved (or had not been located), with LocateOptions::within = @p within (`kdet view --points
+    /// FILE --within D`).
     void set_points(std::vector<double> xyz, double within);
     /// @brief Selects a frame; clamped to the scene's frames.
     void set_frame(int frame);
@@ -123,6 +124,8 @@ public:
     /// know what to upload.
     std::uint64_t positions_version() const { return positions_version_; }
     std::uint64_t result_version() const { return result_version_; }
+    /// @brief Steps whenever the points are located again (located() changed).
+    std::uint64_t located_version() const { return located_version_; }
     /// @brief Steps whenever another scene is opened (its meshes and surfaces changed).
     std::uint64_t scene_version() const { return scene_version_; }
     /// @brief Steps whenever an object's tets (mesh() and faces()) change within the scene.
@@ -157,8 +160,10 @@ private:
     LocateOptions locate_options_;
     LocateResult located_;
     bool points_stale_ = false;
+    bool tets_moved_ = false; ///< positions or tets read since the last detection may differ from those located
     double positions_ms_ = 0, detect_ms_ = 0, detect_cpu_ms_ = 0;
     std::uint64_t positions_version_ = 0, result_version_ = 0, scene_version_ = 0, topology_version_ = 0;
+    std::uint64_t located_version_ = 0;
 };
 
 } // namespace kdet::view

@@ -34,7 +34,8 @@ scene options:
   --allow-degenerate   accept zero-volume tetrahedra in mesh files
   --points FILE        query points (`x y z` lines, or a mesh file's vertices) located in every
                        frame as `kdet locate` does: points in a tet white, the tets holding them
-                       green, points given the nearest tet by --within orange, the rest magenta
+                       green, points given the nearest tet by --within orange, the rest magenta;
+                       a click on a point shows it alone with its tets
   --within D           with --points: a point no tet holds gets the nearest tet within D
 
 detector options:

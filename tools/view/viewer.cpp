@@ -21,6 +21,8 @@ namespace kdet::view {
 namespace {
 
 constexpr float panel_width = 390.0f;
+/// Pixels from a query point within which a click selects it rather than a tet.
+constexpr float point_pick_radius = 6.0f;
 
 std::string glfw_error;
 
@@ -221,8 +223,12 @@ void Viewer::handle_key(int key) {
 void Viewer::handle_click(int scene_x, int scene_width, int scene_height) {
     const ImGuiIO& io = ImGui::GetIO();
     if (io.WantCaptureMouse || !io.MouseReleased[0] || io.MouseDragMaxDistanceSqr[0] > 16.0f) return;
-    selected_ = pick_tet(session_, camera_, io.MousePos.x - static_cast<float>(scene_x), io.MousePos.y, scene_width,
-                         scene_height, config_.display, scene_box_);
+    const float x = io.MousePos.x - static_cast<float>(scene_x), y = io.MousePos.y;
+    selected_point_ = pick_point(session_, camera_, x, y, scene_width, scene_height, point_pick_radius);
+    if (selected_point_)
+        selected_.reset();
+    else
+        selected_ = pick_tet(session_, camera_, x, y, scene_width, scene_height, config_.display, scene_box_);
     selection_version_ = 0;
     selection_topology_ = session_.topology_version();
 }
@@ -308,6 +314,8 @@ void Viewer::run() {
             if (selected_) shown.push_back(*selected_);
             for (const Partner& p : partners_) shown.push_back(p.tet);
             renderer_->select(session_, shown);
+            if (selected_point_ && *selected_point_ >= session_.located().point_count) selected_point_.reset();
+            renderer_->select_point(session_, selected_point_);
             selection_version_ = session_.result_version();
         }
 

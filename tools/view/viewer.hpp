@@ -92,6 +92,7 @@ private:
     bool screenshot_requested_ = false;
     std::vector<int> pending_keys_;
     std::optional<TetRef> selected_;
+    std::optional<std::size_t> selected_point_; ///< a query point clicked: only its tets are shown located
     std::vector<Partner> partners_;      ///< of the selected tet, in the shown frame
     std::uint64_t selection_version_ = 0; ///< the session's result version partners_ belong to
     std::uint64_t selection_topology_ = 0; ///< the session's topology version when the tet was picked
