@@ -279,3 +279,23 @@ def test_a_tet_without_volume_inside_a_tet_gets_a_common_point_on_itself():
         r = margin_detect(meshes, 0.0, distances=True)
         assert pairs_of(r) == {(0, 0, 1, 0)}
         np.testing.assert_array_equal(r.closest_points[0], np.zeros((2, 3), np.float32))
+
+
+@settings(EXACT, max_examples=12)
+@given(data=st.data(), meshes=st.lists(soups(max_tets=4), min_size=2, max_size=2), scale=scales)
+def test_detector_locate_over_objects_gives_each_objects_exact_containment(data, meshes, scale):
+    meshes, _ = at_scale(meshes, 0.0, scale)
+    points = query_points(kdet.TetMesh(np.vstack([m.vertices for m in meshes]),
+                                       np.vstack([meshes[0].tets, meshes[1].tets + len(meshes[0].vertices)]),
+                                       allow_degenerate=True), data.draw)
+    detector = kdet.Detector()
+    ids = [detector.add_object(m) for m in meshes]
+    every = detector.locate(points)
+    got = {(int(p), int(o), int(t)) for p, o, t in zip(every.points, every.objects, every.tets)}
+    expected = set()
+    for k, mesh in zip(ids, meshes):
+        hits, _ = oracle.locate(mesh, points)
+        expected |= {(p, k, t) for p, t in hits}
+        only = detector.locate(points, object=k)
+        assert {(int(p), int(t)) for p, t in zip(only.points, only.tets)} == hits
+    assert got == expected
