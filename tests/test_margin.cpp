@@ -180,6 +180,31 @@ TEST(Margin, IntersectingAndTouchingPairsHaveDistanceZeroAndACommonPoint) {
     EXPECT_GT(r.contacts[1].depth, 0.0f); // the overlapping pair keeps its depth
 }
 
+TEST(Margin, TheCommonPointOfAPairWithATetWithoutVolumeLiesOnIt) {
+    // Regression (found by python/tests/test_properties_margin.py): a point tet, or a flat one, inside a
+    // tet took the other tet's vertex as the common point, since every point read as inside a tet
+    // without volume (all its orientations 0).
+    const Tet big = {-1, -1, -1, 3, -1, -1, -1, 3, -1, -1, -1, 3};
+    const Tet point = {0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
+    const Tet flat = {0, 0, 0.5f, 0.5f, 0, 0.5f, 0, 0.5f, 0.5f, 0.25f, 0.25f, 0.5f};
+    DetectorOptions o;
+    o.distances = true;
+    for (const bool big_first : {true, false}) {
+        const FrameResult with_point = big_first ? detect_pair({big}, {point}, o) : detect_pair({point}, {big}, o);
+        ASSERT_EQ(with_point.pairs.size(), 1u);
+        for (int i = 0; i < 3; ++i) {
+            EXPECT_EQ(with_point.closest_points[0].on_a[i], 0.25f) << big_first;
+            EXPECT_EQ(with_point.closest_points[0].on_b[i], 0.25f) << big_first;
+        }
+        const FrameResult with_flat = big_first ? detect_pair({big}, {flat}, o) : detect_pair({flat}, {big}, o);
+        ASSERT_EQ(with_flat.pairs.size(), 1u);
+        const ClosestPoints& p = with_flat.closest_points[0];
+        EXPECT_EQ(p.on_a[2], 0.5f) << big_first;
+        EXPECT_GE(std::min(p.on_a[0], p.on_a[1]), 0.0f) << big_first;
+        EXPECT_LE(p.on_a[0] + p.on_a[1], 0.5f) << big_first;
+    }
+}
+
 /// The set of pairs of `result` as (a, b) global-ish keys.
 std::set<std::pair<std::uint64_t, std::uint64_t>> pair_set(const FrameResult& result) {
     std::set<std::pair<std::uint64_t, std::uint64_t>> s;

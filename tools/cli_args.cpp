@@ -22,9 +22,15 @@ void CommandLine::flag(const std::string& name, bool& seen) { app_->add_flag(nam
 void CommandLine::option(const std::string& name, const std::string& value_name,
                          std::function<void(const std::string&)> on_value) {
     // Each value when it is read, in the order given: the last one wins, a flag that collects (`kdet
-    // prepare -r`) sees them all, and `kdet bench` knows which procedural-only flag came first.
-    app_->add_option(name, [on_value = std::move(on_value)](const CLI::results_t& values) {
-            for (const std::string& v : values) on_value(v);
+    // prepare -r`) sees them all, and `kdet bench` knows which procedural-only flag came first. An empty
+    // FILE is refused: an empty path reads as "not asked for", so the output asked for would silently not
+    // be written.
+    const std::string no_file = value_name == "FILE" ? command_ + ": option '" + name + "' needs a value <FILE>" : "";
+    app_->add_option(name, [on_value = std::move(on_value), no_file](const CLI::results_t& values) {
+            for (const std::string& v : values) {
+                if (v.empty() && !no_file.empty()) throw UsageError(no_file);
+                on_value(v);
+            }
             return true;
         })
         ->type_name(value_name)

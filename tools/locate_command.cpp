@@ -4,6 +4,7 @@
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 #include <kdet/locate.hpp>
+#include <kdet/option_table.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -36,7 +37,7 @@ double parse_within(const std::string& text) {
     char* end = nullptr;
     const double value = std::strtod(text.c_str(), &end);
     if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value) || value < 0)
-        throw UsageError("locate: invalid value '" + text + "' for --within: expected a finite distance >= 0");
+        throw UsageError("locate: " + invalid_value_message("--within", text, "a finite distance >= 0"));
     return value;
 }
 

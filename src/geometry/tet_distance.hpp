@@ -253,10 +253,19 @@ KDET_NOINLINE KDET_HD inline bool disjoint_tets_within(const vec3 a[4], const ve
 // ---- Distances and closest points (approximate).
 
 /// @brief Distance from x to tet t in double: 0 inside (all four faces' orientations agree with the
-/// tet's), else the nearest face's.
+/// tet's), else the nearest face's. A tet without volume has no inside: every face's orientation
+/// of the opposite vertex is 0 there, which would agree with any point's; its faces cover its hull.
+/// Flat up to rounding (|6V| at most 2^-48 of its extent cubed, above the double computation's error)
+/// counts as without volume: an inside that thin lies within 2^-24 of the extent from its faces.
 KDET_HD inline double point_tet_distance(dvec3 x, const dvec3 t[4]) {
+    double extent = 0.0;
+    for (int k = 1; k < 4; ++k) {
+        const dvec3 e = t[k] - t[0];
+        extent = fmax(extent, fmax(fabs(e.x), fmax(fabs(e.y), fabs(e.z))));
+    }
+    const double volume = fabs(dot(cross(t[1] - t[0], t[2] - t[0]), t[3] - t[0]));
     double side[4];
-    bool inside = true;
+    bool inside = volume > 0x1p-48 * extent * extent * extent;
     for (int face = 0; face < 4; ++face) {
         const dvec3 a = t[face_vertex(face, 0)], b = t[face_vertex(face, 1)], c = t[face_vertex(face, 2)];
         const dvec3 n = cross(b - a, c - a);

@@ -9,10 +9,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <string>
 
 namespace kdet {
+
+/// A refused distance as given: "%g", since std::to_string writes a tiny negative one as -0.000000.
+static std::string distance_text(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
 
 struct Detector::Impl {
     DetectorOptions options;
@@ -169,7 +177,7 @@ struct Detector::Impl {
     /// `on_device`, in the backend's memory.
     const LocateResult& locate(const PositionsView& points, bool on_device, ObjectId object, const LocateOptions& how) {
         if (!(how.within >= 0.0) || !std::isfinite(how.within))
-            throw Error("locate: within must be finite and not negative, got " + std::to_string(how.within));
+            throw Error("locate: within must be finite and not negative, got " + distance_text(how.within));
         if (object != all_objects) check_object(object);
         check_extent("locate: the points", points);
         if (objects() == 0) { // no tets, no pipeline geometry: nothing holds any point
@@ -361,7 +369,7 @@ Detector::Detector(const DetectorOptions& options) : impl_(std::make_unique<Impl
         throw Error("bucket capacity " + std::to_string(options.bucket_capacity) + " out of range [0, " +
                     std::to_string(max_bucket_capacity) + "] (0 chooses it from the scene)");
     if (!(options.margin >= 0.0f) || !std::isfinite(options.margin))
-        throw Error("margin " + std::to_string(options.margin) + ": expected a finite distance >= 0");
+        throw Error("margin " + distance_text(options.margin) + ": expected a finite distance >= 0");
     if (options.cuda_stream && options.backend != Backend::cuda)
         throw Error("option cuda_stream is set, but the backend is '" + std::string(to_string(options.backend)) +
                     "': a CUDA stream needs backend 'cuda'");

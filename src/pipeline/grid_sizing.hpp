@@ -16,12 +16,16 @@
 
 namespace kdet {
 
+/// @brief A size grown by the margin, at most the largest float (as the sphere's diameter is): a sum
+/// that overflowed would read as no tet at all, and its pairs were lost.
+KDET_HD inline float grown_size(float size, float margin) { return fminf(size + margin, FLT_MAX); }
+
 /// @brief The bounds on a size grown by the margin: a tet's size is its sphere's diameter plus the
 /// margin, the extent of its grown box, so that the layers and cells keep their sizes' logic and a
 /// tet's grown box spans at most two cells per axis on its layer (rounded to nearest: monotone, so the
 /// bounds still bound the grown sphere).
 KDET_HD inline SphereDiameterBounds grown_bounds(SphereDiameterBounds bounds, float margin) {
-    return SphereDiameterBounds{bounds.lower + margin, bounds.upper + margin};
+    return SphereDiameterBounds{grown_size(bounds.lower, margin), grown_size(bounds.upper, margin)};
 }
 
 /// @brief Every how many tets TetSizeKernel samples the spacing.
@@ -95,7 +99,7 @@ struct TetSizeKernel {
             info.diameter = -longest;
             return;
         }
-        info.diameter = enclosing_sphere_diameter(v) + scene.margin;
+        info.diameter = grown_size(enclosing_sphere_diameter(v), scene.margin);
         atomic_lower_to(min_size, float_to_ordered(info.diameter));
         atomic_raise_to(max_size, float_to_ordered(info.diameter));
     }
@@ -147,7 +151,7 @@ KDET_HD inline int tet_layer(const SceneView& scene, const GridParams& params, s
     if (low == high) return low;
     vec3 v[4];
     load_tet(scene, t, v);
-    return layer_of(params, enclosing_sphere_diameter(v) + scene.margin);
+    return layer_of(params, grown_size(enclosing_sphere_diameter(v), scene.margin));
 }
 
 /// @brief Cells in a range.

@@ -57,7 +57,7 @@ struct StaticSizeKernel {
             atomic_fetch_add_gathered(&spacing_octaves[float_octave(tet_spacing(info.box, scene.info[t - 1].box))], 1u);
         scene.planes[t] = tet_planes(v);
         if (scene.slabs) scene.slabs[t] = tet_slabs(v, scene.planes[t].longest, scene.margin);
-        info.diameter = enclosing_sphere_diameter(v) + scene.margin; // as TetSizeKernel's, grown by the margin
+        info.diameter = grown_size(enclosing_sphere_diameter(v), scene.margin); // as TetSizeKernel's
         atomic_lower_to(min_size, float_to_ordered(info.diameter));
         atomic_raise_to(max_size, float_to_ordered(info.diameter));
     }

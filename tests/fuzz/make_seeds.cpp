@@ -67,6 +67,9 @@ void write_seeds(const fs::path& root) {
     write_bytes(root / "ply" / "big", square_ply_header("binary_big_endian") + square_ply_binary_body(true));
     // Query points of `kdet locate`: x y z lines, a comment, blank lines, exponents.
     write_bytes(root / "xyz" / "points", "# x y z\n0 0 0\n\n1.5 -2e-3 4E+2\n0.25 0.5 0.75 # last\n");
+    // Points at the ends of float (subnormal, -0, near the largest float) and one beyond it (refused).
+    write_bytes(root / "xyz" / "edges", "1e-45 -0 1.17549435e-38\n3.4028234e38 -3.4028234e38 1e7\n");
+    write_bytes(root / "xyz" / "beyond", "0 0 0\n1e39 0 0\n");
     for (const auto& [name, text] : kdet::scenes::builtin_scene_files()) write_bytes(root / "scene" / name, text);
     write_bytes(root / "scene" / "every_statement", every_statement_scene);
 }
