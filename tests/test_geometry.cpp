@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <vector>
 
 namespace kdet {
 namespace {
@@ -126,6 +127,28 @@ TEST(PowerOfTwo, ScalesAsLdexpfRoundsWhereTheFirstHalfStepIsExact) {
             ASSERT_EQ(std::memcmp(&expected, &got, sizeof got), 0) << x << " * 2^" << exponent << ": " << got;
         }
     for (int exponent = -126; exponent <= 127; ++exponent) ASSERT_EQ(power_of_two(exponent), std::ldexp(1.0f, exponent));
+}
+
+TEST(NextFloat, StepsAsNextafterfForEveryKindOfFloat) {
+    std::vector<float> values = {0.0f, -0.0f, FLT_TRUE_MIN, -FLT_TRUE_MIN, FLT_MIN, -FLT_MIN, FLT_MAX, -FLT_MAX,
+                                 INFINITY, -INFINITY, 1.0f, -1.0f, 0x1p-126f - 0x1p-149f};
+    std::mt19937 rng(11);
+    for (int i = 0; i < 100000; ++i) {
+        const std::uint32_t bits = static_cast<std::uint32_t>(rng());
+        float x;
+        std::memcpy(&x, &bits, sizeof x);
+        values.push_back(x);
+    }
+    for (const float x : values) {
+        const float up = nextafterf(x, INFINITY), down = nextafterf(x, -INFINITY);
+        const float got_up = next_float_up(x), got_down = next_float_down(x);
+        if (std::isnan(x)) {
+            EXPECT_TRUE(std::isnan(got_up) && std::isnan(got_down));
+            continue;
+        }
+        ASSERT_EQ(std::memcmp(&up, &got_up, sizeof up), 0) << x;
+        ASSERT_EQ(std::memcmp(&down, &got_down, sizeof down), 0) << x;
+    }
 }
 
 TEST(PowerOfTwo, FrexpExponentIsFrexpfsForEveryFiniteFloat) {

@@ -95,6 +95,21 @@ KDET_HD inline float times_power_of_two(float x, int exponent) {
     return x * power_of_two(half) * power_of_two(exponent - half);
 }
 
+/// @brief nextafterf(x, INFINITY) without a library call (on the CPU nextafterf is one, and boxes grown
+/// by a margin round each of their bounds outward with it).
+KDET_HD inline float next_float_up(float x) {
+    if (!(x < INFINITY)) return x; // +inf and NaN
+    if (x == 0.0f) return 1.40129846e-45f; // the smallest subnormal, above both zeros
+    std::uint32_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    bits = x > 0.0f ? bits + 1u : bits - 1u;
+    memcpy(&x, &bits, sizeof x);
+    return x;
+}
+
+/// @brief nextafterf(x, -INFINITY) without a library call.
+KDET_HD inline float next_float_down(float x) { return -next_float_up(-x); }
+
 KDET_HD inline vec3 make_vec3(float x, float y, float z) { return vec3{x, y, z}; }
 KDET_HD inline vec3 operator+(vec3 a, vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 KDET_HD inline vec3 operator-(vec3 a, vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }

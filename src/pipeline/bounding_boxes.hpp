@@ -16,15 +16,15 @@ namespace kdet {
 /// @brief At least half of `margin`: what each side of a tet's box grows by.
 KDET_HD inline float half_margin(float margin) {
     const float half = 0.5f * margin;
-    return half + half < margin ? nextafterf(half, INFINITY) : half;
+    return half + half < margin ? next_float_up(half) : half;
 }
 
 /// @brief `box` grown by `half` on every side, each bound rounded outward (and kept finite): two tets
 /// at most 2 half apart have overlapping grown boxes, since along every axis their boxes are at most
 /// that apart.
 KDET_HD inline Aabb grown_box(const Aabb& box, float half) {
-    const auto down = [half](float x) { return fmaxf(nextafterf(x - half, -INFINITY), -FLT_MAX); };
-    const auto up = [half](float x) { return fminf(nextafterf(x + half, INFINITY), FLT_MAX); };
+    const auto down = [half](float x) { return max_f(next_float_down(x - half), -FLT_MAX); };
+    const auto up = [half](float x) { return min_f(next_float_up(x + half), FLT_MAX); };
     return Aabb{{down(box.lo.x), down(box.lo.y), down(box.lo.z)}, {up(box.hi.x), up(box.hi.y), up(box.hi.z)}};
 }
 

@@ -276,13 +276,13 @@ struct LocateContainingKernel {
 KDET_HD inline float grown_down(float x, double d) {
     const double target = static_cast<double>(x) - d;
     float f = static_cast<float>(target);
-    if (static_cast<double>(f) > target) f = nextafterf(f, -INFINITY);
+    if (static_cast<double>(f) > target) f = next_float_down(f);
     return f;
 }
 KDET_HD inline float grown_up(float x, double d) {
     const double target = static_cast<double>(x) + d;
     float f = static_cast<float>(target);
-    if (static_cast<double>(f) < target) f = nextafterf(f, INFINITY);
+    if (static_cast<double>(f) < target) f = next_float_up(f);
     return f;
 }
 
