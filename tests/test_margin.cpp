@@ -25,6 +25,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
@@ -257,6 +258,45 @@ double approximate_distance(const TetMesh& ma, std::uint32_t ta, const TetMesh& 
     bool exact_stage = false;
     if (tets_intersect(NarrowPhase::exact, a, b, exact_stage)) return 0.0;
     return narrow::disjoint_tets_distance(da, db, x, y);
+}
+
+TEST(Margin, GjkFindsTheClosestFeaturesThatTryingEveryPairFinds) {
+    // The margin's decision takes GJK's closest points and feature pair first: their distance is the
+    // exhaustive one's, the pair's conditions hold just beyond it and its direction proves the tets
+    // apart just below it, at sizes 1e-6..1e6, with parallel faces and flat tets among them.
+    std::mt19937 rng(49);
+    int found = 0, tried = 0;
+    for (int n = 0; n < 2000; ++n) {
+        const float size = std::pow(10.0f, static_cast<float>(n % 13) - 6.0f);
+        vec3 a[4], b[4];
+        test::random_nearby_tets(rng, size, a, b);
+        if (n % 5 == 1) b[3] = {(b[0].x + b[1].x) / 2, (b[0].y + b[1].y) / 2, (b[0].z + b[1].z) / 2};
+        if (n % 7 == 3) // b's face 3 parallel to a's face 3, shifted along x
+            for (int k = 0; k < 3; ++k) b[k] = {a[k].x + 2.5f * size, a[k].y + 0.25f * size, a[k].z};
+        bool exact_stage = false;
+        if (tets_intersect(NarrowPhase::exact, a, b, exact_stage)) continue;
+        ++tried;
+        narrow::dvec3 da[4], db[4], x, y, gx, gy;
+        for (int k = 0; k < 4; ++k) {
+            da[k] = narrow::widen(a[k]);
+            db[k] = narrow::widen(b[k]);
+        }
+        narrow::ClosestFeatures every{}, gjk{};
+        const double d = std::sqrt(narrow::closest_features(da, db, x, y, every));
+        if (!narrow::gjk_closest_features(da, db, gx, gy, gjk)) continue;
+        ++found;
+        const narrow::dvec3 gap = gy - gx;
+        const double gd = std::sqrt(narrow::dot(gap, gap));
+        EXPECT_NEAR(gd, d, 1e-9 * size) << n;
+        const float beyond = static_cast<float>(d * (1.0 + 1e-6)), below = static_cast<float>(d * (1.0 - 1e-6));
+        const narrow::ExactMaker exact{beyond};
+        EXPECT_TRUE(narrow::features_within(narrow::margin_filter(a, b, beyond), exact, a, b, gjk)) << n << " kind " << gjk.kind;
+        EXPECT_TRUE(narrow::features_within(narrow::margin_filter(a, b, beyond), exact, a, b, every)) << n;
+        EXPECT_TRUE(narrow::separated_along(narrow::margin_filter(a, b, below), a, b, gap)) << n;
+        EXPECT_FALSE(narrow::separated_along(narrow::margin_filter(a, b, beyond), a, b, gap)) << n;
+    }
+    EXPECT_GT(tried, 1500);
+    EXPECT_GT(found, tried * 99 / 100);
 }
 
 TEST(Margin, EveryMethodFindsTheSamePairsInSoupsAndTheyLieWithinTheMargin) {

@@ -1,9 +1,9 @@
 #pragma once
 /// @file closest_points.hpp
 /// @brief Closest points in double between a point and a segment or a triangle (with its barycentric
-/// coordinates), and between two segments, degenerate ones included (a triangle whose points are
-/// collinear or coincide is taken as the segment or point it is). Approximate: the distances and
-/// points that the margin stage (tet_distance.hpp) and point location (point_tet.hpp) report; the
+/// coordinates), degenerate ones included (a triangle whose points are collinear or coincide is taken
+/// as the segment or point it is), and between two lines. Approximate: the distances and points that
+/// the margin stage (tet_closest.hpp, tet_distance.hpp) and point location (point_tet.hpp) report; the
 /// decisions themselves are exact there.
 
 #include "geometry/dvec3.hpp"
@@ -39,11 +39,9 @@ KDET_HD inline ClosestOnTriangle closest_on_edge(dvec3 p, dvec3 a, dvec3 b) {
     return ClosestOnTriangle{a + t * (b - a), {1.0 - t, t, 0.0}};
 }
 
-/// @brief Whether p projects into triangle (a, b, c) (not a degenerate one); then `projection` is set.
-KDET_HD inline bool project_into_triangle(dvec3 p, dvec3 a, dvec3 b, dvec3 c, dvec3& projection) {
-    const dvec3 n = cross(b - a, c - a);
-    const double n2 = dot(n, n);
-    if (!(n2 > 0.0)) return false;
+/// @brief Whether p projects into triangle (a, b, c) whose normal n = (b - a) x (c - a) has n2 = |n|^2 > 0;
+/// then `projection` is set.
+KDET_HD inline bool project_into_triangle(dvec3 p, dvec3 a, dvec3 b, dvec3 c, dvec3 n, double n2, dvec3& projection) {
     // Barycentric coordinates of the projection, each the signed area of a sub-triangle.
     const double u = dot(cross(c - b, p - b), n), v = dot(cross(a - c, p - c), n), w = dot(cross(b - a, p - a), n);
     if (!(u >= 0.0 && v >= 0.0 && w >= 0.0)) return false;
@@ -95,35 +93,12 @@ KDET_HD inline ClosestOnTriangle closest_on_triangle(dvec3 p, dvec3 a, dvec3 b, 
     return ClosestOnTriangle{a + (v * ab + w * ac), {1.0 - v - w, v, w}};
 }
 
-/// @brief Closest points x on [a, b] and y on [c, d]: the lines' closest points where both fall inside
-/// the segments (lines not parallel), else the best of the four endpoint-to-segment pairs.
-KDET_HD inline void closest_between_segments(dvec3 a, dvec3 b, dvec3 c, dvec3 d, dvec3& x, dvec3& y) {
-    const dvec3 e1 = b - a, e2 = d - c, n = cross(e1, e2);
-    const double n2 = dot(n, n);
-    if (n2 > 0.0) {
-        const dvec3 w = c - a;
-        const double s = dot(cross(w, e2), n) / n2, t = dot(cross(w, e1), n) / n2;
-        if (s >= 0.0 && s <= 1.0 && t >= 0.0 && t <= 1.0) {
-            x = a + s * e1;
-            y = c + t * e2;
-            return;
-        }
-    }
-    x = a;
-    y = closest_on_segment(a, c, d);
-    double best = squared_distance(x, y);
-    const dvec3 ends[4] = {b, c, d, a};
-    for (int k = 0; k < 3; ++k) {
-        const bool on_first = k >= 1; // b lies on [a, b]; c and d on [c, d]
-        const dvec3 p = ends[k];
-        const dvec3 q = on_first ? closest_on_segment(p, a, b) : closest_on_segment(p, c, d);
-        const double d2 = squared_distance(p, q);
-        if (d2 < best) {
-            best = d2;
-            x = on_first ? q : p;
-            y = on_first ? p : q;
-        }
-    }
+/// @brief Where the lines through [a, a + e1] and [c, c + e2] come closest, n = e1 x e2 with n2 = |n|^2 > 0:
+/// the parameters s along the first and t along the second.
+KDET_HD inline void closest_on_lines(dvec3 a, dvec3 e1, dvec3 c, dvec3 e2, dvec3 n, double n2, double& s, double& t) {
+    const dvec3 w = c - a;
+    s = dot(cross(w, e2), n) / n2;
+    t = dot(cross(w, e1), n) / n2;
 }
 
 } // namespace kdet::narrow

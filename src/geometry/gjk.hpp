@@ -147,19 +147,8 @@ KDET_HD inline vec3 closest_on_simplex(Simplex& s) {
 
 /// @brief The point of the Minkowski difference A - B with the smallest projection onto v.
 KDET_HD inline vec3 lowest_point(const LocalPair& p, vec3 v) {
-    int ia = 0, ib = 0;
-    float lo = dot(p.a[0], v), hi = dot(p.b[0], v);
-    for (int i = 1; i < 4; ++i) {
-        const float da = dot(p.a[i], v), db = dot(p.b[i], v);
-        if (da < lo) {
-            lo = da;
-            ia = i;
-        }
-        if (db > hi) {
-            hi = db;
-            ib = i;
-        }
-    }
+    int ia, ib;
+    lowest_difference(p.a, p.b, v, ia, ib);
     return p.a[ia] - p.b[ib];
 }
 

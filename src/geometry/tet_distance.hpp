@@ -28,13 +28,18 @@
 /// gamma_12 magnitude < 2^-48 magnitude (also covering the rounding of the magnitude itself), plus
 /// what underflow may add: after scaling every value is below 2^20, so an underflow's 2^-1075 grows to
 /// less than 2^-1000 however it propagates. A sign beyond that bound is certain; the rest are
-/// evaluated exactly (exact::Number, exact_number.hpp). Before the scan, each tet's face planes are
-/// tried with the filter alone: all four vertices of the other tet certainly more than m beyond one
-/// proves the pair too far apart, for most of the candidates that the grown boxes bring.
+/// evaluated exactly (exact::Number, exact_number.hpp).
+///
+/// **Shortcuts.** Before the scan, the filter alone tries each tet's face planes (all four vertices of
+/// the other tet certainly more than m beyond one proves the pair too far apart), then the pair's
+/// closest features found in double (tet_closest.hpp): the direction between their points, certified
+/// by the filter over all sixteen vertex pairs, proves a pair farther apart than m, and the feature
+/// pair's own conditions above prove it within. Only a proof ends the decision, so the answer does
+/// not depend on those double computations; the scan decides what they leave (a distance within
+/// rounding of m, shapes where GJK stalls).
 
-#include "geometry/closest_points.hpp"
 #include "geometry/exact_number.hpp"
-#include "geometry/tet_pair.hpp"
+#include "geometry/tet_closest.hpp"
 
 namespace kdet::narrow {
 
@@ -178,9 +183,6 @@ KDET_HD inline FilterMaker margin_filter(const vec3 a[4], const vec3 b[4], float
     return FilterMaker{scale, static_cast<double>(margin) * scale};
 }
 
-/// @brief Vertex k of face `face` (the face opposite vertex `face`), k = 0..2.
-KDET_HD inline int face_vertex(int face, int k) { return k + (k >= face ? 1 : 0); }
-
 /// @brief Whether the filter proves every vertex of `other` more than m beyond a face plane of t.
 KDET_HD inline bool face_planes_far(const FilterMaker& f, const vec3 t[4], const vec3 other[4]) {
     for (int face = 0; face < 4; ++face) {
@@ -199,26 +201,53 @@ KDET_HD inline bool face_planes_far(const FilterMaker& f, const vec3 t[4], const
     return false;
 }
 
-/// @brief Whether vertex p lies within m of tet t's edges, vertices or faces by the conditions above
-/// (its features' interiors; the vertex-vertex pairs are the caller's).
+/// @brief Whether the filter proves every vertex pair (a[i], b[j]) more than m apart along the direction
+/// n (any double vector): then the tets are, since a tet projects onto the span of its vertices'
+/// projections. The direction's exact double value is what is certified, so where it comes from does not
+/// matter (closest points found by rounding computations); a direction that proves nothing is harmless.
+KDET_HD inline bool separated_along(const FilterMaker& f, const vec3 a[4], const vec3 b[4], dvec3 n) {
+    const double largest = norm_inf(n);
+    if (!(largest > 0.0 && largest < INFINITY)) return false;
+    n = (1.0 / largest) * n; // 1 <= |n|^2 <= 3: its square root neither underflows nor overflows
+    // Above |n|: the sum of squares rounds twice, the root once, this product once more.
+    const double length_up = sqrt(dot(n, n)) * (1.0 + 0x1p-40);
+    const double reach = f.margin * length_up; // above m |n| in the pair's frame, for the same reason
+    const FilterNumber nx{n.x, fabs(n.x)}, ny{n.y, fabs(n.y)}, nz{n.z, fabs(n.z)}, r{reach, reach};
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+            const auto d = difference(f, b[j], a[i]);
+            const FilterNumber h = nx * d.x + ny * d.y + nz * d.z - r;
+            if (!(h.value > k_margin_relative_bound * h.magnitude + k_margin_absolute_bound)) return false;
+        }
+    return true;
+}
+
+/// @brief Whether vertex p projects into edge [a, b] (a != b) within m of it.
+KDET_HD inline bool vertex_edge_within(const FilterMaker& f, const ExactMaker& e, vec3 p, vec3 a, vec3 b) {
+    return margin_sign(f, e, [&](const auto& mk) { return along_edge(mk, p, a, b); }) >= 0 &&
+           margin_sign(f, e, [&](const auto& mk) { return along_edge(mk, p, b, a); }) >= 0 &&
+           margin_sign(f, e, [&](const auto& mk) { return vertex_line_excess(mk, p, a, b); }) <= 0;
+}
+
+/// @brief Whether vertex p projects into face (a, b, c) within m of it; false for a face without area.
+KDET_HD inline bool vertex_face_within(const FilterMaker& f, const ExactMaker& e, vec3 p, vec3 a, vec3 b, vec3 c) {
+    return margin_sign(f, e, [&](const auto& mk) { return face_normal_squared(mk, a, b, c); }) != 0 &&
+           margin_sign(f, e, [&](const auto& mk) { return face_side(mk, p, a, b, a, b, c); }) >= 0 &&
+           margin_sign(f, e, [&](const auto& mk) { return face_side(mk, p, b, c, a, b, c); }) >= 0 &&
+           margin_sign(f, e, [&](const auto& mk) { return face_side(mk, p, c, a, a, b, c); }) >= 0 &&
+           margin_sign(f, e, [&](const auto& mk) { return vertex_plane_excess(mk, p, a, b, c); }) <= 0;
+}
+
+/// @brief Whether vertex p lies within m of tet t's edges or faces by the conditions above (its
+/// features' interiors; the vertex-vertex pairs are the caller's).
 KDET_HD inline bool vertex_within(const FilterMaker& f, const ExactMaker& e, vec3 p, const vec3 t[4]) {
     for (int k = 0; k < 6; ++k) {
         const vec3 a = t[edge_first(k)], b = t[edge_second(k)];
-        if (points_coincide(a, b)) continue;
-        if (margin_sign(f, e, [&](const auto& mk) { return along_edge(mk, p, a, b); }) >= 0 &&
-            margin_sign(f, e, [&](const auto& mk) { return along_edge(mk, p, b, a); }) >= 0 &&
-            margin_sign(f, e, [&](const auto& mk) { return vertex_line_excess(mk, p, a, b); }) <= 0)
-            return true;
+        if (!points_coincide(a, b) && vertex_edge_within(f, e, p, a, b)) return true;
     }
-    for (int face = 0; face < 4; ++face) {
-        const vec3 a = t[face_vertex(face, 0)], b = t[face_vertex(face, 1)], c = t[face_vertex(face, 2)];
-        if (margin_sign(f, e, [&](const auto& mk) { return face_normal_squared(mk, a, b, c); }) == 0) continue;
-        if (margin_sign(f, e, [&](const auto& mk) { return face_side(mk, p, a, b, a, b, c); }) >= 0 &&
-            margin_sign(f, e, [&](const auto& mk) { return face_side(mk, p, b, c, a, b, c); }) >= 0 &&
-            margin_sign(f, e, [&](const auto& mk) { return face_side(mk, p, c, a, a, b, c); }) >= 0 &&
-            margin_sign(f, e, [&](const auto& mk) { return vertex_plane_excess(mk, p, a, b, c); }) <= 0)
+    for (int face = 0; face < 4; ++face)
+        if (vertex_face_within(f, e, p, t[face_vertex(face, 0)], t[face_vertex(face, 1)], t[face_vertex(face, 2)]))
             return true;
-    }
     return false;
 }
 
@@ -233,12 +262,61 @@ KDET_HD inline bool edges_within(const FilterMaker& f, const ExactMaker& e, vec3
            margin_sign(f, e, [&](const auto& mk) { return edge_edge_excess(mk, a, b, c, d); }) <= 0;
 }
 
+/// @brief Distance and closest points of a disjoint pair, in double.
+KDET_HD inline double disjoint_tets_distance(const dvec3 a[4], const dvec3 b[4], dvec3& on_a, dvec3& on_b) {
+    ClosestFeatures features;
+    return sqrt(closest_features(a, b, on_a, on_b, features));
+}
+
+/// @brief Whether vertex p lies within m of edge [a, b] or of one of its ends.
+KDET_HD inline bool vertex_segment_within(const FilterMaker& f, const ExactMaker& e, vec3 p, vec3 a, vec3 b) {
+    return margin_sign(f, e, [&](const auto& mk) { return vertex_vertex_excess(mk, p, a); }) <= 0 ||
+           margin_sign(f, e, [&](const auto& mk) { return vertex_vertex_excess(mk, p, b); }) <= 0 ||
+           (!points_coincide(a, b) && vertex_edge_within(f, e, p, a, b));
+}
+
+/// @brief Whether the conditions of one feature pair prove the tets within m.
+KDET_HD inline bool features_within(const FilterMaker& f, const ExactMaker& e, const vec3 a[4], const vec3 b[4],
+                                    ClosestFeatures features) {
+    const int i = features.first, j = features.second;
+    switch (features.kind) {
+    case ClosestFeatures::vertex_face:
+        return vertex_face_within(f, e, a[i], b[face_vertex(j, 0)], b[face_vertex(j, 1)], b[face_vertex(j, 2)]);
+    case ClosestFeatures::face_vertex:
+        return vertex_face_within(f, e, b[j], a[face_vertex(i, 0)], a[face_vertex(i, 1)], a[face_vertex(i, 2)]);
+    case ClosestFeatures::vertex_edge:
+        return vertex_segment_within(f, e, a[i], b[edge_first(j)], b[edge_second(j)]);
+    case ClosestFeatures::edge_vertex:
+        return vertex_segment_within(f, e, b[j], a[edge_first(i)], a[edge_second(i)]);
+    case ClosestFeatures::edge_edge:
+        return edges_within(f, e, a[edge_first(i)], a[edge_second(i)], b[edge_first(j)], b[edge_second(j)]);
+    }
+    return false;
+}
+
 /// @brief Whether two tets that do not intersect lie at most `margin` apart (margin >= 0), exactly.
 /// For a pair that intersects the answer is meaningless: the caller's intersection test goes first.
-KDET_NOINLINE KDET_HD inline bool disjoint_tets_within(const vec3 a[4], const vec3 b[4], float margin) {
+/// The face planes go first unless the caller tried them already (`face_planes_first` false); then the
+/// pair's closest features found in double (by GJK, else by trying every feature pair): the direction
+/// between their points proves most pairs farther apart, their own conditions most pairs within. The
+/// scan of every feature pair decides the rest (distances within rounding of m, degenerate tets).
+KDET_NOINLINE KDET_HD inline bool disjoint_tets_within(const vec3 a[4], const vec3 b[4], float margin,
+                                                      bool face_planes_first = true) {
     const FilterMaker f = margin_filter(a, b, margin);
     const ExactMaker e{margin};
-    if (face_planes_far(f, a, b) || face_planes_far(f, b, a)) return false;
+    if (face_planes_first && (face_planes_far(f, a, b) || face_planes_far(f, b, a))) return false;
+    {
+        dvec3 da[4], db[4];
+        for (int i = 0; i < 4; ++i) {
+            da[i] = widen(a[i]);
+            db[i] = widen(b[i]);
+        }
+        dvec3 on_a, on_b;
+        ClosestFeatures features;
+        if (!gjk_closest_features(da, db, on_a, on_b, features)) closest_features(da, db, on_a, on_b, features);
+        if (separated_along(f, a, b, on_b - on_a)) return false;
+        if (features_within(f, e, a, b, features)) return true;
+    }
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j)
             if (margin_sign(f, e, [&](const auto& mk) { return vertex_vertex_excess(mk, a[i], b[j]); }) <= 0) return true;
@@ -315,36 +393,6 @@ KDET_HD inline dvec3 common_point(const dvec3 a[4], const dvec3 b[4]) {
         }
     }
     return best;
-}
-
-/// @brief Distance and closest points of a disjoint pair, in double: the least over its vertex-face
-/// pairs where the vertex projects into the face, and its edge-edge pairs (which hold the vertex-edge
-/// and vertex-vertex pairs).
-KDET_HD inline double disjoint_tets_distance(const dvec3 a[4], const dvec3 b[4], dvec3& on_a, dvec3& on_b) {
-    double best = INFINITY;
-    const auto consider = [&](dvec3 x, dvec3 y) {
-        const double d2 = squared_distance(x, y);
-        if (d2 < best) {
-            best = d2;
-            on_a = x;
-            on_b = y;
-        }
-    };
-    for (int face = 0; face < 4; ++face) {
-        const int i = face_vertex(face, 0), j = face_vertex(face, 1), k = face_vertex(face, 2);
-        for (int v = 0; v < 4; ++v) {
-            dvec3 q;
-            if (project_into_triangle(a[v], b[i], b[j], b[k], q)) consider(a[v], q);
-            if (project_into_triangle(b[v], a[i], a[j], a[k], q)) consider(q, b[v]);
-        }
-    }
-    for (int i = 0; i < 6; ++i)
-        for (int j = 0; j < 6; ++j) {
-            dvec3 x, y;
-            closest_between_segments(a[edge_first(i)], a[edge_second(i)], b[edge_first(j)], b[edge_second(j)], x, y);
-            consider(x, y);
-        }
-    return sqrt(best);
 }
 
 /// @brief DetectorOptions::distances of a reported pair: the distance (0 when `intersecting`) and a

@@ -74,6 +74,26 @@ struct LocalPair {
 KDET_HD inline int edge_first(int k) { return k < 3 ? 0 : (k < 5 ? 1 : 2); }
 KDET_HD inline int edge_second(int k) { return k < 3 ? k + 1 : (k < 5 ? k - 1 : 3); }
 
+/// @brief GJK's support point of the Minkowski difference A - B along -v: the vertex ia of A lowest
+/// along v and the vertex ib of B highest (the first on a tie), for float or double vectors.
+template <class V>
+KDET_HD inline void lowest_difference(const V a[4], const V b[4], V v, int& ia, int& ib) {
+    ia = 0;
+    ib = 0;
+    auto lo = dot(a[0], v), hi = dot(b[0], v);
+    for (int i = 1; i < 4; ++i) {
+        const auto da = dot(a[i], v), db = dot(b[i], v);
+        if (da < lo) {
+            lo = da;
+            ia = i;
+        }
+        if (db > hi) {
+            hi = db;
+            ib = i;
+        }
+    }
+}
+
 /// @brief Fills p with the pair in the local frame. Returns false when every edge of both tets has
 /// zero length (two points), where no frame of unit size exists. Tets of any size whose edges are
 /// finite floats get the same frame as the same tets scaled by a power of two.

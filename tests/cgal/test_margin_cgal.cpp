@@ -24,6 +24,7 @@
 #include "geometry/tet_intersect.hpp"
 #include "pipeline/bounding_boxes.hpp"
 #include "narrow_cases.hpp"
+#include "../test_support.hpp"
 
 namespace kdet {
 namespace {
@@ -122,22 +123,82 @@ TEST(MarginCgal, RandomPairsNearTheirDistanceAreDecidedAsTheOracleDoes) {
     EXPECT_GT(checked, 1000);
 }
 
+/// test::random_nearby_tets, some with a flat b (its last vertex on an edge).
+void random_near_pair(std::mt19937& rng, int n, float size, vec3 a[4], vec3 b[4]) {
+    test::random_nearby_tets(rng, size, a, b);
+    if (n % 5 == 1) b[3] = {(b[0].x + b[1].x) / 2, (b[0].y + b[1].y) / 2, (b[0].z + b[1].z) / 2};
+}
+
+TEST(MarginCgal, MarginsFromHalfToTwiceTheDistanceAreDecidedAsTheOracleDoes) {
+    // Margins 2^-k of the distance either side of it, k from 1 to 40: the closest features found in double
+    // decide the pairs far from their margin, the scan of every feature pair those within rounding of it.
+    std::mt19937 rng(4546);
+    int checked = 0, within = 0;
+    for (int n = 0; n < 200; ++n) {
+        const float size = std::pow(10.0f, static_cast<float>(n % 13) - 6.0f);
+        vec3 a[4], b[4];
+        random_near_pair(rng, n, size, a, b);
+        const HullSquaredDistance d = cgal_squared_distance(a, b);
+        const double distance = oracle_distance(d);
+        for (int k : {1, 4, 12, 20, 28, 36, 40})
+            for (int side : {-1, 1}) {
+                const float m = static_cast<float>(distance * (1.0 + side * std::ldexp(1.0, -k)));
+                const bool expected = oracle_within(d, m);
+                EXPECT_EQ(kdet_within(a, b, m), expected) << "size " << size << " margin " << m << " distance " << distance;
+                within += expected;
+                ++checked;
+            }
+    }
+    EXPECT_GT(checked, 2000);
+    EXPECT_GT(within, checked / 3);
+    EXPECT_LT(within, 2 * checked / 3);
+}
+
+TEST(MarginCgal, ADirectionProvesOnlyPairsFartherApartThanTheMargin) {
+    // narrow::separated_along certifies a direction whatever its source: the pair's own closest
+    // direction, tilted a little or a lot, at margins around the distance.
+    std::mt19937 rng(4547);
+    std::uniform_real_distribution<double> tilt(-1.0, 1.0);
+    int proven = 0, tried = 0;
+    for (int n = 0; n < 200; ++n) {
+        const float size = std::pow(10.0f, static_cast<float>(n % 13) - 6.0f);
+        vec3 a[4], b[4];
+        random_near_pair(rng, n, size, a, b);
+        narrow::dvec3 da[4], db[4], on_a, on_b;
+        for (int k = 0; k < 4; ++k) {
+            da[k] = narrow::widen(a[k]);
+            db[k] = narrow::widen(b[k]);
+        }
+        const double distance = narrow::disjoint_tets_distance(da, db, on_a, on_b);
+        const HullSquaredDistance d = cgal_squared_distance(a, b);
+        for (double amount : {0.0, 1e-12, 1e-6, 1e-2, 1.0}) {
+            const narrow::dvec3 n_dir = (on_b - on_a) + narrow::dvec3{tilt(rng) * amount * distance,
+                                                                      tilt(rng) * amount * distance,
+                                                                      tilt(rng) * amount * distance};
+            for (double fraction : {0.5, 0.999, 1.0 - 1e-9, 1.0, 1.0 + 1e-9}) {
+                const float m = static_cast<float>(distance * fraction);
+                const bool far = narrow::separated_along(narrow::margin_filter(a, b, m), a, b, n_dir);
+                EXPECT_FALSE(far && oracle_within(d, m)) << "size " << size << " margin " << m << " tilt " << amount;
+                proven += far;
+                ++tried;
+            }
+        }
+    }
+    // The untilted direction proves the pairs at half their distance, and more (the test is not empty).
+    EXPECT_GT(proven, tried / 5);
+}
+
 TEST(MarginCgal, ThePreTestsSeparateOnlyPairsFartherApartThanTheMargin) {
     // With a margin the face planes and the slabs reject the candidates they prove farther apart than
     // it (face_plane_reach, slabs.hpp): random pairs of sizes 1e-6..1e6, at margins from half their
     // distance to one float beyond it, wherever their boxes grown by the margin overlap (the only pairs
     // the pipeline pre-tests).
     std::mt19937 rng(4545);
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
     long long tried = 0, planes_separated = 0, slabs_separated = 0;
     for (int n = 0; n < 400; ++n) {
         const float size = std::pow(10.0f, static_cast<float>(n % 13) - 6.0f);
         vec3 a[4], b[4];
-        const vec3 offset{(2.2f + 0.5f * unit(rng)) * size, unit(rng) * size, unit(rng) * size};
-        for (int k = 0; k < 4; ++k) {
-            a[k] = {unit(rng) * size, unit(rng) * size, unit(rng) * size};
-            b[k] = {unit(rng) * size + offset.x, unit(rng) * size + offset.y, unit(rng) * size + offset.z};
-        }
+        test::random_nearby_tets(rng, size, a, b);
         const HullSquaredDistance d = cgal_squared_distance(a, b);
         const float distance = static_cast<float>(oracle_distance(d));
         const TetPlanes pa = tet_planes(a), pb = tet_planes(b);
