@@ -5,6 +5,7 @@
 /// and a double reference; the CUDA backend bit for bit as the CPU's. tests/cgal/test_margin_cgal.cpp
 /// holds the exact oracle.
 
+#include "nearby_tets.hpp"
 #include "test_support.hpp"
 
 #include "geometry/tet_distance.hpp"

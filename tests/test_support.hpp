@@ -8,8 +8,6 @@
 
 #include <gtest/gtest.h>
 
-#include "geometry/vec3.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -73,17 +71,6 @@ inline TetMesh random_soup(std::size_t count, double extent, double decades, uns
         for (std::uint32_t k = 0; k < 4; ++k) mesh.tets.push_back(static_cast<std::uint32_t>(4 * t) + k);
     }
     return mesh;
-}
-
-/// @brief Two random tets of about `size` (coordinates within it of their centres), b's centre 1.7 to
-/// 2.7 sizes from a's along x: near each other, now and then touching.
-inline void random_nearby_tets(std::mt19937& rng, float size, vec3 a[4], vec3 b[4]) {
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-    const vec3 offset{(2.2f + 0.5f * unit(rng)) * size, unit(rng) * size, unit(rng) * size};
-    for (int k = 0; k < 4; ++k) {
-        a[k] = {unit(rng) * size, unit(rng) * size, unit(rng) * size};
-        b[k] = {unit(rng) * size + offset.x, unit(rng) * size + offset.y, unit(rng) * size + offset.z};
-    }
 }
 
 /// @brief Rotates about the z axis through the mesh's box centre, then translates.

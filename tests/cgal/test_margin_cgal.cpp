@@ -24,7 +24,7 @@
 #include "geometry/tet_intersect.hpp"
 #include "pipeline/bounding_boxes.hpp"
 #include "narrow_cases.hpp"
-#include "../test_support.hpp"
+#include "../nearby_tets.hpp"
 
 namespace kdet {
 namespace {
