@@ -284,7 +284,8 @@ TEST(Margin, GjkFindsTheClosestFeaturesThatTryingEveryPairFinds) {
         }
         narrow::ClosestFeatures every{}, gjk{};
         const double d = std::sqrt(narrow::closest_features(da, db, x, y, every));
-        if (!narrow::gjk_closest_features(da, db, gx, gy, gjk)) continue;
+        narrow::MinkowskiSimplex simplex;
+        if (!narrow::gjk_closest_points(da, db, gx, gy, simplex) || !narrow::simplex_features(simplex, gjk)) continue;
         ++found;
         const narrow::dvec3 gap = gy - gx;
         const double gd = std::sqrt(narrow::dot(gap, gap));
@@ -298,6 +299,40 @@ TEST(Margin, GjkFindsTheClosestFeaturesThatTryingEveryPairFinds) {
     }
     EXPECT_GT(tried, 1500);
     EXPECT_GT(found, tried * 99 / 100);
+}
+
+TEST(Margin, GjkFindsTheClosestPointsOfARealMeshsNearPairs) {
+    // A mesh's pairs within a margin hold many nearly coplanar features (neighbours' neighbours), where
+    // GJK's simplex turns flat: every such pair's GJK distance is the exhaustive one's.
+    const TetMesh m = test::load_model("bunny.mesh");
+    DetectorOptions o;
+    o.margin = 0.001f;
+    Detector d(o);
+    d.set_self_collision(d.add_object(m), true);
+    const FrameResult r = d.detect();
+    ASSERT_GT(r.pairs.size(), 10000u);
+    std::size_t compared = 0;
+    for (const TetPair& pair : r.pairs) {
+        narrow::dvec3 a[4], b[4], x, y, gx, gy;
+        vec3 fa[4], fb[4];
+        for (int k = 0; k < 4; ++k) {
+            const double* p = &m.positions[3 * m.tets[4 * pair.tet_a + k]];
+            const double* q = &m.positions[3 * m.tets[4 * pair.tet_b + k]];
+            fa[k] = vec3{static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])};
+            fb[k] = vec3{static_cast<float>(q[0]), static_cast<float>(q[1]), static_cast<float>(q[2])};
+            a[k] = narrow::widen(fa[k]);
+            b[k] = narrow::widen(fb[k]);
+        }
+        bool exact_stage = false;
+        if (tets_intersect(NarrowPhase::exact, fa, fb, exact_stage)) continue;
+        narrow::ClosestFeatures features{};
+        narrow::MinkowskiSimplex simplex;
+        const double every = std::sqrt(narrow::closest_features(a, b, x, y, features));
+        if (!narrow::gjk_closest_points(a, b, gx, gy, simplex)) continue;
+        EXPECT_NEAR(std::sqrt(narrow::squared_distance(gx, gy)), every, 1e-9) << pair.tet_a << " " << pair.tet_b;
+        ++compared;
+    }
+    EXPECT_GT(compared, r.pairs.size() * 9 / 10);
 }
 
 TEST(Margin, EveryMethodFindsTheSamePairsInSoupsAndTheyLieWithinTheMargin) {

@@ -114,14 +114,15 @@ KDET_HD inline bool closest_on_simplex(MinkowskiSimplex& s) {
         const ClosestOnTriangle c = closest_on_triangle(origin, s.w[0], s.w[1], s.w[2]);
         for (int k = 0; k < 3; ++k) weight[k] = c.weight[k];
     } else if (s.size == 4) {
-        // The faces that the origin lies beyond (all of them for a flat simplex), the nearest one's point.
+        // Outside the tetrahedron its closest point is its boundary's: the nearest face's. Every face is
+        // tried, since a side test of a nearly flat simplex (a new point nearly in the old triangle's
+        // plane) is rounding noise that could drop the face holding the old closest point.
         double best = INFINITY;
-        bool beyond_any = false;
+        bool inside = true;
         for (int m = 0; m < 4; ++m) {
             const int i = face_vertex(m, 0), j = face_vertex(m, 1), k = face_vertex(m, 2);
             const dvec3 n = cross(s.w[j] - s.w[i], s.w[k] - s.w[i]);
-            if (dot(origin - s.w[i], n) * dot(s.w[m] - s.w[i], n) > 0.0) continue;
-            beyond_any = true;
+            inside = inside && dot(origin - s.w[i], n) * dot(s.w[m] - s.w[i], n) > 0.0;
             const ClosestOnTriangle c = closest_on_triangle(origin, s.w[i], s.w[j], s.w[k]);
             const double d2 = dot(c.point, c.point);
             if (d2 < best) {
@@ -132,7 +133,7 @@ KDET_HD inline bool closest_on_simplex(MinkowskiSimplex& s) {
                 weight[k] = c.weight[2];
             }
         }
-        if (!beyond_any) return false;
+        if (inside) return false;
     }
     keep_weighted(s, weight);
     return s.size > 0;
@@ -144,12 +145,10 @@ constexpr int k_closest_gjk_iterations = 32;
 /// @brief GJK stops when the next support point lowers |v|^2 by less than this fraction of it.
 constexpr double k_closest_gjk_progress = 0x1p-40;
 
-/// @brief The closest points of disjoint tets a and b by GJK, with the feature pair that the final
-/// simplex spans; false where GJK cannot tell (the tets touch or intersect up to rounding, or the
-/// simplex spans no vertex-face, vertex-edge, vertex-vertex or edge-edge pair).
-KDET_HD inline bool gjk_closest_features(const dvec3 a[4], const dvec3 b[4], dvec3& on_a, dvec3& on_b,
-                                         ClosestFeatures& features) {
-    MinkowskiSimplex s{{a[0] - b[0]}, {0}, {0}, {1.0}, 1};
+/// @brief The closest points of disjoint tets a and b by GJK, with the final simplex `s` that spans
+/// them; false where GJK cannot tell (the tets touch or intersect up to rounding).
+KDET_HD inline bool gjk_closest_points(const dvec3 a[4], const dvec3 b[4], dvec3& on_a, dvec3& on_b, MinkowskiSimplex& s) {
+    s = MinkowskiSimplex{{a[0] - b[0]}, {0}, {0}, {1.0}, 1};
     dvec3 v = s.w[0];
     double vv = dot(v, v);
     for (int iteration = 0; iteration < k_closest_gjk_iterations; ++iteration) {
@@ -174,10 +173,18 @@ KDET_HD inline bool gjk_closest_features(const dvec3 a[4], const dvec3 b[4], dve
     }
     on_a = dvec3{0.0, 0.0, 0.0};
     on_b = dvec3{0.0, 0.0, 0.0};
-    int vertices_a = 0, vertices_b = 0, count_a = 0, count_b = 0;
     for (int k = 0; k < s.size; ++k) {
         on_a = on_a + s.weight[k] * a[s.from_a[k]];
         on_b = on_b + s.weight[k] * b[s.from_b[k]];
+    }
+    return true;
+}
+
+/// @brief The feature pair that GJK's final simplex spans: the vertices of each tet among its points
+/// name a vertex, an edge or a face; false for none of ClosestFeatures' kinds.
+KDET_HD inline bool simplex_features(const MinkowskiSimplex& s, ClosestFeatures& features) {
+    int vertices_a = 0, vertices_b = 0, count_a = 0, count_b = 0;
+    for (int k = 0; k < s.size; ++k) {
         count_a += (vertices_a >> s.from_a[k] & 1) ? 0 : 1;
         count_b += (vertices_b >> s.from_b[k] & 1) ? 0 : 1;
         vertices_a |= 1 << s.from_a[k];
@@ -203,6 +210,15 @@ KDET_HD inline bool gjk_closest_features(const dvec3 a[4], const dvec3 b[4], dve
         return false;
     }
     return true;
+}
+
+/// @brief Squared distance and closest points of a disjoint pair, in double, with the feature pair
+/// that reaches them: GJK's where it can tell, else those of trying every feature pair.
+KDET_HD inline double closest_points_and_features(const dvec3 a[4], const dvec3 b[4], dvec3& on_a, dvec3& on_b,
+                                                  ClosestFeatures& features) {
+    MinkowskiSimplex s;
+    if (gjk_closest_points(a, b, on_a, on_b, s) && simplex_features(s, features)) return squared_distance(on_a, on_b);
+    return closest_features(a, b, on_a, on_b, features);
 }
 
 } // namespace kdet::narrow

@@ -265,7 +265,7 @@ KDET_HD inline bool edges_within(const FilterMaker& f, const ExactMaker& e, vec3
 /// @brief Distance and closest points of a disjoint pair, in double.
 KDET_HD inline double disjoint_tets_distance(const dvec3 a[4], const dvec3 b[4], dvec3& on_a, dvec3& on_b) {
     ClosestFeatures features;
-    return sqrt(closest_features(a, b, on_a, on_b, features));
+    return sqrt(closest_points_and_features(a, b, on_a, on_b, features));
 }
 
 /// @brief Whether vertex p lies within m of edge [a, b] or of one of its ends.
@@ -313,7 +313,7 @@ KDET_NOINLINE KDET_HD inline bool disjoint_tets_within(const vec3 a[4], const ve
         }
         dvec3 on_a, on_b;
         ClosestFeatures features;
-        if (!gjk_closest_features(da, db, on_a, on_b, features)) closest_features(da, db, on_a, on_b, features);
+        closest_points_and_features(da, db, on_a, on_b, features);
         if (separated_along(f, a, b, on_b - on_a)) return false;
         if (features_within(f, e, a, b, features)) return true;
     }
