@@ -361,22 +361,27 @@ KDET_HD inline double point_tet_distance(dvec3 x, const dvec3 t[4]) {
 }
 
 /// @brief A common point of two intersecting tets, in double: of the vertices and of each edge's
-/// crossing of the other tet's face planes (brought onto the face), the one farthest from neither tet.
+/// crossing of the other tet's face planes (brought onto the face), the one farthest from neither tet
+/// (the first on a tie). A candidate's second distance is computed only where its first leaves it a
+/// chance, and a candidate on both tets (score 0) ends the search: no later one could replace it.
 KDET_HD inline dvec3 common_point(const dvec3 a[4], const dvec3 b[4]) {
     dvec3 best = a[0];
     double best_score = INFINITY;
-    const auto consider = [&](dvec3 x) {
-        const double da = point_tet_distance(x, a), db = point_tet_distance(x, b);
-        const double score = da > db ? da : db;
+    // True once the best candidate lies on both tets.
+    const auto consider = [&](dvec3 x, const dvec3* first, const dvec3* second) {
+        const double d1 = point_tet_distance(x, first);
+        if (!(d1 < best_score)) return false;
+        const double d2 = point_tet_distance(x, second);
+        const double score = d1 > d2 ? d1 : d2;
         if (score < best_score) {
             best_score = score;
             best = x;
         }
+        return best_score == 0.0;
     };
-    for (int i = 0; i < 4; ++i) {
-        consider(a[i]);
-        consider(b[i]);
-    }
+    // A vertex lies on its own tet: the other tet's distance decides first.
+    for (int i = 0; i < 4; ++i)
+        if (consider(a[i], b, a) || consider(b[i], a, b)) return best;
     for (int side = 0; side < 2; ++side) {
         const dvec3* s = side ? b : a;
         const dvec3* t = side ? a : b;
@@ -388,7 +393,7 @@ KDET_HD inline dvec3 common_point(const dvec3 a[4], const dvec3 b[4]) {
                 const double hp = dot(n, p - fa), hq = dot(n, q - fa);
                 if (!(hp * hq <= 0.0) || hp == hq) continue;
                 const dvec3 x = p + (hp / (hp - hq)) * (q - p);
-                consider(closest_on_triangle(x, fa, fb, fc).point);
+                if (consider(closest_on_triangle(x, fa, fb, fc).point, s, t)) return best;
             }
         }
     }
