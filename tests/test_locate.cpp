@@ -125,8 +125,8 @@ TEST(Locate, BoxMeshSharedFeatures) {
 }
 
 TEST(Locate, AnswersFollowThePointsWhateverTheirOrder) {
-    // The hits are described in the queries' (Morton) order and then placed in the points' order: the
-    // same points shuffled, some twice, and with a distance get each point's own answer.
+    // The hits are found tet by tet and then placed in the points' order: the same points shuffled,
+    // some twice, and with a distance get each point's own answer.
     const TetMesh mesh = make_box_mesh(3, 3, 2, 0.5);
     const std::vector<double> xyz = test::locate_query_points(mesh, mesh.num_tets(), 400, 4);
     const std::size_t n = xyz.size() / 3;
@@ -153,6 +153,106 @@ TEST(Locate, AnswersFollowThePointsWhateverTheirOrder) {
             }
         }
     }
+}
+
+/// The nearest tet within d against brute force (distance to the boundary of each tet that does not
+/// hold the point); returns how many points got one.
+std::size_t expect_nearest_matches_brute_force(const TetMesh& mesh, const std::vector<double>& xyz, double within) {
+    LocateOptions options;
+    options.within = within;
+    const LocateResult r = locate(mesh, xyz, options);
+    const LocateResult held = locate(mesh, xyz);
+    expect_consistent(mesh, xyz, r);
+    std::size_t nearest = 0;
+    for (std::size_t p = 0; p < r.point_count; ++p) {
+        const vec3 q = float_point(xyz, p);
+        if (held.offsets[p + 1] > held.offsets[p]) {
+            // Held points keep exactly their holding tets.
+            EXPECT_EQ(r.offsets[p + 1] - r.offsets[p], held.offsets[p + 1] - held.offsets[p]) << "point " << p;
+            continue;
+        }
+        double best = within;
+        std::uint32_t best_tet = 0xffffffffu;
+        for (std::size_t t = 0; t < mesh.num_tets(); ++t) {
+            vec3 v[4];
+            float_tet(mesh, t, v);
+            const double d = point_query::closest_on_tet_boundary(v, q).distance;
+            if (d < best || (d == best && t < best_tet)) best = d, best_tet = static_cast<std::uint32_t>(t);
+        }
+        if (best_tet == 0xffffffffu) {
+            EXPECT_EQ(r.offsets[p + 1], r.offsets[p]) << "point " << p;
+            continue;
+        }
+        if (r.offsets[p + 1] - r.offsets[p] != 1u) {
+            ADD_FAILURE() << "point " << p << " within " << within << ": " << r.offsets[p + 1] - r.offsets[p] << " hits";
+            continue;
+        }
+        // The nearest tet, up to the rounding of the distances in double (docs/point-location.md):
+        // its distance as brute force computes it is within a tolerance of the least.
+        const std::uint64_t h = r.offsets[p];
+        vec3 v[4];
+        float_tet(mesh, r.tets[h], v);
+        const double tolerance = 1e-7 * test::extent_of(mesh);
+        EXPECT_LE(point_query::closest_on_tet_boundary(v, q).distance, best + tolerance) << "point " << p;
+        EXPECT_NEAR(r.distances[h], best, tolerance) << "point " << p;
+        EXPECT_GT(r.distances[h], 0.0);
+        const double dx = r.closest_points[3 * h] - q.x, dy = r.closest_points[3 * h + 1] - q.y, dz = r.closest_points[3 * h + 2] - q.z;
+        EXPECT_NEAR(std::sqrt(dx * dx + dy * dy + dz * dz), r.distances[h], 1e-12 * (1 + best));
+        ++nearest;
+    }
+    return nearest;
+}
+
+TEST(Locate, PreparedFacesGiveTheExactOrientations) {
+    // TetFaces decides each face's orientation from rows computed once per tet; its signs must be
+    // orient3d's with the point in place of the vertex, on the faces' planes (vertices and edge
+    // midpoints of a power-of-two lattice, exactly coplanar) and a float step off them too.
+    std::mt19937 random(9);
+    std::uniform_int_distribution<int> lattice(-8, 8);
+    std::uniform_real_distribution<float> scale(-30.0f, 30.0f);
+    std::size_t zeros = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        const float unit = std::ldexp(1.0f, static_cast<int>(scale(random)));
+        vec3 v[4];
+        for (vec3& q : v) q = vec3{unit * static_cast<float>(lattice(random)), unit * static_cast<float>(lattice(random)),
+                                   unit * static_cast<float>(lattice(random))};
+        const point_query::TetFaces faces(v);
+        for (int n = 0; n < 8; ++n) {
+            const vec3& a = v[random() % 4];
+            const vec3& b = v[random() % 4];
+            vec3 p{(a.x + b.x) * 0.5f, (a.y + b.y) * 0.5f, (a.z + b.z) * 0.5f};
+            if (n % 2) p.y = n % 4 == 1 ? next_float_up(p.y) : next_float_down(p.y);
+            for (int k = 0; k < 4; ++k) {
+                vec3 w[4];
+                point_query::replace_vertex(v, k, p, w);
+                const int expected = point_query::orient3d_sign(w[0], w[1], w[2], w[3]);
+                double value = 0.0;
+                ASSERT_EQ(faces.face_sign(v, k, p, value), expected) << trial << " " << n << " " << k;
+                zeros += expected == 0;
+            }
+        }
+    }
+    EXPECT_GT(zeros, 1000u); // the points on a face's plane were tested
+}
+
+TEST(Locate, FarApartClustersAndABigTet) {
+    // Two box meshes 1e5 apart leave too many cells in their common region for a dense table: the
+    // hashed grid answers. A tet larger than all the others spans more cells than there are points
+    // and scans every point; points far outside the tets get no grid key and no hit.
+    TetMesh mesh = make_box_mesh(4, 3, 3, 0.25);
+    TetMesh other = make_box_mesh(3, 3, 2, 0.5);
+    const auto vertices = static_cast<std::uint32_t>(mesh.num_vertices());
+    for (std::size_t i = 0; i < other.positions.size(); ++i) mesh.positions.push_back(other.positions[i] + (i % 3 == 1 ? 1e5 : 0.0));
+    for (const std::uint32_t v : other.tets) mesh.tets.push_back(v + vertices);
+    std::vector<double> xyz = test::locate_query_points(mesh, mesh.num_tets(), 1000, 8);
+    xyz.insert(xyz.end(), {-5e5, 3, 3, 7, 2e5, 1, 0.5, 1e5 + 0.5, 0.5});
+    expect_matches_brute_force(mesh, xyz, "clusters");
+    for (const double within : {0.1, 3.0}) EXPECT_GT(expect_nearest_matches_brute_force(mesh, xyz, within), 0u) << within;
+    const auto first = static_cast<std::uint32_t>(mesh.num_vertices());
+    mesh.positions.insert(mesh.positions.end(), {-1e3, -1e3, -1e3, 1e3, -1e3, -1e3, 0, 1e3, -1e3, 0, 0, 1e3});
+    mesh.tets.insert(mesh.tets.end(), {first, first + 1, first + 2, first + 3});
+    const std::vector<double> few = {0.3, 0.2, 0.1, 0.5, 1e5 + 0.7, 0.2, 2e3, 0, 0};
+    expect_matches_brute_force(mesh, few, "big tet");
 }
 
 TEST(Locate, RandomSoupOfManySizes) {
@@ -189,53 +289,10 @@ TEST(Locate, DegenerateTets) {
     EXPECT_EQ(hits_of(r), (std::set<Hit>{{0, 0}, {2, 0}, {4, 1}, {6, 2}, {8, 1}, {9, 0}}));
 }
 
-/// The nearest tet within d by brute force: distance to the boundary of each tet that does not hold the
-/// point.
 TEST(Locate, WithinGivesNearestTet) {
     const TetMesh mesh = test::random_soup(300, 10.0, 2.0, 11);
     const std::vector<double> xyz = test::locate_query_points(mesh, 50, 1500, 6);
-    for (double within : {0.05, 0.5, 30.0}) {
-        LocateOptions options;
-        options.within = within;
-        const LocateResult r = locate(mesh, xyz, options);
-        const LocateResult held = locate(mesh, xyz);
-        expect_consistent(mesh, xyz, r);
-        std::size_t nearest = 0;
-        for (std::size_t p = 0; p < r.point_count; ++p) {
-            const vec3 q = float_point(xyz, p);
-            if (held.offsets[p + 1] > held.offsets[p]) {
-                // Held points keep exactly their holding tets.
-                ASSERT_EQ(r.offsets[p + 1] - r.offsets[p], held.offsets[p + 1] - held.offsets[p]);
-                continue;
-            }
-            double best = within;
-            std::uint32_t best_tet = 0xffffffffu;
-            for (std::size_t t = 0; t < mesh.num_tets(); ++t) {
-                vec3 v[4];
-                float_tet(mesh, t, v);
-                const double d = point_query::closest_on_tet_boundary(v, q).distance;
-                if (d < best || (d == best && t < best_tet)) best = d, best_tet = static_cast<std::uint32_t>(t);
-            }
-            if (best_tet == 0xffffffffu) {
-                EXPECT_EQ(r.offsets[p + 1], r.offsets[p]) << "point " << p;
-                continue;
-            }
-            ASSERT_EQ(r.offsets[p + 1] - r.offsets[p], 1u) << "point " << p << " within " << within;
-            // The nearest tet, up to the rounding of the distances in double (docs/point-location.md):
-            // its distance as brute force computes it is within a tolerance of the least.
-            const std::uint64_t h = r.offsets[p];
-            vec3 v[4];
-            float_tet(mesh, r.tets[h], v);
-            const double tolerance = 1e-7 * test::extent_of(mesh);
-            EXPECT_LE(point_query::closest_on_tet_boundary(v, q).distance, best + tolerance) << "point " << p;
-            EXPECT_NEAR(r.distances[h], best, tolerance) << "point " << p;
-            EXPECT_GT(r.distances[h], 0.0);
-            const double dx = r.closest_points[3 * h] - q.x, dy = r.closest_points[3 * h + 1] - q.y, dz = r.closest_points[3 * h + 2] - q.z;
-            EXPECT_NEAR(std::sqrt(dx * dx + dy * dy + dz * dz), r.distances[h], 1e-12 * (1 + best));
-            ++nearest;
-        }
-        EXPECT_GT(nearest, 0u) << within;
-    }
+    for (double within : {0.05, 0.5, 30.0}) EXPECT_GT(expect_nearest_matches_brute_force(mesh, xyz, within), 0u) << within;
 }
 
 TEST(Locate, DetectorObjectsAndMovedPositions) {

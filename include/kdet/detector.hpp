@@ -214,6 +214,9 @@ public:
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
+    // The one-off point location hands its detector's result over instead of copying it.
+    friend LocateResult locate(const TetMesh& mesh, const PositionsView& points, const LocateOptions& options,
+                               const DetectorOptions& detector_options);
 };
 
 /// @brief A pair of tet indices (in file order) of a one-off query.

@@ -123,6 +123,8 @@ public:
     using stage_clock = CpuStageClock;
     /// How the pipeline divides its work on this backend.
     using tuning = CpuTuning;
+    /// The layer's buffers are host memory: a step may write its results where the host reads them.
+    static constexpr bool memory_is_host = true;
 
     /// @brief options.threads = 0 keeps OpenMP's default; the block size and stream only matter on the GPU.
     explicit CpuExec(const DetectorOptions& options);

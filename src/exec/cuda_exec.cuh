@@ -221,6 +221,8 @@ public:
     using stage_clock = CudaStageClock;
     /// How the pipeline divides its work on this backend.
     using tuning = CudaTuning;
+    /// The layer's buffers are GPU memory: results reach the host by download.
+    static constexpr bool memory_is_host = false;
 
     explicit CudaExec(const DetectorOptions& options)
         : block_size_(options.block_size), stream_(static_cast<cudaStream_t>(options.cuda_stream)) {

@@ -22,41 +22,96 @@ KDET_HD inline void replace_vertex(const vec3 v[4], int k, vec3 p, vec3 out[4]) 
 }
 
 /// @brief How a tet and a point lie: the tet's orientation (0: no volume) and, for a tet with volume,
-/// the sign of each orientation with vertex k replaced by the point.
+/// the sign of each orientation with vertex k replaced by the point and its value in double (as
+/// TetFaces computes it, within the bound of narrow::sign_det3).
 struct PointTetSigns {
     int tet;
     int face[4];
+    double det[4];
 };
 
-/// @brief Whether the closed tet v, whose orientation (orient3d_sign of its vertices) is given, holds
-/// p, exactly. A tet with volume holds p iff no orientation with a
+/// @brief A tet's faces prepared for testing many points: the orientation with p in place of vertex k
+/// is, up to sign `flip[k]`, det(e1, e2, p - base[k]) for two edges e1, e2 of face k from its vertex
+/// base[k], so their double cross product and the rows' part of narrow::sign_det3's bound are computed
+/// once per tet. Per point it is then sign_det3's own computation: a dot product, decided where it
+/// exceeds its bound, else the exact sign.
+struct TetFaces {
+    // Per face k, side by side so that the four are computed together.
+    double base_x[4], base_y[4], base_z[4];
+    double normal_x[4], normal_y[4], normal_z[4];
+    double bound[4];
+    double sign[4]; ///< -1 where orient3d with p at k has these rows after an odd permutation of its points
+    KDET_HD explicit TetFaces(const vec3 v[4]) {
+        // Face k's rows: v[first[k]] - v[from[k]], v[second[k]] - v[from[k]], p - v[from[k]].
+        const int from[4] = {1, 0, 0, 0}, first[4] = {2, 2, 1, 1}, second[4] = {3, 3, 3, 2};
+        const double odd[4] = {-1.0, 1.0, -1.0, 1.0};
+        for (int k = 0; k < 4; ++k) {
+            const dvec3 base = narrow::widen(v[from[k]]);
+            const dvec3 e1 = narrow::operator-(narrow::widen(v[first[k]]), base);
+            const dvec3 e2 = narrow::operator-(narrow::widen(v[second[k]]), base);
+            const dvec3 normal = narrow::cross(e1, e2);
+            base_x[k] = base.x;
+            base_y[k] = base.y;
+            base_z[k] = base.z;
+            normal_x[k] = normal.x;
+            normal_y[k] = normal.y;
+            normal_z[k] = normal.z;
+            bound[k] = narrow::k_double_det_bound * narrow::norm1(e1) * narrow::norm1(e2);
+            sign[k] = odd[k];
+        }
+    }
+    /// The orientation of v with vertex k replaced by p, in double, and its rounding bound.
+    KDET_HD void face_value(int k, vec3 p, double& value, double& error) const {
+        const double rx = double{p.x} - base_x[k], ry = double{p.y} - base_y[k], rz = double{p.z} - base_z[k];
+        value = sign[k] * (normal_x[k] * rx + normal_y[k] * ry + normal_z[k] * rz);
+        error = bound[k] * narrow::max_d(fabs(rx), narrow::max_d(fabs(ry), fabs(rz)));
+    }
+    /// The exact sign of that orientation: the double value where it exceeds its bound.
+    KDET_HD static int decided_sign(const vec3 v[4], int k, vec3 p, double value, double error) {
+        if (value > error) return 1;
+        if (value < -error) return -1;
+        vec3 w[4];
+        replace_vertex(v, k, p, w);
+        return orient3d_sign(w[0], w[1], w[2], w[3]);
+    }
+    KDET_HD int face_sign(const vec3 v[4], int k, vec3 p, double& value) const {
+        double error;
+        face_value(k, p, value, error);
+        return decided_sign(v, k, p, value, error);
+    }
+};
+
+/// @brief Whether the closed tet v, whose orientation (orient3d_sign of its vertices) and faces are
+/// given, holds p, exactly. A tet with volume holds p iff no orientation with a
 /// vertex replaced by p has the opposite sign of the tet's own (zero: p lies on that face's plane).
+/// The four double values come first: one certainly opposite decides without any exact sign.
 /// A tet without volume is decided by the exact tet-tet test against the point as a tet of four equal
 /// vertices, which handles flat and collinear tets.
-KDET_HD inline bool tet_holds_point(const vec3 v[4], vec3 p, int orientation, PointTetSigns& signs) {
+KDET_HD inline bool tet_holds_point(const TetFaces& faces, const vec3 v[4], vec3 p, int orientation, PointTetSigns& signs) {
     signs.tet = orientation;
     if (signs.tet == 0) {
         const vec3 point[4] = {p, p, p, p};
         bool exact_stage = false;
         return narrow::exact_intersect(v, point, exact_stage);
     }
-    bool holds = true;
+    double error[4];
+    bool opposite = false;
     for (int k = 0; k < 4; ++k) {
-        vec3 w[4];
-        replace_vertex(v, k, p, w);
-        signs.face[k] = orient3d_sign(w[0], w[1], w[2], w[3]);
-        if (signs.face[k] == -signs.tet) {
-            holds = false;
-            break;
-        }
+        faces.face_value(k, p, signs.det[k], error[k]);
+        opposite |= signs.tet * signs.det[k] < -error[k];
     }
-    return holds;
+    if (opposite) return false;
+    for (int k = 0; k < 4; ++k) {
+        signs.face[k] = TetFaces::decided_sign(v, k, p, signs.det[k], error[k]);
+        if (signs.face[k] == -signs.tet) return false;
+    }
+    return true;
 }
 
-/// @brief As above, with the tet's orientation computed here (a caller testing many points against
-/// one tet computes it once instead).
+/// @brief As above, with the tet's orientation and faces computed here (a caller testing many points
+/// against one tet computes them once instead).
 KDET_HD inline bool tet_holds_point(const vec3 v[4], vec3 p, PointTetSigns& signs) {
-    return tet_holds_point(v, p, orient3d_sign(v[0], v[1], v[2], v[3]), signs);
+    return tet_holds_point(TetFaces(v), v, p, orient3d_sign(v[0], v[1], v[2], v[3]), signs);
 }
 
 /// @brief A point's place relative to a tet, in double: barycentric coordinates (of the point when the
@@ -93,8 +148,8 @@ KDET_HD inline PointInTet closest_on_tet_boundary(const vec3 v[4], vec3 p) {
 
 /// @brief Where p lies in tet v, given whether the tet holds it (tet_holds_point, with its signs).
 /// For a tet with volume that holds p: the barycentric coordinates are the orientations with p in
-/// place of each vertex over their sum (those the exact signs put on a face exactly 0, any the double
-/// values put on the wrong side 0 too), the point itself and distance 0. Otherwise the closest point
+/// place of each vertex (the double values in `signs`) over their sum (those the exact signs put on a
+/// face exactly 0, any the double values put on the wrong side 0 too), the point itself and distance 0. Otherwise the closest point
 /// of the boundary (for a tet without volume that holds p, distance 0 and the point itself).
 KDET_HD inline PointInTet locate_in_tet(const vec3 v[4], vec3 p, bool holds, const PointTetSigns& signs) {
     if (holds && signs.tet != 0) {
@@ -103,13 +158,7 @@ KDET_HD inline PointInTet locate_in_tet(const vec3 v[4], vec3 p, bool holds, con
         for (int k = 0; k < 4; ++k) {
             double part = 0.0;
             if (signs.face[k] != 0) {
-                vec3 w[4];
-                replace_vertex(v, k, p, w);
-                const dvec3 a = narrow::widen(w[0]);
-                const double det = narrow::dot(narrow::cross(narrow::operator-(narrow::widen(w[1]), a),
-                                                             narrow::operator-(narrow::widen(w[2]), a)),
-                                               narrow::operator-(narrow::widen(w[3]), a));
-                part = signs.tet > 0 ? det : -det;
+                part = signs.tet > 0 ? signs.det[k] : -signs.det[k];
                 if (part < 0.0) part = 0.0;
             }
             r.barycentric[k] = part;

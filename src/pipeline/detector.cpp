@@ -173,18 +173,18 @@ struct Detector::Impl {
         positions_on_device[object] = positions_staged[object] = 0;
     }
 
-    /// Point location over the current positions (locate.hpp); `points` on the host or, with
-    /// `on_device`, in the backend's memory.
-    const LocateResult& locate(const PositionsView& points, bool on_device, ObjectId object, const LocateOptions& how) {
+    /// Point location over the current positions (locate.hpp) into `out`; `points` on the host
+    /// or, with `on_device`, in the backend's memory.
+    void locate(const PositionsView& points, bool on_device, ObjectId object, const LocateOptions& how, LocateResult& out) {
         if (!(how.within >= 0.0) || !std::isfinite(how.within))
             throw Error("locate: within must be finite and not negative, got " + distance_text(how.within));
         if (object != all_objects) check_object(object);
         check_extent("locate: the points", points);
         if (objects() == 0) { // no tets, no pipeline geometry: nothing holds any point
-            located = LocateResult{};
-            located.point_count = points.vertex_count;
-            located.offsets.assign(points.vertex_count + 1, 0);
-            return located;
+            out = LocateResult{};
+            out.point_count = points.vertex_count;
+            out.offsets.assign(points.vertex_count + 1, 0);
+            return;
         }
         if (topology_changed) rebuild_pipeline();
         for (std::size_t o = 0; o < objects(); ++o)
@@ -208,10 +208,13 @@ struct Detector::Impl {
         request.tet_count = object == all_objects ? begin.back() : begin[object + 1] - begin[object];
         request.options = how;
         std::vector<vec3> converted;
+        const bool packed_floats = !points.is_double && points.row_stride == 3 && points.column_stride == 1;
         if (!on_device) {
             const std::uint32_t bad = first_non_finite(points);
             if (bad != no_vertex)
                 throw Error("locate: point " + std::to_string(bad) + " has a non-finite coordinate (or one beyond float range)");
+        }
+        if (!on_device && !packed_floats) { // the pipeline reads x y z float32 per point
             converted.resize(points.vertex_count);
             const auto count = static_cast<std::ptrdiff_t>(points.vertex_count);
             with_positions(points, [&](const auto& source) {
@@ -220,8 +223,7 @@ struct Detector::Impl {
             });
             request.points = xyz_view(converted.data(), converted.size());
         }
-        pipeline->locate(request, located);
-        return located;
+        pipeline->locate(request, out);
     }
 
     /// Rejects a scene of more tets or vertices than ids can number, were `tets` and `vertices` to
@@ -577,16 +579,27 @@ DeviceResults Detector::device_results() const {
 
 const LocateResult& Detector::locate(const PositionsView& points, ObjectId object, const LocateOptions& options) {
     if (impl_->frame_pending) finish();
-    return impl_->locate(points, false, object, options);
+    impl_->locate(points, false, object, options, impl_->located);
+    return impl_->located;
 }
+
 const LocateResult& Detector::locate(const PositionsView& points, ObjectId object) {
     return locate(points, object, LocateOptions{});
 }
 const LocateResult& Detector::locate_on_device(const PositionsView& points, ObjectId object, const LocateOptions& options) {
     if (impl_->frame_pending) finish();
-    return impl_->locate(points, true, object, options);
+    impl_->locate(points, true, object, options, impl_->located);
+    return impl_->located;
 }
 DeviceLocateResults Detector::device_locate_results() const { return impl_->pipeline->device_locate_results(); }
+
+LocateResult locate(const TetMesh& mesh, const PositionsView& points, const LocateOptions& options,
+                    const DetectorOptions& detector_options) {
+    Detector detector(detector_options);
+    const ObjectId object = detector.add_object(mesh);
+    detector.locate(points, object, options);
+    return std::move(detector.impl_->located);
+}
 
 std::uint32_t Detector::first_tet(ObjectId object) const {
     impl_->check_object(object);

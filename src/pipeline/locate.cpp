@@ -8,13 +8,6 @@
 
 namespace kdet {
 
-LocateResult locate(const TetMesh& mesh, const PositionsView& points, const LocateOptions& options,
-                    const DetectorOptions& detector_options) {
-    Detector detector(detector_options);
-    const ObjectId object = detector.add_object(mesh);
-    return detector.locate(points, object, options);
-}
-
 LocateResult locate(const TetMesh& mesh, const std::vector<double>& xyz, const LocateOptions& options,
                     const DetectorOptions& detector_options) {
     if (xyz.size() % 3 != 0)

@@ -1,13 +1,14 @@
 #pragma once
 /// @file locate_driver.hpp
 /// @brief Locator: point location over a detector's tets at their current positions, written once over
-/// an execution layer (the kernels are in point_location.hpp). Each call grids the located tets anew
-/// (their positions may have moved since the last call), then runs the queries; a buffer that was too
-/// small grows to what its step counted and the step runs again.
+/// an execution layer (the kernels are in point_location.hpp). Each call grids the points anew, then
+/// each located tet at its current position reads the points in its box; a buffer that was too small
+/// grows to what its step counted and the step runs again.
 
 #include "pipeline/capacity.hpp"
 #include "pipeline/gather_positions.hpp"
 #include "pipeline/point_location.hpp"
+#include "pipeline/scene_view.hpp"
 #include "pipeline/positions_check.hpp"
 
 #include <kdet/error.hpp>
@@ -50,25 +51,39 @@ public:
         if (n >= 0xffffffffull) throw Error("locate: too many points (" + std::to_string(n) + "), at most 2^32 - 2");
         point_count_ = n;
         hit_count_ = 0;
-        counters_.resize_discard(1);
-        reset_counters(exec, n);
-        stage_points(exec, request);
-        const LocateGridView grid = build_grid(exec, scene, request, hash);
-        order_points(exec, n);
-        find_hits(exec, grid, request.options.within, n, scene.total_tets);
-        describe(exec, scene, static_cast<std::uint32_t>(n));
 
-        result = LocateResult{};
+        counters_.resize_discard(1);
+        reset_counters(exec);
+        stage_points(exec, request);
+        const LocateTetsView tets{scene.positions, scene.tets,  request.first_tet,      scene.user_id,
+                                  scene.stored_id, scene.tet_object, scene.object_tet_begin};
+        const LocatePointsView points = grid_points(exec, tets, request, hash);
+        find_hits(exec, tets, points, request);
         result.point_count = n;
         result.hit_count = hit_count_;
-        if (!request.options.results_to_host) return;
+        if (!request.options.results_to_host) {
+            describe(exec, static_cast<std::uint32_t>(n), request.options.within > 0.0, own_outputs());
+            for (auto* v : {&result.barycentrics, &result.closest_points, &result.distances}) v->clear();
+            result.offsets.clear();
+            result.objects.clear();
+            result.tets.clear();
+            return;
+        }
         result.offsets.resize(n + 1);
-        exec.download(result.offsets.data(), offsets_.data(), n + 1);
         result.objects.resize(hit_count_);
         result.tets.resize(hit_count_);
         result.barycentrics.resize(4 * hit_count_);
         result.closest_points.resize(3 * hit_count_);
         result.distances.resize(hit_count_);
+        if constexpr (Exec::memory_is_host) {
+            // Described where the caller reads them: no second copy of every hit.
+            outputs_ = Outputs{result.offsets.data(),      result.objects.data(),        result.tets.data(),
+                               result.barycentrics.data(), result.closest_points.data(), result.distances.data()};
+            describe(exec, static_cast<std::uint32_t>(n), request.options.within > 0.0, outputs_);
+            return;
+        }
+        describe(exec, static_cast<std::uint32_t>(n), request.options.within > 0.0, own_outputs());
+        exec.download(result.offsets.data(), offsets_.data(), n + 1);
         exec.download(result.objects.data(), objects_.data(), hit_count_);
         exec.download(result.tets.data(), tets_.data(), hit_count_);
         exec.download(result.barycentrics.data(), barycentrics_.data(), 4 * hit_count_);
@@ -77,15 +92,17 @@ public:
     }
 
     DeviceLocateResults device_results() const {
-        return DeviceLocateResults{offsets_.data(),        objects_.data(),   tets_.data(), barycentrics_.data(),
-                                   closest_points_.data(), distances_.data(), point_count_, hit_count_};
+        return DeviceLocateResults{outputs_.offsets,        outputs_.objects,   outputs_.tets, outputs_.barycentrics,
+                                   outputs_.closest_points, outputs_.distances, point_count_, hit_count_};
     }
 
     std::size_t memory_bytes() const {
-        return points_.capacity_bytes() + sorted_points_.capacity_bytes() + order_.capacity_bytes() + held_.capacity_bytes() + boxes_.capacity_bytes() + orientation_.capacity_bytes() + entry_boxes_.capacity_bytes() + keys_.capacity_bytes() +
-               slot_begin_.capacity_bytes() + slot_end_.capacity_bytes() + big_.capacity_bytes() + hits_.capacity_bytes() + hits_grown_.capacity_bytes() +
-               offsets_.capacity_bytes() + objects_.capacity_bytes() + tets_.capacity_bytes() + barycentrics_.capacity_bytes() +
-               closest_points_.capacity_bytes() + distances_.capacity_bytes() + counters_.capacity_bytes();
+        return points_.capacity_bytes() + point_keys_.capacity_bytes() + slot_start_.capacity_bytes() + sorted_points_.capacity_bytes() +
+               held_.capacity_bytes() + best_distance_.capacity_bytes() + best_tet_.capacity_bytes() + nearest_closest_.capacity_bytes() +
+               nearest_distance_.capacity_bytes() + hit_keys_.capacity_bytes() +
+               hits_.capacity_bytes() + hit_keys_grown_.capacity_bytes() + hits_grown_.capacity_bytes() + offsets_.capacity_bytes() +
+               objects_.capacity_bytes() + tets_.capacity_bytes() + barycentrics_.capacity_bytes() + closest_points_.capacity_bytes() +
+               distances_.capacity_bytes() + counters_.capacity_bytes();
     }
 
 private:
@@ -94,9 +111,8 @@ private:
         exec.download(&c, counters_.data(), 1);
         return c;
     }
-    void reset_counters(Exec& exec, std::size_t points) {
+    void reset_counters(Exec& exec) {
         LocateCounters c{};
-        c.points = points;
         c.first_non_finite_point = no_vertex;
         for (int a = 0; a < 3; ++a) {
             c.region.lo[a] = float_to_ordered(std::numeric_limits<float>::infinity());
@@ -109,16 +125,20 @@ private:
         exec.for_each(b.size(), FillKernel<T>{b.data(), value});
     }
 
-    /// The points as float32 in the backend's memory: uploaded from the host, or gathered there and
-    /// checked to be finite.
+    /// The points as float32 in the backend's memory: the host's own where that is the backend's,
+    /// else uploaded from the host, or gathered there and checked to be finite.
     void stage_points(Exec& exec, const LocateRequest& request) {
         const PositionsView& view = request.points;
-        points_.resize_discard(view.vertex_count);
-        held_.resize_discard(view.vertex_count);
         if (!request.points_on_device) {
-            exec.upload(points_.data(), static_cast<const vec3*>(view.data), view.vertex_count);
+            points_in_ = static_cast<const vec3*>(view.data);
+            if constexpr (Exec::memory_is_host) return;
+            points_.resize_discard(view.vertex_count);
+            exec.upload(points_.data(), points_in_, view.vertex_count);
+            points_in_ = points_.data();
             return;
         }
+        points_.resize_discard(view.vertex_count);
+        points_in_ = points_.data();
         if (view.vertex_count == 0) return;
         exec.check_readable(view.data, "locate_on_device: the points");
         with_positions(view, [&](const auto& source) {
@@ -130,161 +150,220 @@ private:
             throw Error("locate_on_device: point " + std::to_string(bad) + " has a non-finite coordinate (or one beyond float range)");
     }
 
-    /// Grids the located tets: c0 is the median of their boxes' extents rounded up to a power of two
-    /// (so that most tets sit on layers 0 and 1), with as many layers as the largest needs.
-    LocateGridView build_grid(Exec& exec, const LocateScene& scene, const LocateRequest& request, HashFunction hash) {
+    /// Grids the points: c0 is the lower end of the binary octave that holds the median of the located
+    /// tets' box extents, and a point has a key on each layer that a tet's box (grown by `within` for
+    /// the nearest tets) goes to.
+    LocatePointsView grid_points(Exec& exec, const LocateTetsView& tets, const LocateRequest& request, HashFunction hash) {
         const std::uint32_t count = request.tet_count;
-        boxes_.resize_discard(count);
-        orientation_.resize_discard(count);
-        big_.resize_discard(std::max<std::uint32_t>(count, 1));
+        const std::size_t n = point_count_;
+        const double within = request.options.within;
         LocateCounters* c = counters_.data();
-        exec.for_each(count, LocateTetBoxesKernel{scene.positions, scene.tets, request.first_tet, boxes_.data(), orientation_.data(), c});
+        exec.for_each(count, LocateTetBoxesKernel{tets.positions, tets.tets, tets.first, within, c});
         const LocateCounters sizes = read_counters(exec);
-        GridParams params{};
-        std::uint32_t slot_bits = 10;
-        while ((std::uint64_t{1} << slot_bits) < 2ull * count && slot_bits < 30) ++slot_bits;
-        order_scale_ = vec3{0.0f, 0.0f, 0.0f};
+        LocateGrid grid{};
+        grid.hash = hash;
+        grid.params.layer_count = 1;
+        grid.params.cell_size0 = 1.0f;
+        grid.params.inv_cell_size0 = 1.0f;
+        std::uint32_t layer_mask = 0;
+        Aabb region{{0.0f, 0.0f, 0.0f}, {-1.0f, -1.0f, -1.0f}}; // holds no point
         if (count > 0) {
             std::uint64_t seen = 0;
             std::uint32_t median = 0, largest = 0;
+            const auto present = [&](std::uint32_t e) { return (sizes.present[e / 32] >> (e % 32)) & 1u; };
+            const std::uint32_t samples = (count + 7) / 8;
             for (std::uint32_t e = 0; e < float_octaves; ++e) {
-                if (!sizes.octaves[e]) continue;
-                if (seen < (count + 1) / 2) median = e;
-                seen += sizes.octaves[e];
-                largest = e;
+                if (sizes.sampled[e]) {
+                    if (seen < (samples + 1) / 2) median = e;
+                    seen += sizes.sampled[e];
+                }
+                if (present(e)) largest = e;
             }
-            // Bins 254 and 255 (extents of 2^127 and up, or infinite) have no float end: the top layer takes them.
-            median = std::min<std::uint32_t>(median, 253);
-            params.cell_size0 = float_octave_end(median);
-            params.inv_cell_size0 = 1.0f / params.cell_size0;
-            params.layer_count = static_cast<int>(std::min<std::uint32_t>(largest - std::min(largest, median) + 1, max_grid_layers));
-            params.origin = vec3{ordered_to_float(sizes.region.lo[0]), ordered_to_float(sizes.region.lo[1]),
-                                 ordered_to_float(sizes.region.lo[2])};
-            const float lo[3] = {params.origin.x, params.origin.y, params.origin.z};
-            float scale[3];
+            // c0 must be a normal float; bins 254 and 255 (2^127 and up, or infinite) have no float end.
+            grid.base_octave = std::clamp<std::uint32_t>(median, 1, 253);
+            grid.params.cell_size0 = float_octave_end(grid.base_octave - 1);
+            grid.params.inv_cell_size0 = 1.0f / grid.params.cell_size0;
+            grid.params.layer_count =
+                static_cast<int>(std::min<std::uint32_t>(largest - std::min(largest, grid.base_octave) + 1, max_grid_layers));
+            for (std::uint32_t e = 0; e < float_octaves; ++e)
+                if (present(e)) layer_mask |= 1u << locate_layer_of_octave(grid, e);
             for (int a = 0; a < 3; ++a) {
-                const float extent = ordered_to_float(sizes.region.hi[a]) - lo[a];
-                scale[a] = extent > 0.0f && extent < std::numeric_limits<float>::infinity() ? 1024.0f / extent : 0.0f;
+                const float lo = ordered_to_float(sizes.region.lo[a]), hi = ordered_to_float(sizes.region.hi[a]);
+                (&region.lo.x)[a] = within > 0.0 ? grown_down(lo, within) : lo;
+                (&region.hi.x)[a] = within > 0.0 ? grown_up(hi, within) : hi;
             }
-            order_lo_ = params.origin;
-            order_scale_ = vec3{scale[0], scale[1], scale[2]};
+            grid.params.origin = region.lo;
         }
-        if (keys_.size() < std::size_t{4} * count) keys_.resize_discard(std::size_t{4} * count);
-        for (;;) {
-            const KeyAppender out{keys_.data(), keys_.size(), &c->entries, nullptr};
-            exec.for_each(count, PopulateKernel<LocateCells>{LocateCells{boxes_.data(), params, hash, slot_bits, out, big_.data(), c}});
-            const LocateCounters inserted = read_counters(exec);
-            if (inserted.entries <= keys_.size()) {
-                entries_ = inserted.entries;
-                big_count_ = inserted.big_count;
-                layer_mask_ = inserted.layer_mask;
+        // Hashed: at least a slot per point on each layer; a slot's number (up to 32 layers' slots) in 31 bits.
+        grid.slot_bits = 10;
+        while ((std::uint64_t{1} << grid.slot_bits) < n && grid.slot_bits < 26) ++grid.slot_bits;
+        std::uint32_t layers = 0;
+        for (int layer = 0; layer < grid.params.layer_count; ++layer) layers += (layer_mask >> layer) & 1u;
+        // Dense where its table is not much larger than a hashed one (a slot per point and per tet),
+        // with cells along x a quarter of c_l where those fit: a tet's rows then scan little beyond
+        // its box, at no cost per cell.
+        const std::uint64_t dense_room =
+            std::min<std::uint64_t>(std::max<std::uint64_t>(std::uint64_t{layers} << grid.slot_bits, count) * 4, 0x7fffffffull);
+        for (const int refine : {2, 0}) {
+            grid.refine[0] = refine;
+            std::uint64_t dense_slots = 0;
+            for (int layer = 0; layer < grid.params.layer_count && dense_slots <= dense_room; ++layer) {
+                if (!((layer_mask >> layer) & 1u)) continue;
+                grid.layer_slots[layer] = static_cast<std::uint32_t>(dense_slots);
+                std::uint64_t cells = 1;
+                for (int a = 0; a < 3 && cells <= dense_room; ++a) {
+                    const std::uint32_t along = locate_cell(grid, (&region.hi.x)[a], a, layer) + 1;
+                    if (a < 2) grid.cells[layer][a] = along;
+                    cells *= along; // each factor at most 2^30 + 1, the product so far within the room
+                }
+                dense_slots += cells;
+            }
+            grid.dense = dense_slots <= dense_room;
+            if (grid.dense) {
+                dense_total_ = dense_slots;
                 break;
             }
-            grow_or_refuse(keys_, inserted.entries, "grid entries");
-            LocateCounters again = inserted;
-            again.entries = again.big_count = again.layer_mask = 0;
-            exec.upload(c, &again, 1);
         }
-        if (entries_ >= 0xffffffffull) throw Error("locate: too many grid entries for 32-bit offsets");
-        exec.sort(keys_.data(), keys_.size(), &c->entries, 32 + static_cast<int>(slot_bits),
-                  high_word_key_bits(std::max<std::uint32_t>(count, 1)) - 32);
-        const std::size_t slots = std::size_t{1} << slot_bits;
-        slot_begin_.resize_discard(slots);
-        slot_end_.resize_discard(slots);
-        fill(exec, slot_begin_, 0u);
-        fill(exec, slot_end_, 0u);
-        exec.for_each(entries_, LocateSlotRunsKernel{keys_.data(), entries_, slot_begin_.data(), slot_end_.data()});
-        entry_boxes_.resize_discard(std::max<std::uint64_t>(entries_, 1));
-        exec.for_each(entries_, LocateEntryBoxesKernel{keys_.data(), boxes_.data(), entry_boxes_.data()});
-        return LocateGridView{scene.positions, scene.tets, scene.user_id, request.first_tet, boxes_.data(), orientation_.data(), keys_.data(),
-                              entry_boxes_.data(), entries_, slot_begin_.data(), slot_end_.data(), big_.data(), big_count_, params, hash,
-                              slot_bits, layer_mask_};
-    }
+        if (!grid.dense) {
+            grid.refine[0] = 0;
+            std::uint32_t rank = 0;
+            for (int layer = 0; layer < grid.params.layer_count; ++layer)
+                if ((layer_mask >> layer) & 1u) grid.layer_slots[layer] = rank++ << grid.slot_bits;
+        }
+        const std::uint64_t slots = grid.dense ? dense_total_ : std::uint64_t{layers} << grid.slot_bits;
 
-    /// Grows a key buffer for a rerun; a need the memory cannot hold is a one-line error naming it.
-    static void grow_or_refuse(buffer<std::uint64_t>& keys, std::uint64_t wanted, const char* what) {
-        if (!grow_for_rerun(keys, wanted, std::numeric_limits<std::size_t>::max()))
-            throw Error("locate: out of memory: " + std::to_string(wanted) + " " + what + " take " +
-                        bytes_text(wanted * sizeof(std::uint64_t)));
-    }
-
-    /// The order the queries run in: the points sorted along a Morton curve (LocatePointOrderKernel),
-    /// and their coordinates in that order.
-    void order_points(Exec& exec, std::size_t n) {
-        order_.resize_discard(std::max<std::size_t>(n, 1));
-        exec.for_each(n, LocatePointOrderKernel{points_.data(), order_lo_, order_scale_, order_.data()});
-        exec.sort(order_.data(), n, &counters_.data()->points, 62,
+        const std::uint64_t keys = std::uint64_t{n} * layers;
+        if (keys >= 0xffffffffull) throw Error("locate: too many grid entries for 32-bit offsets");
+        point_keys_.resize_discard(std::max<std::uint64_t>(keys, 1));
+        exec.for_each(n, LocatePointKeysKernel{points_in_, grid, region, layer_mask, layers, slots << 32, point_keys_.data()});
+        const unsigned long long sorted = keys;
+        exec.upload(&c->point_keys, &sorted, 1);
+        exec.sort(point_keys_.data(), point_keys_.size(), &c->point_keys, high_word_key_bits(slots + 1),
                   high_word_key_bits(std::max<std::uint64_t>(n, 1)) - 32);
-        sorted_points_.resize_discard(n);
-        exec.for_each(n, LocateSortedPointsKernel{points_.data(), order_.data(), sorted_points_.data()});
+        slot_start_.resize_discard(slots + 1);
+        if (keys == 0) fill(exec, slot_start_, 0u);
+        exec.for_each(keys, KeyRunStartsKernel<std::uint32_t>{point_keys_.data(), keys, static_cast<std::uint32_t>(slots), slot_start_.data()});
+        sorted_points_.resize_discard(std::max<std::uint64_t>(keys, 1));
+        exec.for_each(keys, LocateSortedPointsKernel{point_keys_.data(), static_cast<std::uint32_t>(slots), points_in_, sorted_points_.data()});
+        return LocatePointsView{grid, slot_start_.data(), point_keys_.data(), sorted_points_.data(), points_in_, static_cast<std::uint32_t>(n)};
     }
 
-    /// The hits' keys, sorted: the tets that hold each point, then, for `within`, the nearest tet of
+    /// Grows a buffer for a rerun; a need the memory cannot hold is a one-line error naming it.
+    template <class T>
+    static void grow_or_refuse(buffer<T>& b, std::uint64_t wanted, const char* what) {
+        if (!grow_for_rerun(b, wanted, std::numeric_limits<std::size_t>::max()))
+            throw Error("locate: out of memory: " + std::to_string(wanted) + " " + what + " take " + bytes_text(wanted * sizeof(T)));
+    }
+    /// Room for `wanted` hits, keeping the first `kept`.
+    void reserve_hits(Exec& exec, std::uint64_t wanted, std::uint64_t kept) {
+        if (hit_keys_.size() >= wanted) return;
+        if (kept == 0) {
+            grow_or_refuse(hit_keys_, wanted, "hits");
+            grow_or_refuse(hits_, wanted, "hits");
+            return;
+        }
+        grow_or_refuse(hit_keys_grown_, wanted, "hits");
+        grow_or_refuse(hits_grown_, wanted, "hits");
+        exec.copy(hit_keys_grown_.data(), hit_keys_.data(), kept);
+        exec.copy(hits_grown_.data(), hits_.data(), kept);
+        hit_keys_.swap(hit_keys_grown_);
+        hits_.swap(hits_grown_);
+    }
+    HitAppender hit_appender() {
+        return HitAppender{hit_keys_.data(), hits_.data(), std::min(hit_keys_.size(), hits_.size()), &counters_.data()->hits};
+    }
+
+    /// The hits, sorted by point: the tets that hold each point, then, for `within`, the nearest tet of
     /// each point that none holds.
-    void find_hits(Exec& exec, const LocateGridView& grid, double within, std::size_t n, std::uint32_t total_tets) {
-        LocateCounters* c = counters_.data();
-        if (hits_.size() < n + 1024) hits_.resize_discard(n + 1024);
+    void find_hits(Exec& exec, const LocateTetsView& tets, const LocatePointsView& points, const LocateRequest& request) {
+        const std::size_t n = point_count_;
+        const double within = request.options.within;
+        unsigned long long* hits = &counters_.data()->hits;
+        if (within > 0.0) {
+            held_.resize_discard(n);
+            fill(exec, held_, 0u);
+        }
+        reserve_hits(exec, n + 1024, 0);
         for (;;) {
-            const KeyAppender out{hits_.data(), hits_.size(), &c->hits, nullptr};
-            exec.for_each(n, LocateContainingKernel{grid, sorted_points_.data(), order_.data(), out, held_.data()});
-            const LocateCounters found = read_counters(exec);
-            hit_count_ = found.hits;
-            if (found.hits <= hits_.size()) break;
-            grow_or_refuse(hits_, found.hits, "hits");
-            LocateCounters again = found;
-            again.hits = 0;
-            exec.upload(c, &again, 1);
+            exec.for_each(request.tet_count, LocateContainingKernel{tets, points, hit_appender(), within > 0.0 ? held_.data() : nullptr});
+            exec.download(&hit_count_, hits, 1);
+            if (hit_count_ <= hit_keys_.size()) break;
+            reserve_hits(exec, hit_count_, 0);
+            const unsigned long long none = 0;
+            exec.upload(hits, &none, 1);
         }
         if (within > 0.0) {
-            // At most one hit more per point: room for all of them, keeping the hits found.
-            if (hits_.size() < hit_count_ + n) {
-                hits_grown_.resize_discard(rerun_capacity(hits_.size(), hit_count_ + n));
-                exec.copy(hits_grown_.data(), hits_.data(), hit_count_);
-                hits_.swap(hits_grown_);
-            }
-            const KeyAppender out{hits_.data(), hits_.size(), &c->hits, nullptr};
-            exec.for_each(n, LocateNearestKernel{grid, sorted_points_.data(), order_.data(), held_.data(), within, out});
-            hit_count_ = read_counters(exec).hits;
+            best_distance_.resize_discard(n);
+            best_tet_.resize_discard(n);
+            fill(exec, best_distance_, ~std::uint64_t{0});
+            fill(exec, best_tet_, 0xffffffffu);
+            for (std::uint32_t* ties : {static_cast<std::uint32_t*>(nullptr), best_tet_.data()})
+                exec.for_each(request.tet_count,
+                              LocateNearestKernel{tets, points, within, held_.data(), best_distance_.data(), ties});
+            // At most one hit more per point.
+            reserve_hits(exec, hit_count_ + n, hit_count_);
+            nearest_closest_.resize_discard(3 * n);
+            nearest_distance_.resize_discard(n);
+            exec.for_each(n, LocateNearestHitsKernel{tets, points_in_, best_tet_.data(), hit_appender(), nearest_closest_.data(),
+                                                     nearest_distance_.data()});
+            exec.download(&hit_count_, hits, 1);
         }
-        const auto points = static_cast<std::uint32_t>(n);
-        exec.sort(hits_.data(), hits_.size(), &c->hits, high_word_key_bits(std::max<std::uint32_t>(points, 1)),
-                  high_word_key_bits(std::max<std::uint32_t>(total_tets, 1)) - 32);
+        if (hit_count_ >= 0xffffffffull) throw Error("locate: too many hits (" + std::to_string(hit_count_) + ") for 32-bit indices");
+        exec.sort(hit_keys_.data(), hit_keys_.size(), hits, high_word_key_bits(std::max<std::uint64_t>(n, 1)),
+                  high_word_key_bits(std::max<std::uint64_t>(hit_count_, 1)) - 32);
     }
 
-    /// Each hit's object, tet, barycentric coordinates, closest point and distance; each point's offset.
-    void describe(Exec& exec, const LocateScene& scene, std::uint32_t n) {
+    /// Where the results are described: the backend's buffers, or the caller's arrays.
+    struct Outputs {
+        std::uint64_t* offsets;
+        std::uint32_t* objects;
+        std::uint32_t* tets;
+        double* barycentrics;
+        double* closest_points;
+        double* distances;
+    };
+    Outputs own_outputs() {
         const std::size_t hits = std::max<std::size_t>(hit_count_, 1);
         objects_.resize_discard(hits);
         tets_.resize_discard(hits);
         barycentrics_.resize_discard(4 * hits);
         closest_points_.resize_discard(3 * hits);
         distances_.resize_discard(hits);
-        offsets_.resize_discard(std::size_t{n} + 1);
-        const LocateHitsView view{scene.positions, scene.tets, scene.stored_id, scene.tet_object, scene.object_tet_begin, points_.data()};
-        exec.for_each(hit_count_, LocateDescribeKernel{view, hits_.data(), objects_.data(), tets_.data(), barycentrics_.data(),
-                                                       closest_points_.data(), distances_.data()});
-        exec.for_each(std::uint64_t{n} + 1, LocateOffsetsKernel{hits_.data(), hit_count_, offsets_.data()});
+        offsets_.resize_discard(point_count_ + 1);
+        outputs_ = Outputs{offsets_.data(), objects_.data(), tets_.data(), barycentrics_.data(), closest_points_.data(), distances_.data()};
+        return outputs_;
+    }
+
+    /// Each hit's object, tet, barycentric coordinates, closest point and distance, in the points'
+    /// order; each point's offset.
+    void describe(Exec& exec, std::uint32_t n, bool nearest, const Outputs& out) {
+        exec.for_each(hit_count_, LocateDescribeKernel{hit_keys_.data(), hits_.data(), points_in_, nearest ? held_.data() : nullptr,
+                                                       nearest_closest_.data(), nearest_distance_.data(), out.objects, out.tets,
+                                                       out.barycentrics, out.closest_points, out.distances});
+        if (hit_count_ == 0) exec.for_each(std::uint64_t{n} + 1, FillKernel<std::uint64_t>{out.offsets, 0});
+        exec.for_each(hit_count_, KeyRunStartsKernel<std::uint64_t>{hit_keys_.data(), hit_count_, n, out.offsets});
+        exec.for_each(n, LocateHitOrderKernel{out.offsets, out.objects, out.tets, out.barycentrics, out.closest_points, out.distances});
     }
 
     buffer<vec3> points_;
-    buffer<vec3> sorted_points_; ///< per query
-    buffer<std::uint64_t> order_; ///< the points' keys in the order the queries run
-    buffer<std::uint8_t> held_;
-    buffer<Aabb> boxes_;
-    buffer<std::int8_t> orientation_;
-    buffer<Aabb> entry_boxes_;
-    buffer<std::uint64_t> keys_;
-    buffer<std::uint32_t> slot_begin_, slot_end_;
-    buffer<std::uint32_t> big_;
-    buffer<std::uint64_t> hits_, hits_grown_;
+    const vec3* points_in_ = nullptr; ///< the points the kernels read: points_, or the host's on a host backend
+    buffer<std::uint64_t> point_keys_;
+    buffer<std::uint32_t> slot_start_; ///< LocateSlotStartsKernel's
+    buffer<vec3> sorted_points_; ///< per sorted point key
+    buffer<std::uint32_t> held_;          ///< per point, for `within`
+    buffer<std::uint64_t> best_distance_; ///< per point, for `within`
+    buffer<std::uint32_t> best_tet_;      ///< per point, for `within`
+    buffer<double> nearest_closest_, nearest_distance_; ///< per point, for `within`
+    buffer<std::uint64_t> hit_keys_, hit_keys_grown_;
+    buffer<LocateHit> hits_, hits_grown_;
     buffer<std::uint64_t> offsets_;
     buffer<std::uint32_t> objects_, tets_;
     buffer<double> barycentrics_, closest_points_, distances_;
     buffer<LocateCounters> counters_;
-    std::uint64_t entries_ = 0, hit_count_ = 0;
+    unsigned long long hit_count_ = 0;
     std::size_t point_count_ = 0;
-    std::uint32_t big_count_ = 0, layer_mask_ = 0;
-    vec3 order_lo_{}, order_scale_{}; ///< LocatePointOrderKernel's grid
+    std::uint64_t dense_total_ = 0;
+    Outputs outputs_{}; ///< what device_results() hands out
 };
 
 } // namespace kdet

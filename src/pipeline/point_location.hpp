@@ -1,275 +1,53 @@
 #pragma once
 /// @file point_location.hpp
-/// @brief Point location's kernels (Locator, locate_driver.hpp, drives them): a hashed grid of the
-/// located tets, then per point the tets that hold it and, for `within`, the nearest one, then the
-/// hits described (barycentric coordinates, closest points, distances) and indexed per point.
+/// @brief Point location's kernels (Locator, locate_driver.hpp, drives them): the query points in a
+/// hashed grid, then per located tet the points in its box tested exactly and the hits described
+/// there, then, for `within`, the nearest tet of each point that none holds, then the hits sorted by
+/// point and indexed.
 ///
-/// The grid is the hierarchical one of the collision pipeline (grid_math.hpp: layer l has cell size
-/// c0 * 2^l, a tet goes to the layer whose cells its box's extent fits, so it spans at most two cells
-/// per axis), filled by the pipeline's populate step (PopulateKernel) and stored for queries by points
-/// instead of tets: each (cell slot, tet) is one 64-bit key,
-/// sorted, and a table gives each slot's run of keys. A point visits one cell per occupied layer;
-/// a box (a point grown by `within`) the cells it overlaps. Cells whose hashes share a slot only add
-/// candidates: every candidate passes a box test and the exact test.
+/// The points are gridded, not the tets: each point is one key (slot << 32 | point) per layer that
+/// some tet uses, sorted, and a table gives each slot's run. A tet reads only the cells of its own
+/// layer that its box overlaps, so it meets each point in its box once, with its vertices loaded and
+/// its orientation computed once for all of them. Cell sizes are powers of two (layer l: c0 * 2^l),
+/// and a tet's layer depends only on the binary exponent of its box's extent: a tet whose extent lies
+/// in [c_l, 2 c_l) goes to layer l and spans at most three cells per axis there. Cells whose hashes
+/// share a slot only add candidates: a point is taken from a cell only if it lies in the tet's box
+/// and that is its own cell on the layer (each layer has slots of its own).
 
 #include "exec/atomic.hpp"
 #include "geometry/point_tet.hpp"
 #include "grid/grid_math.hpp"
 #include "pipeline/bounding_boxes.hpp"
-#include "pipeline/grid_populate.hpp"
 #include "pipeline/pair_keys.hpp"
-#include "pipeline/scene_view.hpp"
 
 #include <kdet/options.hpp>
 
 #include <cstdint>
+#include <cstring>
 
 namespace kdet {
 
 /// @brief What point location's kernels count and find, in the backend's memory; read by the host
 /// between the steps.
 struct LocateCounters {
-    alignas(64) unsigned long long entries; ///< grid keys appended (counts past the buffer's end)
-    alignas(64) unsigned long long hits;    ///< hit keys appended (counts past the buffer's end)
-    alignas(64) std::uint32_t big_count;    ///< tets too large for the top layer's cells
-    unsigned long long points;              ///< the query points (the count the sort of their order reads)
-    std::uint32_t layer_mask;
+    alignas(64) unsigned long long hits; ///< hits appended (counts past the buffer's end)
+    unsigned long long point_keys;      ///< the points' grid keys (the count their sort reads)
     std::uint32_t first_non_finite_point;
-    OrderedBox region; ///< the located tets' boxes
-    std::uint32_t octaves[float_octaves]; ///< histogram of the tets' box extents (float_octave)
+    OrderedBox region;                       ///< the located tets' boxes
+    std::uint32_t sampled[float_octaves];    ///< histogram of every eighth tet's box extent (float_octave)
+    std::uint32_t present[float_octaves / 32]; ///< bit e: some tet's extent, or grown extent, is in bin e
 };
 
 /// @brief The largest side of a box (infinite where the sides overflow float: such a tet goes to the
-/// top layer and, spanning too many cells there, to the list every query scans).
+/// top layer).
 KDET_HD inline float box_extent(const Aabb& b) {
     return max_f(b.hi.x - b.lo.x, max_f(b.hi.y - b.lo.y, b.hi.z - b.lo.z));
 }
 
-/// @brief Per located tet (stored tets first .. first + count): its box and orientation (each query
-/// that tests the tet reads it instead of computing it), the histogram of extents and the region.
-struct LocateTetBoxesKernel {
-    const vec3* positions;
-    const TetIndices* tets;
-    std::uint32_t first;
-    Aabb* boxes; ///< per located tet
-    std::int8_t* orientation; ///< per located tet: point_query::orient3d_sign of its vertices
-    LocateCounters* counters;
-    KDET_HD void operator()(std::uint64_t i) const {
-        vec3 v[4];
-        for (int k = 0; k < 4; ++k) v[k] = positions[tets[first + i].v[k]];
-        const Aabb box = tet_box(v);
-        boxes[i] = box;
-        orientation[i] = static_cast<std::int8_t>(point_query::orient3d_sign(v[0], v[1], v[2], v[3]));
-        atomic_fetch_add_gathered(&counters->octaves[float_octave(box_extent(box))], 1u);
-        const float lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
-        for (int a = 0; a < 3; ++a) {
-            atomic_lower_to(&counters->region.lo[a], float_to_ordered(lo[a]));
-            atomic_raise_to(&counters->region.hi[a], float_to_ordered(hi[a]));
-        }
-    }
-};
-
-/// @brief Bits of a located tet's index in a grid key's low word.
-constexpr std::uint64_t locate_key_low = 0xffffffffull;
-
-/// @brief The table slot of a cell.
-KDET_HD inline std::uint32_t locate_slot(HashFunction hash, std::uint32_t x, std::uint32_t y, std::uint32_t z, int layer,
-                                         std::uint32_t slot_bits) {
-    return table_slot(hash_cell(hash, make_cell(x, y, z, layer), 0u), slot_bits);
+KDET_HD inline bool box_holds(const Aabb& b, vec3 p) {
+    // One branch for the six comparisons: most points a tet scans are outside its box.
+    return (p.x >= b.lo.x) & (p.x <= b.hi.x) & (p.y >= b.lo.y) & (p.y <= b.hi.y) & (p.z >= b.lo.z) & (p.z <= b.hi.z);
 }
-
-/// @brief What point location's grid stores (run by the populate step, PopulateKernel): per located
-/// tet, on the layer its box's extent picks, a key (slot << 32 | tet) per cell its box overlaps, or,
-/// when it spans more than two cells along an axis there (larger than the top layer's cells), its
-/// index in the list that every query scans.
-struct LocateCells {
-    const Aabb* boxes;
-    GridParams grid;
-    HashFunction hash;
-    std::uint32_t slot_bits;
-    KeyAppender out;
-    std::uint32_t* big; ///< [located tets]
-    LocateCounters* counters;
-
-    struct Tet {
-        std::uint64_t keys[8];
-        std::uint32_t count;
-        std::uint32_t id;
-        int layer;
-    };
-    KDET_HD const GridParams& params() const { return grid; }
-    KDET_HD bool place(std::uint64_t i, Aabb& box, int& layer) const {
-        box = boxes[i];
-        layer = layer_of(grid, box_extent(box));
-        return true;
-    }
-    KDET_HD bool open(std::uint64_t i, const CellRange& r, int layer, Tet& tet) const {
-        if (r.hi[0] - r.lo[0] > 1u || r.hi[1] - r.lo[1] > 1u || r.hi[2] - r.lo[2] > 1u) {
-            big[atomic_fetch_add(&counters->big_count, 1u)] = static_cast<std::uint32_t>(i);
-            return false;
-        }
-        const std::uint32_t bit = 1u << layer;
-        if (!(atomic_load_acquire(&counters->layer_mask) & bit)) atomic_fetch_or(&counters->layer_mask, bit);
-        tet.count = 0;
-        tet.id = static_cast<std::uint32_t>(i);
-        tet.layer = layer;
-        return true;
-    }
-    KDET_HD bool add(Tet& tet, std::uint32_t x, std::uint32_t y, std::uint32_t z) const {
-        // Two of a tet's cells that share a slot keep one key: a query scans each slot's keys once.
-        const std::uint64_t key = static_cast<std::uint64_t>(locate_slot(hash, x, y, z, tet.layer, slot_bits)) << 32 | tet.id;
-        for (std::uint32_t k = 0; k < tet.count; ++k)
-            if (tet.keys[k] == key) return true;
-        tet.keys[tet.count++] = key;
-        return true;
-    }
-    KDET_HD void close(Tet& tet) const { out.write(tet.keys, tet.count); }
-};
-
-/// @brief After the keys are sorted: the run of keys of each slot, [begin, end) (both 0 for a slot
-/// that holds none: filled so beforehand).
-struct LocateSlotRunsKernel {
-    const std::uint64_t* keys;
-    std::uint64_t count;
-    std::uint32_t* begin;
-    std::uint32_t* end;
-    KDET_HD void operator()(std::uint64_t i) const {
-        const std::uint32_t slot = key_first(keys[i]);
-        if (i == 0 || key_first(keys[i - 1]) != slot) begin[slot] = static_cast<std::uint32_t>(i);
-        if (i + 1 == count || key_first(keys[i + 1]) != slot) end[slot] = static_cast<std::uint32_t>(i + 1);
-    }
-};
-
-/// @brief After the keys are sorted: each key's tet box beside it, so that a query scanning a slot's
-/// run reads the boxes one after the other instead of each at its tet.
-struct LocateEntryBoxesKernel {
-    const std::uint64_t* keys;
-    const Aabb* boxes;
-    Aabb* entry_boxes;
-    KDET_HD void operator()(std::uint64_t k) const { entry_boxes[k] = boxes[keys[k] & locate_key_low]; }
-};
-
-/// @brief The located tets and their grid, as the queries read them.
-struct LocateGridView {
-    const vec3* positions;
-    const TetIndices* tets;
-    const std::uint32_t* user_id; ///< stored tet -> the caller's global id
-    std::uint32_t first;          ///< stored id of located tet 0
-    const Aabb* boxes;
-    const std::int8_t* orientation; ///< per located tet
-    const std::uint64_t* keys;
-    const Aabb* entry_boxes; ///< the box of each key's tet
-    std::uint64_t key_count;
-    const std::uint32_t* begin;
-    const std::uint32_t* end;
-    const std::uint32_t* big;
-    std::uint32_t big_count;
-    GridParams params;
-    HashFunction hash;
-    std::uint32_t slot_bits;
-    std::uint32_t layer_mask;
-};
-
-/// @brief Calls visit(t) for located tets t whose box overlaps `box`: every such tet at least once; a
-/// point's box (a single cell per layer) visits each at most once, since a tet is visited only from
-/// its own layer's cell. A box spanning more cells on a layer than the table has slots scans every key
-/// instead.
-template <class Visit>
-KDET_HD inline void locate_candidates(const LocateGridView& g, const Aabb& box, Visit& visit) {
-    const std::uint64_t slots = std::uint64_t{1} << g.slot_bits;
-    const auto try_tet = [&](std::uint32_t t, const Aabb& b, int layer) {
-        if (boxes_overlap(b, box) && (layer < 0 || layer_of(g.params, box_extent(b)) == layer)) visit(t);
-    };
-    for (int layer = 0; layer < g.params.layer_count; ++layer) {
-        if (!((g.layer_mask >> layer) & 1u)) continue;
-        const CellRange r = cell_range(g.params, box, layer);
-        const std::uint64_t cells = std::uint64_t{r.hi[0] - r.lo[0] + 1} * (r.hi[1] - r.lo[1] + 1) * (r.hi[2] - r.lo[2] + 1);
-        if (cells > slots) {
-            for (std::uint64_t k = 0; k < g.key_count; ++k)
-                try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), g.entry_boxes[k], -1);
-            break;
-        }
-        for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-            const std::uint32_t slot = locate_slot(g.hash, x, y, z, layer, g.slot_bits);
-            for (std::uint32_t k = g.begin[slot], e = g.end[slot]; k < e; ++k)
-                try_tet(static_cast<std::uint32_t>(g.keys[k] & locate_key_low), g.entry_boxes[k], layer);
-            return true;
-        });
-    }
-    for (std::uint32_t k = 0; k < g.big_count; ++k) try_tet(g.big[k], g.boxes[g.big[k]], -1);
-}
-
-/// @brief A hit's key: the point in the high word, the tet's global id (the caller's) in the low one.
-KDET_HD inline std::uint64_t hit_key(std::uint64_t point, std::uint32_t user_tet) { return point << 32 | user_tet; }
-
-KDET_HD inline void load_located(const LocateGridView& g, std::uint32_t stored, vec3 v[4]) {
-    for (int k = 0; k < 4; ++k) v[k] = g.positions[g.tets[stored].v[k]];
-}
-
-/// @brief Per point: its key in the order the queries run, the Morton code of its place in a grid of
-/// 1024 cells per axis over the located tets' region (high word) and its index (low word): queries in
-/// that order read the cells their neighbours just read, where queries in the caller's order (at
-/// random, say) fetched each cell's keys and boxes from memory anew.
-struct LocatePointOrderKernel {
-    const vec3* points;
-    vec3 lo;
-    vec3 scale; ///< order cells per unit along each axis
-    std::uint64_t* keys;
-    KDET_HD static std::uint32_t cell(float x, float lo, float scale) {
-        const float v = (x - lo) * scale;
-        return v >= 0.0f ? static_cast<std::uint32_t>(v < 1023.0f ? v : 1023.0f) : 0u; // NaN: 0
-    }
-    KDET_HD void operator()(std::uint64_t i) const {
-        const vec3 p = points[i];
-        const std::uint32_t code = hash_detail::spread_bits_3(cell(p.x, lo.x, scale.x)) |
-                                   hash_detail::spread_bits_3(cell(p.y, lo.y, scale.y)) << 1 |
-                                   hash_detail::spread_bits_3(cell(p.z, lo.z, scale.z)) << 2;
-        keys[i] = static_cast<std::uint64_t>(code) << 32 | i;
-    }
-};
-
-/// @brief Per query (item): its point's coordinates, copied from the caller's order into the queries'
-/// (one pass whose reads overlap, where each query's read of its point waited on memory).
-struct LocateSortedPointsKernel {
-    const vec3* points;
-    const std::uint64_t* order; ///< LocatePointOrderKernel's keys, sorted
-    vec3* sorted;
-    KDET_HD void operator()(std::uint64_t item) const { sorted[item] = points[key_second(order[item])]; }
-};
-
-/// @brief Per query: a hit for every tet that holds its point (exactly), and whether it has one.
-struct LocateContainingKernel {
-    LocateGridView grid;
-    const vec3* points;         ///< per query (LocateSortedPointsKernel)
-    const std::uint64_t* order; ///< LocatePointOrderKernel's keys, sorted: item i queries point key_second(order[i])
-    KeyAppender out;
-    std::uint8_t* held; ///< per query
-    struct Visit {
-        const LocateGridView* grid;
-        vec3 p;
-        std::uint64_t point;
-        KeyBatch* batch;
-        std::uint32_t hits;
-        KDET_HD void operator()(std::uint32_t t) {
-            const std::uint32_t stored = grid->first + t;
-            vec3 v[4];
-            load_located(*grid, stored, v);
-            point_query::PointTetSigns signs;
-            if (!point_query::tet_holds_point(v, p, grid->orientation[t], signs)) return;
-            batch->push(hit_key(point, grid->user_id[stored]));
-            ++hits;
-        }
-    };
-    KDET_HD void operator()(std::uint64_t item) const {
-        const std::uint32_t i = key_second(order[item]);
-        const vec3 p = points[item];
-        KeyBatch batch(&out);
-        Visit visit{&grid, p, i, &batch, 0};
-        locate_candidates(grid, Aabb{p, p}, visit);
-        batch.flush();
-        held[item] = visit.hits > 0 ? 1 : 0;
-    }
-};
 
 /// @brief The float below (down) or above x - d or x + d in double: a box that holds every point
 /// within d of x.
@@ -285,59 +63,338 @@ KDET_HD inline float grown_up(float x, double d) {
     if (static_cast<double>(f) < target) f = next_float_up(f);
     return f;
 }
+KDET_HD inline Aabb grown_box(const Aabb& b, double d) {
+    return Aabb{{grown_down(b.lo.x, d), grown_down(b.lo.y, d), grown_down(b.lo.z, d)},
+                {grown_up(b.hi.x, d), grown_up(b.hi.y, d), grown_up(b.hi.z, d)}};
+}
 
-/// @brief Per point that no tet holds: a hit for the nearest tet at distance at most `within` (the
-/// smaller global id on a tie), if any.
-struct LocateNearestKernel {
-    LocateGridView grid;
-    const vec3* points;         ///< as LocateContainingKernel's
-    const std::uint64_t* order; ///< as LocateContainingKernel's
-    const std::uint8_t* held;   ///< per query
-    double within;
-    KeyAppender out;
-    struct Visit {
-        const LocateGridView* grid;
-        vec3 p;
-        double best_distance;
-        std::uint32_t best; ///< the caller's global id, or none
-        KDET_HD void operator()(std::uint32_t t) {
-            const std::uint32_t stored = grid->first + t;
-            vec3 v[4];
-            load_located(*grid, stored, v);
-            const double d = point_query::closest_on_tet_boundary(v, p).distance;
-            const std::uint32_t id = grid->user_id[stored];
-            if (d < best_distance || (d == best_distance && id < best)) {
-                best_distance = d;
-                best = id;
-            }
+/// @brief The points' grid: cells of layer l are c0 * 2^l with c0 = 2^(base_octave - 127), the lower
+/// end of float_octave bin base_octave (the median of the tets' extents). Each layer the tets use has
+/// slots of its own, from layer_slots[l] on: a slot holds one layer's points. Where the region's cells
+/// on those layers are few (`dense`), a cell's slot is its index in the region, x fastest, so that a
+/// tet's cells along x are neighbours in the table and their points in the sorted keys; otherwise
+/// the cell's hash picks one of 2^slot_bits.
+struct LocateGrid {
+    GridParams params;
+    std::uint32_t base_octave;
+    HashFunction hash;
+    std::uint32_t slot_bits;
+    bool dense;
+    int refine[3]; ///< cells along axis a are 2^refine[a] times thinner than c_l (a dense grid's rows along x)
+    std::uint32_t layer_slots[max_grid_layers];
+    std::uint32_t cells[max_grid_layers][2]; ///< dense: the region's cells along x and y per layer
+};
+
+/// @brief The layer of a box of extent `extent`: bin base_octave + l of float_octave goes to layer l
+/// (the bins below to layer 0, those above the top layer to it), so that the box spans at most three
+/// cells per axis but on the top layer. Only the extent's bits decide it: the host predicts from the
+/// histograms which layers the tets use.
+KDET_HD inline int locate_layer_of_octave(const LocateGrid& g, std::uint32_t octave) {
+    const int layer = octave > g.base_octave ? static_cast<int>(octave - g.base_octave) : 0;
+    return layer < g.params.layer_count ? layer : g.params.layer_count - 1;
+}
+KDET_HD inline int locate_layer(const LocateGrid& g, float extent) { return locate_layer_of_octave(g, float_octave(extent)); }
+
+/// @brief Cell index of coordinate x along axis a on `layer` (cell_index, monotone in x).
+KDET_HD inline std::uint32_t locate_cell(const LocateGrid& g, float x, int axis, int layer) {
+    const float origin = axis == 0 ? g.params.origin.x : axis == 1 ? g.params.origin.y : g.params.origin.z;
+    return cell_index(g.params, x, origin, layer - g.refine[axis]);
+}
+KDET_HD inline CellRange locate_cell_range(const LocateGrid& g, const Aabb& box, int layer) {
+    CellRange r;
+    r.lo[0] = locate_cell(g, box.lo.x, 0, layer);
+    r.lo[1] = locate_cell(g, box.lo.y, 1, layer);
+    r.lo[2] = locate_cell(g, box.lo.z, 2, layer);
+    r.hi[0] = locate_cell(g, box.hi.x, 0, layer);
+    r.hi[1] = locate_cell(g, box.hi.y, 1, layer);
+    r.hi[2] = locate_cell(g, box.hi.z, 2, layer);
+    return r;
+}
+
+/// @brief The table slot of a cell of a layer the tets use.
+KDET_HD inline std::uint32_t locate_slot(const LocateGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z, int layer) {
+    if (g.dense) return g.layer_slots[layer] + (z * g.cells[layer][1] + y) * g.cells[layer][0] + x;
+    return g.layer_slots[layer] + table_slot(hash_cell(g.hash, make_cell(x, y, z, layer), 0u), g.slot_bits);
+}
+
+/// @brief Per located tet (stored tets first .. first + count): the bins of its box's extent and of
+/// the box grown by `within` (which decide the layers that points are gridded on), the histogram of a
+/// sample of the extents (which only sizes the cells: a count per tet contended for a few bins'
+/// counters) and the region of the boxes.
+struct LocateTetBoxesKernel {
+    const vec3* positions;
+    const TetIndices* tets;
+    std::uint32_t first;
+    double within; ///< 0: no grown boxes
+    LocateCounters* counters;
+    KDET_HD void mark_present(std::uint32_t octave) const {
+        std::uint32_t* word = &counters->present[octave / 32];
+        const std::uint32_t bit = 1u << (octave % 32);
+        if (!(atomic_load_acquire(word) & bit)) atomic_fetch_or(word, bit);
+    }
+    KDET_HD void operator()(std::uint64_t i) const {
+        vec3 v[4];
+        for (int k = 0; k < 4; ++k) v[k] = positions[tets[first + i].v[k]];
+        const Aabb box = tet_box(v);
+        const std::uint32_t octave = float_octave(box_extent(box));
+        if (i % 8 == 0) atomic_fetch_add_gathered(&counters->sampled[octave], 1u);
+        mark_present(octave);
+        if (within > 0.0) mark_present(float_octave(box_extent(grown_box(box, within))));
+        const float lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
+        for (int a = 0; a < 3; ++a) {
+            atomic_lower_to(&counters->region.lo[a], float_to_ordered(lo[a]));
+            atomic_raise_to(&counters->region.hi[a], float_to_ordered(hi[a]));
         }
-    };
-    KDET_HD void operator()(std::uint64_t item) const {
-        if (held[item]) return;
-        const std::uint32_t i = key_second(order[item]);
-        const vec3 p = points[item];
-        const Aabb box{{grown_down(p.x, within), grown_down(p.y, within), grown_down(p.z, within)},
-                       {grown_up(p.x, within), grown_up(p.y, within), grown_up(p.z, within)}};
-        Visit visit{&grid, p, within, 0xffffffffu};
-        locate_candidates(grid, box, visit);
-        if (visit.best != 0xffffffffu) out.push(hit_key(i, visit.best));
     }
 };
 
-/// @brief The located scene as the description of hits reads it.
-struct LocateHitsView {
+/// @brief Per point: its keys, one per layer the tets use (slot << 32 | point, at point * layers +
+/// j), or, for a point outside the region that the tets' boxes (grown by `within`) cover, which no
+/// tet can hold or be near, `no_point_key` in each: sorted after every other key.
+struct LocatePointKeysKernel {
+    const vec3* points;
+    LocateGrid grid;
+    Aabb region;
+    std::uint32_t layer_mask;
+    std::uint32_t layers; ///< set bits of layer_mask
+    std::uint64_t no_point_key;
+    std::uint64_t* keys;
+    KDET_HD void operator()(std::uint64_t i) const {
+        const vec3 p = points[i];
+        std::uint64_t* out = keys + i * layers;
+        if (!box_holds(region, p)) {
+            for (std::uint32_t j = 0; j < layers; ++j) out[j] = no_point_key;
+            return;
+        }
+        std::uint32_t j = 0;
+        for (int layer = 0; layer < grid.params.layer_count; ++layer) {
+            if (!((layer_mask >> layer) & 1u)) continue;
+            const std::uint32_t x = locate_cell(grid, p.x, 0, layer), y = locate_cell(grid, p.y, 1, layer), z = locate_cell(grid, p.z, 2, layer);
+            out[j++] = static_cast<std::uint64_t>(locate_slot(grid, x, y, z, layer)) << 32 | i;
+        }
+    }
+};
+
+/// @brief For keys sorted by their high word: start[r] = the first key whose high word is >= r, for r
+/// up to `runs` (keys whose high word is `runs` or more end the last run). Each start is written by
+/// the one key that follows it; with no keys, nothing is (the caller fills them).
+template <class Index>
+struct KeyRunStartsKernel {
+    const std::uint64_t* keys;
+    std::uint64_t count;
+    std::uint32_t runs;
+    Index* start; ///< [runs + 1]
+    KDET_HD void operator()(std::uint64_t k) const {
+        const std::uint32_t run = key_first(keys[k]);
+        const std::uint32_t from = k == 0 ? 0u : key_first(keys[k - 1]) + 1u;
+        for (std::uint32_t r = from; r <= run && r <= runs; ++r) start[r] = static_cast<Index>(k);
+        if (k + 1 == count)
+            for (std::uint32_t r = run + 1; r <= runs; ++r) start[r] = static_cast<Index>(count);
+    }
+};
+
+/// @brief After the point keys are sorted: each key's point, so that a tet scanning a slot's run
+/// reads the coordinates one after the other (the keys of points outside the region, whose slot is
+/// one past the table's, have none).
+struct LocateSortedPointsKernel {
+    const std::uint64_t* keys;
+    std::uint32_t slots;
+    const vec3* points;
+    vec3* sorted;
+    KDET_HD void operator()(std::uint64_t k) const {
+        if (key_first(keys[k]) < slots) sorted[k] = points[key_second(keys[k])];
+    }
+};
+
+/// @brief The gridded points as the tets read them.
+struct LocatePointsView {
+    LocateGrid grid;
+    const std::uint32_t* start; ///< each slot's first entry (KeyRunStartsKernel), one past the table's last
+    const std::uint64_t* keys; ///< sorted: key k's point is key_second(keys[k])
+    const vec3* sorted;        ///< key k's point's coordinates
+    const vec3* points; ///< every point, in the caller's order
+    std::uint32_t point_count;
+};
+
+/// @brief Calls visit(i, p) once for each point i (at p) that `box` holds: from the cells of the box's
+/// layer that it overlaps (a dense grid's row of them at once), or, when those are more than there
+/// are points, from all points.
+template <class Visit>
+KDET_HD inline void for_each_point_in_box(const LocatePointsView& g, const Aabb& box, Visit&& visit) {
+    const int layer = locate_layer(g.grid, box_extent(box));
+    const CellRange r = locate_cell_range(g.grid, box, layer);
+    const std::uint64_t span[3] = {std::uint64_t{r.hi[0] - r.lo[0]} + 1, std::uint64_t{r.hi[1] - r.lo[1]} + 1,
+                                   std::uint64_t{r.hi[2] - r.lo[2]} + 1};
+    // Checked one axis at a time: the product of three spans of up to 2^30 cells overflows.
+    const bool few_cells = span[0] <= g.point_count && span[0] * span[1] <= g.point_count &&
+                           span[0] * span[1] * span[2] <= g.point_count;
+    if (!few_cells) {
+        for (std::uint32_t i = 0; i < g.point_count; ++i)
+            if (box_holds(box, g.points[i])) visit(i, g.points[i]);
+        return;
+    }
+    if (g.grid.dense) {
+        const std::uint32_t nx = g.grid.cells[layer][0], ny = g.grid.cells[layer][1];
+        for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+            for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
+                const std::uint32_t row = g.grid.layer_slots[layer] + (z * ny + y) * nx;
+                const std::uint32_t end = g.start[row + r.hi[0] + 1];
+                for (std::uint32_t k = g.start[row + r.lo[0]]; k < end; ++k) {
+                    const vec3 p = g.sorted[k];
+                    if (box_holds(box, p)) visit(key_second(g.keys[k]), p);
+                }
+            }
+        return;
+    }
+    for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+        const std::uint32_t slot = locate_slot(g.grid, x, y, z, layer);
+        for (std::uint32_t k = g.start[slot], end = g.start[slot + 1]; k < end; ++k) {
+            const vec3 p = g.sorted[k];
+            if (!box_holds(box, p)) continue;
+            // Its own cell, not one whose hash shares the slot.
+            if (locate_cell(g.grid, p.x, 0, layer) != x || locate_cell(g.grid, p.y, 1, layer) != y || locate_cell(g.grid, p.z, 2, layer) != z)
+                continue;
+            visit(key_second(g.keys[k]), p);
+        }
+        return true;
+    });
+}
+
+/// @brief The located tets as the kernels read them.
+struct LocateTetsView {
     const vec3* positions;
     const TetIndices* tets;
+    std::uint32_t first;                   ///< stored id of located tet 0
+    const std::uint32_t* user_id;          ///< stored tet -> the caller's global id
     const std::uint32_t* stored_id;        ///< the caller's global id -> stored tet
     const std::uint32_t* tet_object;       ///< per stored tet
     const std::uint32_t* object_tet_begin; ///< the caller's global id of each object's first tet
-    const vec3* points;
 };
 
-/// @brief Per sorted hit: its object, tet, barycentric coordinates, closest point and distance.
+KDET_HD inline void load_stored_tet(const LocateTetsView& s, std::uint32_t stored, vec3 v[4]) {
+    for (int k = 0; k < 4; ++k) v[k] = s.positions[s.tets[stored].v[k]];
+}
+
+/// @brief One (point, tet) answer as a kernel finds it: the tet's object and index there, and the
+/// barycentric coordinates of the point (or, for a nearest tet, of its closest point). The closest
+/// point is the point itself for a tet that holds it, and a nearest tet's is kept per point.
+struct LocateHit {
+    std::uint32_t object;
+    std::uint32_t tet;
+    double barycentric[4];
+};
+
+KDET_HD inline LocateHit make_hit(const LocateTetsView& s, std::uint32_t stored, const point_query::PointInTet& where) {
+    LocateHit h;
+    h.object = s.tet_object[stored];
+    h.tet = s.user_id[stored] - s.object_tet_begin[h.object];
+    for (int k = 0; k < 4; ++k) h.barycentric[k] = where.barycentric[k];
+    return h;
+}
+
+/// @brief Appends hits: hit s goes to hits[s] with the key (point << 32 | s) that sorts it by point.
+/// Past the capacity only the count goes on, and the step runs again with room for all.
+struct HitAppender {
+    std::uint64_t* keys;
+    LocateHit* hits;
+    std::uint64_t capacity;
+    unsigned long long* count;
+    KDET_HD void push(std::uint32_t point, const LocateHit& hit) const {
+        const unsigned long long s = atomic_fetch_add_gathered(count, 1ull);
+        if (s >= capacity) return;
+        keys[s] = static_cast<std::uint64_t>(point) << 32 | s;
+        hits[s] = hit;
+    }
+};
+
+/// @brief Per located tet: a hit for every point it holds (exactly), described here, where its
+/// vertices and the point's signs are at hand; with `held`, marks those points.
+struct LocateContainingKernel {
+    LocateTetsView scene;
+    LocatePointsView points;
+    HitAppender out;
+    std::uint32_t* held; ///< per point, or null
+    KDET_HD void operator()(std::uint64_t t) const {
+        const std::uint32_t stored = scene.first + static_cast<std::uint32_t>(t);
+        vec3 v[4];
+        load_stored_tet(scene, stored, v);
+        const int orientation = point_query::orient3d_sign(v[0], v[1], v[2], v[3]);
+        const point_query::TetFaces faces(v);
+        for_each_point_in_box(points, tet_box(v), [&](std::uint32_t i, vec3 p) {
+            point_query::PointTetSigns signs;
+            if (!point_query::tet_holds_point(faces, v, p, orientation, signs)) return;
+            out.push(i, make_hit(scene, stored, point_query::locate_in_tet(v, p, true, signs)));
+            if (held) atomic_store_relaxed(&held[i], 1u);
+        });
+    }
+};
+
+/// @brief The bits of a distance (not negative): ordered as the distances are.
+KDET_HD inline std::uint64_t distance_bits(double d) {
+    std::uint64_t bits;
+    memcpy(&bits, &d, sizeof bits);
+    return bits;
+}
+
+/// @brief Per located tet, for `within`, in two passes: the first lowers best_distance[i] of every
+/// point i that no tet holds to the tet's distance when it is at most `within`; the second (with
+/// best_tet) lowers best_tet[i] to the caller's global id of each tet at that least distance (the
+/// smaller id wins a tie).
+struct LocateNearestKernel {
+    LocateTetsView scene;
+    LocatePointsView points;
+    double within;
+    const std::uint32_t* held;
+    std::uint64_t* best_distance; ///< per point: distance_bits, all ones for none
+    std::uint32_t* best_tet;      ///< per point; null in the first pass
+    KDET_HD void operator()(std::uint64_t t) const {
+        const std::uint32_t stored = scene.first + static_cast<std::uint32_t>(t);
+        vec3 v[4];
+        load_stored_tet(scene, stored, v);
+        for_each_point_in_box(points, grown_box(tet_box(v), within), [&](std::uint32_t i, vec3 p) {
+            if (held[i]) return;
+            const double d = point_query::closest_on_tet_boundary(v, p).distance;
+            if (!(d <= within)) return;
+            if (!best_tet)
+                atomic_lower_to(&best_distance[i], distance_bits(d));
+            else if (distance_bits(d) == best_distance[i])
+                atomic_min(&best_tet[i], scene.user_id[stored]);
+        });
+    }
+};
+
+/// @brief Per point with a nearest tet (LocateNearestKernel): its hit, and the tet's closest point
+/// and distance.
+struct LocateNearestHitsKernel {
+    LocateTetsView scene;
+    const vec3* points;
+    const std::uint32_t* best_tet;
+    HitAppender out;
+    double* closest;  ///< 3 per point
+    double* distance; ///< per point
+    KDET_HD void operator()(std::uint64_t i) const {
+        if (best_tet[i] == 0xffffffffu) return;
+        const std::uint32_t stored = scene.stored_id[best_tet[i]];
+        vec3 v[4];
+        load_stored_tet(scene, stored, v);
+        const point_query::PointInTet where = point_query::closest_on_tet_boundary(v, points[i]);
+        out.push(static_cast<std::uint32_t>(i), make_hit(scene, stored, where));
+        closest[3 * i] = where.closest.x;
+        closest[3 * i + 1] = where.closest.y;
+        closest[3 * i + 2] = where.closest.z;
+        distance[i] = where.distance;
+    }
+};
+
+/// @brief Per sorted hit: its description, from where the kernel that found it left it, into the
+/// result's arrays.
 struct LocateDescribeKernel {
-    LocateHitsView scene;
     const std::uint64_t* keys;
+    const LocateHit* hits;
+    const vec3* points;
+    const std::uint32_t* held;      ///< per point, or null: every hit's tet holds its point
+    const double* nearest_closest;  ///< LocateNearestHitsKernel's, for the points no tet holds
+    const double* nearest_distance;
     std::uint32_t* objects;
     std::uint32_t* tets;
     double* barycentrics;
@@ -345,39 +402,52 @@ struct LocateDescribeKernel {
     double* distances;
     KDET_HD void operator()(std::uint64_t h) const {
         const std::uint64_t key = keys[h];
-        const vec3 p = scene.points[key_first(key)];
-        const std::uint32_t user = key_second(key), stored = scene.stored_id[user];
-        vec3 v[4];
-        for (int k = 0; k < 4; ++k) v[k] = scene.positions[scene.tets[stored].v[k]];
-        point_query::PointTetSigns signs;
-        const bool holds = point_query::tet_holds_point(v, p, signs);
-        const point_query::PointInTet where = point_query::locate_in_tet(v, p, holds, signs);
-        const std::uint32_t object = scene.tet_object[stored];
-        objects[h] = object;
-        tets[h] = user - scene.object_tet_begin[object];
-        for (int k = 0; k < 4; ++k) barycentrics[4 * h + k] = where.barycentric[k];
-        closest_points[3 * h] = where.closest.x;
-        closest_points[3 * h + 1] = where.closest.y;
-        closest_points[3 * h + 2] = where.closest.z;
-        distances[h] = where.distance;
+        const std::uint32_t point = key_first(key);
+        const LocateHit& hit = hits[key_second(key)];
+        objects[h] = hit.object;
+        tets[h] = hit.tet;
+        for (int k = 0; k < 4; ++k) barycentrics[4 * h + k] = hit.barycentric[k];
+        if (!held || held[point]) {
+            const vec3 p = points[point];
+            closest_points[3 * h] = p.x;
+            closest_points[3 * h + 1] = p.y;
+            closest_points[3 * h + 2] = p.z;
+            distances[h] = 0.0;
+            return;
+        }
+        for (int k = 0; k < 3; ++k) closest_points[3 * h + k] = nearest_closest[3 * std::uint64_t{point} + k];
+        distances[h] = nearest_distance[point];
     }
 };
 
-/// @brief Per point p (and one past the last): offsets[p], the first sorted hit of a point >= p.
-struct LocateOffsetsKernel {
-    const std::uint64_t* keys;
-    std::uint64_t count;
-    std::uint64_t* offsets;
+/// @brief Per point: its hits (in the order they were found) sorted by object and tet; a point has
+/// few, so an insertion sort.
+struct LocateHitOrderKernel {
+    const std::uint64_t* offsets;
+    std::uint32_t* objects;
+    std::uint32_t* tets;
+    double* barycentrics;
+    double* closest_points;
+    double* distances;
+    KDET_HD bool before(std::uint64_t a, std::uint64_t b) const {
+        return objects[a] < objects[b] || (objects[a] == objects[b] && tets[a] < tets[b]);
+    }
+    KDET_HD void swap_hits(std::uint64_t a, std::uint64_t b) const {
+        const auto swap = [](auto& x, auto& y) {
+            const auto t = x;
+            x = y;
+            y = t;
+        };
+        swap(objects[a], objects[b]);
+        swap(tets[a], tets[b]);
+        for (int k = 0; k < 4; ++k) swap(barycentrics[4 * a + k], barycentrics[4 * b + k]);
+        for (int k = 0; k < 3; ++k) swap(closest_points[3 * a + k], closest_points[3 * b + k]);
+        swap(distances[a], distances[b]);
+    }
     KDET_HD void operator()(std::uint64_t p) const {
-        std::uint64_t lo = 0, hi = count;
-        while (lo < hi) {
-            const std::uint64_t mid = lo + (hi - lo) / 2;
-            if ((keys[mid] >> 32) < p)
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
-        offsets[p] = lo;
+        const std::uint64_t begin = offsets[p], end = offsets[p + 1];
+        for (std::uint64_t h = begin + 1; h < end; ++h)
+            for (std::uint64_t k = h; k > begin && before(k, k - 1); --k) swap_hits(k, k - 1);
     }
 };
 
