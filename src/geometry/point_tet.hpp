@@ -31,10 +31,10 @@ struct PointTetSigns {
 };
 
 /// @brief A tet's faces prepared for testing many points: the orientation with p in place of vertex k
-/// is, up to sign `flip[k]`, det(e1, e2, p - base[k]) for two edges e1, e2 of face k from its vertex
-/// base[k], so their double cross product and the rows' part of narrow::sign_det3's bound are computed
-/// once per tet. Per point it is then sign_det3's own computation: a dot product, decided where it
-/// exceeds its bound, else the exact sign.
+/// is sign[k] det(e1, e2, p - base[k]) for two edges e1, e2 of face k from its vertex base[k], so their
+/// double cross product and the rows' part of narrow::sign_det3's bound are computed once per tet. Per
+/// point it is then sign_det3's own computation: a dot product, decided where it exceeds its bound,
+/// else the exact sign.
 struct TetFaces {
     // Per face k, side by side so that the four are computed together.
     double base_x[4], base_y[4], base_z[4];
@@ -60,11 +60,17 @@ struct TetFaces {
             sign[k] = odd[k];
         }
     }
-    /// The orientation of v with vertex k replaced by p, in double, and its rounding bound.
-    KDET_HD void face_value(int k, vec3 p, double& value, double& error) const {
-        const double rx = double{p.x} - base_x[k], ry = double{p.y} - base_y[k], rz = double{p.z} - base_z[k];
-        value = sign[k] * (normal_x[k] * rx + normal_y[k] * ry + normal_z[k] * rz);
-        error = bound[k] * narrow::max_d(fabs(rx), narrow::max_d(fabs(ry), fabs(rz)));
+    /// Per face k, the orientation of v with vertex k replaced by p, in double, and its rounding
+    /// bound: plain loops over the faces, which a compiler runs two or four faces at a time.
+    KDET_HD void face_values(vec3 p, double value[4], double error[4]) const {
+        double rx[4], ry[4], rz[4];
+        for (int k = 0; k < 4; ++k) {
+            rx[k] = double{p.x} - base_x[k];
+            ry[k] = double{p.y} - base_y[k];
+            rz[k] = double{p.z} - base_z[k];
+        }
+        for (int k = 0; k < 4; ++k) value[k] = sign[k] * (normal_x[k] * rx[k] + normal_y[k] * ry[k] + normal_z[k] * rz[k]);
+        for (int k = 0; k < 4; ++k) error[k] = bound[k] * narrow::max_d(fabs(rx[k]), narrow::max_d(fabs(ry[k]), fabs(rz[k])));
     }
     /// The exact sign of that orientation: the double value where it exceeds its bound.
     KDET_HD static int decided_sign(const vec3 v[4], int k, vec3 p, double value, double error) {
@@ -74,10 +80,12 @@ struct TetFaces {
         replace_vertex(v, k, p, w);
         return orient3d_sign(w[0], w[1], w[2], w[3]);
     }
+    /// The exact sign for face k alone, and its double value.
     KDET_HD int face_sign(const vec3 v[4], int k, vec3 p, double& value) const {
-        double error;
-        face_value(k, p, value, error);
-        return decided_sign(v, k, p, value, error);
+        double values[4], errors[4];
+        face_values(p, values, errors);
+        value = values[k];
+        return decided_sign(v, k, p, values[k], errors[k]);
     }
 };
 
@@ -95,11 +103,9 @@ KDET_HD inline bool tet_holds_point(const TetFaces& faces, const vec3 v[4], vec3
         return narrow::exact_intersect(v, point, exact_stage);
     }
     double error[4];
+    faces.face_values(p, signs.det, error);
     bool opposite = false;
-    for (int k = 0; k < 4; ++k) {
-        faces.face_value(k, p, signs.det[k], error[k]);
-        opposite |= signs.tet * signs.det[k] < -error[k];
-    }
+    for (int k = 0; k < 4; ++k) opposite |= signs.tet * signs.det[k] < -error[k];
     if (opposite) return false;
     for (int k = 0; k < 4; ++k) {
         signs.face[k] = TetFaces::decided_sign(v, k, p, signs.det[k], error[k]);
