@@ -29,9 +29,9 @@ struct CpuTuning {
     static constexpr std::uint32_t search_layer_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
     static constexpr std::uint32_t search_block_parts(bool /*self_collision*/, std::size_t /*tets*/) { return 1; }
 
-    /// @brief Consecutive tets per work item of the grid's searches (the candidates', kdet_no_pairs'):
-    /// a thread appends their keys and adds their counts with one atomic per run, where an item per tet
-    /// passed the counters' cache line between the threads at every tet.
+    /// @brief Consecutive tets per work item of the grid's searches (the candidates', kdet_no_pairs',
+    /// point location's scans): a thread appends their keys and adds their counts with one atomic per
+    /// run, where an item per tet passed the counters' cache line between the threads at every tet.
     static constexpr std::uint32_t search_tets_per_item = 32;
 
     /// @brief The face-plane pre-test runs inside the candidate search, where the searching tet's

@@ -285,7 +285,10 @@ private:
         }
         reserve_hits(exec, n + 1024, 0);
         for (;;) {
-            exec.for_each(request.tet_count, LocateContainingKernel{tets, points, hit_appender(), within > 0.0 ? held_.data() : nullptr});
+            constexpr std::uint32_t run = Exec::tuning::search_tets_per_item;
+            exec.for_each(TetRuns<run>::count(request.tet_count),
+                          LocateContainingKernel<run>{tets, points, hit_appender(), within > 0.0 ? held_.data() : nullptr, request.tet_count},
+                          run);
             exec.download(&hit_count_, hits, 1);
             if (hit_count_ <= hit_keys_.size()) break;
             reserve_hits(exec, hit_count_, 0);

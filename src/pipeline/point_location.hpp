@@ -19,6 +19,7 @@
 #include "grid/grid_math.hpp"
 #include "pipeline/bounding_boxes.hpp"
 #include "pipeline/pair_keys.hpp"
+#include "pipeline/tet_runs.hpp"
 
 #include <kdet/options.hpp>
 
@@ -299,33 +300,63 @@ struct HitAppender {
     LocateHit* hits;
     std::uint64_t capacity;
     unsigned long long* count;
-    KDET_HD void push(std::uint32_t point, const LocateHit& hit) const {
-        const unsigned long long s = atomic_fetch_add_gathered(count, 1ull);
-        if (s >= capacity) return;
-        keys[s] = static_cast<std::uint64_t>(point) << 32 | s;
-        hits[s] = hit;
+    KDET_HD void write(const std::uint32_t* points, const LocateHit* found, std::uint32_t n) const {
+        const unsigned long long first = atomic_fetch_add_gathered(count, static_cast<unsigned long long>(n));
+        for (std::uint32_t k = 0; k < n && first + k < capacity; ++k) {
+            keys[first + k] = static_cast<std::uint64_t>(points[k]) << 32 | (first + k);
+            hits[first + k] = found[k];
+        }
+    }
+    KDET_HD void push(std::uint32_t point, const LocateHit& hit) const { write(&point, &hit, 1); }
+};
+
+/// @brief A work item's hits, appended Size at a time: one atomic per batch, where the threads of
+/// the CPU passed the counter's cache line between them at every hit.
+template <std::uint32_t Size>
+struct HitBatch {
+    const HitAppender* out;
+    std::uint32_t n = 0;
+    std::uint32_t points[Size];
+    LocateHit hits[Size];
+    KDET_HD explicit HitBatch(const HitAppender* appender) : out(appender) {}
+    KDET_HD void push(std::uint32_t point, const LocateHit& hit) {
+        points[n] = point;
+        hits[n] = hit;
+        if (++n == Size) flush();
+    }
+    KDET_HD void flush() {
+        if (n) out->write(points, hits, n);
+        n = 0;
     }
 };
 
-/// @brief Per located tet: a hit for every point it holds (exactly), described here, where its
-/// vertices and the point's signs are at hand; with `held`, marks those points.
+/// @brief Per run of located tets (TetRuns, Tuning::search_tets_per_item): a hit for every point a
+/// tet holds (exactly), described here, where its vertices and the point's signs are at hand, and
+/// appended with the run's others; with `held`, marks those points.
+template <std::uint32_t TetsPerItem>
 struct LocateContainingKernel {
     LocateTetsView scene;
     LocatePointsView points;
     HitAppender out;
     std::uint32_t* held; ///< per point, or null
-    KDET_HD void operator()(std::uint64_t t) const {
-        const std::uint32_t stored = scene.first + static_cast<std::uint32_t>(t);
-        vec3 v[4];
-        load_stored_tet(scene, stored, v);
-        const int orientation = point_query::orient3d_sign(v[0], v[1], v[2], v[3]);
-        const point_query::TetFaces faces(v);
-        for_each_point_in_box(points, tet_box(v), [&](std::uint32_t i, vec3 p) {
-            point_query::PointTetSigns signs;
-            if (!point_query::tet_holds_point(faces, v, p, orientation, signs)) return;
-            out.push(i, make_hit(scene, stored, point_query::locate_in_tet(v, p, true, signs)));
-            if (held) atomic_store_relaxed(&held[i], 1u);
+    std::uint32_t tet_count;
+    KDET_HD void operator()(std::uint64_t run) const {
+        HitBatch<TetsPerItem == 1 ? 1 : 8> batch(&out);
+        TetRuns<TetsPerItem>::for_each_tet(static_cast<std::uint32_t>(run), tet_count, [&](std::uint32_t t) {
+            const std::uint32_t stored = scene.first + t;
+            vec3 v[4];
+            load_stored_tet(scene, stored, v);
+            const int orientation = point_query::orient3d_sign(v[0], v[1], v[2], v[3]);
+            const point_query::TetFaces faces(v);
+            for_each_point_in_box(points, tet_box(v), [&](std::uint32_t i, vec3 p) {
+                point_query::PointTetSigns signs;
+                if (!point_query::tet_holds_point(faces, v, p, orientation, signs)) return;
+                batch.push(i, make_hit(scene, stored, point_query::locate_in_tet(v, p, true, signs)));
+                if (held) atomic_store_relaxed(&held[i], 1u);
+            });
+            return true;
         });
+        batch.flush();
     }
 };
 
