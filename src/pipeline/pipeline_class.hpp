@@ -29,6 +29,7 @@
 #include <kdet/options.hpp>
 #include <kdet/results.hpp>
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -49,10 +50,18 @@ public:
         : exec_(options), clock_(exec_.make_stage_clock()), options_(options) {}
 
     void set_topology(const SceneTopology& given) override {
-        topology_ = keeps_static_grid() ? static_last(given, frame_tets_) : given;
-        const SceneTopology& topology = topology_;
+        // The static objects' tets go last (a copy of the topology reordered); without any, the
+        // buffers are filled from the detector's own.
+        const bool reorder = keeps_static_grid() && std::any_of(given.object_static.begin(), given.object_static.end(),
+                                                                [](std::uint8_t s) { return s != 0; });
+        SceneTopology reordered;
+        if (reorder) reordered = static_last(given, frame_tets_);
+        const SceneTopology& topology = reorder ? reordered : given;
         const std::size_t tets = topology.tets.size();
-        if (!keeps_static_grid()) frame_tets_ = static_cast<std::uint32_t>(tets);
+        if (!reorder) frame_tets_ = static_cast<std::uint32_t>(tets);
+        topology_.object_tet_begin = topology.object_tet_begin;
+        topology_.object_static = topology.object_static;
+        topology_.vertex_count = topology.vertex_count;
         object_first_.assign(topology.object_tet_begin.size(), static_cast<std::uint32_t>(tets));
         for (std::uint32_t t = static_cast<std::uint32_t>(tets); t-- > 0;) object_first_[topology.tet_object[t]] = t;
         statics_.placed = statics_.search.active = false;
@@ -63,7 +72,9 @@ public:
         user_id_.resize_discard(tets);
         exec_.upload(user_id_.data(), topology.tet_user_id.data(), tets);
         std::vector<std::uint32_t> stored_id(tets);
-        for (std::uint32_t t = 0; t < tets; ++t) stored_id[topology.tet_user_id[t]] = t;
+        const auto count = static_cast<std::ptrdiff_t>(tets);
+#pragma omp parallel for num_threads(host_threads(options_.threads)) schedule(static) if (count > host_parallel_elements)
+        for (std::ptrdiff_t t = 0; t < count; ++t) stored_id[topology.tet_user_id[t]] = static_cast<std::uint32_t>(t);
         stored_id_.resize_discard(tets);
         exec_.upload(stored_id_.data(), stored_id.data(), tets);
         object_tet_begin_.resize_discard(topology.object_tet_begin.size());
@@ -272,7 +283,7 @@ protected:
     Exec exec_;
     typename Exec::stage_clock clock_; // kept between frames: on the GPU it holds CUDA events, created once
     DetectorOptions options_;
-    SceneTopology topology_;
+    SceneTopology topology_; ///< the per-object parts (the per-tet and per-vertex ones are in the buffers)
     std::vector<std::uint32_t> object_first_; ///< object_first_tets()
     std::uint32_t stamp_ = 0;
 
