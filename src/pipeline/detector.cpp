@@ -207,6 +207,7 @@ struct Detector::Impl {
         request.first_tet = object == all_objects ? 0 : pipeline->object_first_tets()[object];
         request.tet_count = object == all_objects ? begin.back() : begin[object + 1] - begin[object];
         request.options = how;
+        request.threads = host_threads();
         std::vector<vec3> converted;
         const bool packed_floats = !points.is_double && points.row_stride == 3 && points.column_stride == 1;
         if (!on_device) {

@@ -15,6 +15,7 @@
 #include <kdet/locate.hpp>
 
 #include <algorithm>
+#include <exception>
 #include <limits>
 #include <string>
 
@@ -27,6 +28,7 @@ struct LocateRequest {
     std::uint32_t first_tet = 0;   ///< stored tets [first_tet, first_tet + tet_count) are located
     std::uint32_t tet_count = 0;
     LocateOptions options;
+    int threads = 1; ///< the host's threads for its own steps
 };
 
 /// @brief The pipeline's buffers that point location reads.
@@ -69,12 +71,7 @@ public:
             result.tets.clear();
             return;
         }
-        result.offsets.resize(n + 1);
-        result.objects.resize(hit_count_);
-        result.tets.resize(hit_count_);
-        result.barycentrics.resize(4 * hit_count_);
-        result.closest_points.resize(3 * hit_count_);
-        result.distances.resize(hit_count_);
+        resize_result(result, request.threads);
         if constexpr (Exec::memory_is_host) {
             // Described where the caller reads them: no second copy of every hit.
             outputs_ = Outputs{result.offsets.data(),      result.objects.data(),        result.tets.data(),
@@ -314,6 +311,30 @@ private:
         if (hit_count_ >= 0xffffffffull) throw Error("locate: too many hits (" + std::to_string(hit_count_) + ") for 32-bit indices");
         exec.sort(hit_keys_.data(), hit_keys_.size(), hits, high_word_key_bits(std::max<std::uint64_t>(n, 1)),
                   high_word_key_bits(std::max<std::uint64_t>(hit_count_, 1)) - 32);
+    }
+
+    /// The result's arrays at the sizes of this call's hits. A vector's growth fills it with zeros,
+    /// the first touch of fresh memory for a large one: the arrays are grown on the host's threads.
+    void resize_result(LocateResult& result, int threads) const {
+        const std::size_t hits = hit_count_;
+        std::exception_ptr failed;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+        for (int a = 0; a < 6; ++a) {
+            try {
+                switch (a) {
+                case 0: result.barycentrics.resize(4 * hits); break;
+                case 1: result.closest_points.resize(3 * hits); break;
+                case 2: result.offsets.resize(point_count_ + 1); break;
+                case 3: result.distances.resize(hits); break;
+                case 4: result.objects.resize(hits); break;
+                default: result.tets.resize(hits); break;
+                }
+            } catch (...) {
+#pragma omp critical(kdet_locate_result)
+                failed = std::current_exception();
+            }
+        }
+        if (failed) std::rethrow_exception(failed);
     }
 
     /// Where the results are described: the backend's buffers, or the caller's arrays.

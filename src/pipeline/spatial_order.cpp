@@ -40,7 +40,8 @@ std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::u
     // codes keep their order as the whole key would order them (three passes of 11 bits instead of six).
     radix_sort(keys.data(), tet_count, 62, scratch.data(), threads, 32);
     std::vector<std::uint32_t> order(tet_count);
-    for (std::size_t i = 0; i < tet_count; ++i) order[i] = static_cast<std::uint32_t>(keys[i] & 0xffffffffu);
+#pragma omp parallel for num_threads(threads) schedule(static) if (n > host_parallel_elements)
+    for (std::ptrdiff_t i = 0; i < n; ++i) order[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(keys[static_cast<std::size_t>(i)] & 0xffffffffu);
     return order;
 }
 
