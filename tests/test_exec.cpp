@@ -100,6 +100,25 @@ TEST(RadixSort, SortsByTheBitsFromFirstBitOnAndKeepsTheOrderOfKeysEqualThere) {
             }
 }
 
+TEST(CpuSort, ByHighWordKeepsTheOrderOfKeysOfOneHighWord) {
+    // What point location's sorts rely on: keys of one high word (a slot, a point) stay in the order
+    // they were written; the slots past the count (small keys here) are not sorted in.
+    std::mt19937_64 random(3);
+    for (const int threads : {1, 2})
+        for (const std::size_t n : {std::size_t{0}, std::size_t{1000}, std::size_t{100003}}) {
+            DetectorOptions options;
+            options.threads = threads;
+            const CpuExec exec(options);
+            std::vector<std::uint64_t> keys(n + 5, 0x5555u);
+            for (std::size_t i = 0; i < n; ++i) keys[i] = (random() % 211) << 32 | (random() & 0xffffffffu);
+            std::vector<std::uint64_t> expected(keys.begin(), keys.begin() + static_cast<std::ptrdiff_t>(n));
+            std::stable_sort(expected.begin(), expected.end(), [](std::uint64_t a, std::uint64_t b) { return a >> 32 < b >> 32; });
+            const unsigned long long count = n;
+            exec.sort_by_high_word(keys.data(), keys.size(), &count, 40);
+            EXPECT_TRUE(std::equal(expected.begin(), expected.end(), keys.begin())) << n << " keys, " << threads << " threads";
+        }
+}
+
 TEST(CpuExec, UploadsCopyEveryElementWhateverTheSlices) {
     // Below 1 MiB one copy; above it a slice per thread (3 MiB + 3 elements: slices of unequal size).
     for (const int threads : {1, 2, 3})

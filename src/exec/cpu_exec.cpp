@@ -19,6 +19,12 @@ void CpuExec::sort(std::uint64_t* keys, std::size_t capacity, const unsigned lon
     radix_sort(keys, n, bits, sort_scratch_.data(), threads_, 0, low_word_bits);
 }
 
+void CpuExec::sort_by_high_word(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
+    const std::size_t n = std::min<std::size_t>(capacity, *count);
+    if (sort_scratch_.size() < n) sort_scratch_.resize_discard(n);
+    radix_sort(keys, n, bits, sort_scratch_.data(), threads_, 32);
+}
+
 void CpuExec::sort_lists(const std::uint32_t* keys, std::uint32_t* sorted, std::size_t, const std::uint32_t* begin,
                          const std::uint32_t* end, std::size_t lists) const {
     // Ciura's gaps, then times 2.25; only those below half the list are used.

@@ -167,6 +167,9 @@ public:
     /// 2^low_word_bits, which shortens the radix sort (one pass per 12 bits used here, per 8 bits
     /// below 2^bits in CUB's).
     void sort(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits, int low_word_bits = 32) const;
+    /// @brief As sort, by the high words alone (every key below 2^bits), stably: keys of one high word
+    /// keep their order, in half the passes where the low words need not be ordered.
+    void sort_by_high_word(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const;
     /// @brief Holds the spare keys sort() needs for `capacity` keys now, so that a window of colliding
     /// pairs is refused before a frame's narrow phase rather than when it sorts; false when the memory
     /// cannot hold them.

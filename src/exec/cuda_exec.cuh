@@ -284,7 +284,13 @@ public:
               int /*low_word_bits*/ = 32) const {
         if (capacity < 2) return;
         for_each(capacity, PadKeysKernel{keys, count});
-        sort_keys(keys, capacity, bits);
+        sort_keys(keys, capacity, 0, bits);
+    }
+    /// @brief As CpuExec's: by the high words alone, stably (CUB's radix sort over bits 32 .. bits).
+    void sort_by_high_word(std::uint64_t* keys, std::size_t capacity, const unsigned long long* count, int bits) const {
+        if (capacity < 2) return;
+        for_each(capacity, PadKeysKernel{keys, count});
+        sort_keys(keys, capacity, 32, bits);
     }
 
     /// @brief Copies each list [begin[i], end[i]) of `keys`, i < lists, to the same places of `sorted`,
@@ -310,7 +316,7 @@ public:
                    "scan");
         for_each(capacity, PrefixListKeysKernel{keys, begin, end, list_marks_.data(), prefixed_keys_.data()});
         // A list's start is below capacity; the keys outside every list (all ones) still sort last.
-        sort_keys(prefixed_keys_.data(), capacity, high_word_key_bits(capacity));
+        sort_keys(prefixed_keys_.data(), capacity, 0, high_word_key_bits(capacity));
         for_each(capacity, LowHalvesKernel{prefixed_keys_.data(), sorted});
     }
 
@@ -474,13 +480,13 @@ private:
     }
 
     /// @brief Sorts n keys ascending by their bits below 2^bits (CUB's radix sort through spare_keys_).
-    void sort_keys(std::uint64_t* keys, std::size_t n, int bits) const {
+    void sort_keys(std::uint64_t* keys, std::size_t n, int first_bit, int bits) const {
         spare_keys_.resize_discard(n);
         cub::DoubleBuffer<std::uint64_t> buffers(keys, spare_keys_.data());
         std::size_t bytes = 0;
-        cub::DeviceRadixSort::SortKeys(nullptr, bytes, buffers, n, 0, bits, stream_);
+        cub::DeviceRadixSort::SortKeys(nullptr, bytes, buffers, n, first_bit, bits, stream_);
         temp_.resize_discard(bytes);
-        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, buffers, n, 0, bits, stream_), "radix sort");
+        cuda_check(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, buffers, n, first_bit, bits, stream_), "radix sort");
         if (buffers.Current() != keys) copy(keys, buffers.Current(), n);
     }
 

@@ -235,8 +235,8 @@ private:
         exec.for_each(n, LocatePointKeysKernel{points_in_, grid, region, layer_mask, layers, slots << 32, point_keys_.data()});
         const unsigned long long sorted = keys;
         exec.upload(&c->point_keys, &sorted, 1);
-        exec.sort(point_keys_.data(), point_keys_.size(), &c->point_keys, high_word_key_bits(slots + 1),
-                  high_word_key_bits(std::max<std::uint64_t>(n, 1)) - 32);
+        // By slot alone: the keys were written in the points' order, which the sort keeps within a slot.
+        exec.sort_by_high_word(point_keys_.data(), point_keys_.size(), &c->point_keys, high_word_key_bits(slots + 1));
         slot_start_.resize_discard(slots + 1);
         if (keys == 0) fill(exec, slot_start_, 0u);
         exec.for_each(keys, KeyRunStartsKernel<std::uint32_t>{point_keys_.data(), keys, static_cast<std::uint32_t>(slots), slot_start_.data()});
@@ -309,8 +309,8 @@ private:
             exec.download(&hit_count_, hits, 1);
         }
         if (hit_count_ >= 0xffffffffull) throw Error("locate: too many hits (" + std::to_string(hit_count_) + ") for 32-bit indices");
-        exec.sort(hit_keys_.data(), hit_keys_.size(), hits, high_word_key_bits(std::max<std::uint64_t>(n, 1)),
-                  high_word_key_bits(std::max<std::uint64_t>(hit_count_, 1)) - 32);
+        // By point alone (LocateHitOrderKernel orders a point's hits afterwards).
+        exec.sort_by_high_word(hit_keys_.data(), hit_keys_.size(), hits, high_word_key_bits(std::max<std::uint64_t>(n, 1)));
     }
 
     /// The result's arrays at the sizes of this call's hits. A vector's growth fills it with zeros,
