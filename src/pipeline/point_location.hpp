@@ -235,16 +235,27 @@ KDET_HD inline void for_each_point_in_box(const LocatePointsView& g, const Aabb&
         return;
     }
     if (g.grid.dense) {
+        // The points in the box are gathered without a branch (most of a row's are outside, at random)
+        // and visited a batch at a time.
+        constexpr std::uint32_t batch = 16;
+        std::uint32_t held[batch];
+        std::uint32_t count = 0;
+        const auto visit_held = [&]() {
+            for (std::uint32_t j = 0; j < count; ++j) visit(key_second(g.keys[held[j]]), g.sorted[held[j]]);
+            count = 0;
+        };
         const std::uint32_t nx = g.grid.cells[layer][0], ny = g.grid.cells[layer][1];
         for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
             for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
                 const std::uint32_t row = g.grid.layer_slots[layer] + (z * ny + y) * nx;
                 const std::uint32_t end = g.start[row + r.hi[0] + 1];
                 for (std::uint32_t k = g.start[row + r.lo[0]]; k < end; ++k) {
-                    const vec3 p = g.sorted[k];
-                    if (box_holds(box, p)) visit(key_second(g.keys[k]), p);
+                    held[count] = k;
+                    count += box_holds(box, g.sorted[k]) ? 1u : 0u;
+                    if (count == batch) visit_held();
                 }
             }
+        visit_held();
         return;
     }
     for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
