@@ -3,9 +3,10 @@
 //     OMP_NUM_THREADS=1 perf record -g build/bench/locate_profile 55 1000000 3
 //
 // A box of cubes^3 cubes split into six tets each, inner vertices moved at random by up to a fifth of a
-// cube, and uniform points in the box. Each run is one kdet::locate (detector, grid and queries); its
-// wall and process CPU time (every thread's: on a shared machine the wall clock also counts the wait for
-// a core) and hit count are printed, with a checksum of the answers to compare builds.
+// cube, and uniform points in the box grown by SPREAD on every side, located with `within` = WITHIN.
+// Each run is one kdet::locate (detector, grid and queries); its wall and process CPU time (every
+// thread's: on a shared machine the wall clock also counts the wait for a core) and hit count are
+// printed, with a checksum of the answers to compare builds.
 #include <kdet/locate.hpp>
 
 #include <chrono>
@@ -58,13 +59,17 @@ int main(int argc, char** argv) {
     const int cubes = argc > 1 ? std::atoi(argv[1]) : 55;
     const long count = argc > 2 ? std::atol(argv[2]) : 1000000;
     const int runs = argc > 3 ? std::atoi(argv[3]) : 3;
-    if (cubes < 1 || count < 1 || runs < 1) {
-        std::fprintf(stderr, "usage: locate_profile [CUBES [POINTS [RUNS]]] (each at least 1)\n");
+    kdet::LocateOptions options;
+    options.within = argc > 4 ? std::atof(argv[4]) : 0.0;
+    const float spread = argc > 5 ? static_cast<float>(std::atof(argv[5])) : 0.0f;
+    if (cubes < 1 || count < 1 || runs < 1 || !(options.within >= 0.0) || !(spread >= 0.0f)) {
+        std::fprintf(stderr, "usage: locate_profile [CUBES [POINTS [RUNS [WITHIN [SPREAD]]]]] (counts at least 1, "
+                             "distances not negative)\n");
         return 2;
     }
     std::mt19937_64 random(7);
     const kdet::TetMesh mesh = jittered_box(cubes, random);
-    std::uniform_real_distribution<float> coordinate(0.0f, 1.0f);
+    std::uniform_real_distribution<float> coordinate(-spread, 1.0f + spread);
     std::vector<float> points(3 * static_cast<std::size_t>(count));
     for (float& v : points) v = coordinate(random);
     const kdet::PositionsView view{points.data(), false, static_cast<std::size_t>(count), 3, 1};
@@ -72,7 +77,7 @@ int main(int argc, char** argv) {
     for (int r = 0; r < runs; ++r) {
         const auto start = std::chrono::steady_clock::now();
         const double cpu_start = cpu_seconds();
-        const kdet::LocateResult result = kdet::locate(mesh, view);
+        const kdet::LocateResult result = kdet::locate(mesh, view, options);
         const double cpu = cpu_seconds() - cpu_start;
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (r == 0 || seconds < best) best = seconds;

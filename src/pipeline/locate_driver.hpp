@@ -59,8 +59,9 @@ public:
         stage_points(exec, request);
         const LocateTetsView tets{scene.positions, scene.tets,  request.first_tet,      scene.user_id,
                                   scene.stored_id, scene.tet_object, scene.object_tet_begin};
-        const LocatePointsView points = grid_points(exec, tets, request, hash);
-        find_hits(exec, tets, points, request);
+        frame_tets_ = request.tet_count;
+        const TetSizes sizes = size_tets(exec, tets, request, hash);
+        find_hits(exec, tets, sizes, request);
         result.point_count = n;
         result.hit_count = hit_count_;
         if (!request.options.results_to_host) {
@@ -147,63 +148,77 @@ private:
             throw Error("locate_on_device: point " + std::to_string(bad) + " has a non-finite coordinate (or one beyond float range)");
     }
 
-    /// Grids the points: c0 is the lower end of the binary octave that holds the median of the located
-    /// tets' box extents, and a point has a key on each layer that a tet's box (grown by `within` for
-    /// the nearest tets) goes to.
-    LocatePointsView grid_points(Exec& exec, const LocateTetsView& tets, const LocateRequest& request, HashFunction hash) {
+    /// What gridding the points needs from the located tets: their region and, for their boxes (and
+    /// those grown by `within`), the layers those go to.
+    struct TetSizes {
+        LocateGrid grid; ///< c0 and the layers; hash and slot_bits set, the rest per point grid
+        std::uint32_t layers = 0, grown_layers = 0; ///< masks
+        Aabb region{{0.0f, 0.0f, 0.0f}, {-1.0f, -1.0f, -1.0f}}; ///< the boxes' (none: holds no point)
+    };
+
+    /// c0 is the lower end of the binary octave that holds the median of the located tets' box
+    /// extents (of every eighth tet); the layers are those of the octaves present.
+    TetSizes size_tets(Exec& exec, const LocateTetsView& tets, const LocateRequest& request, HashFunction hash) {
         const std::uint32_t count = request.tet_count;
-        const std::size_t n = point_count_;
-        const double within = request.options.within;
         LocateCounters* c = counters_.data();
-        exec.for_each(count, LocateTetBoxesKernel{tets.positions, tets.tets, tets.first, within, c});
+        exec.for_each(count, LocateTetBoxesKernel{tets.positions, tets.tets, tets.first, request.options.within, c});
         const LocateCounters sizes = read_counters(exec);
-        LocateGrid grid{};
+        TetSizes out;
+        LocateGrid& grid = out.grid;
         grid.hash = hash;
         grid.params.layer_count = 1;
         grid.params.cell_size0 = 1.0f;
         grid.params.inv_cell_size0 = 1.0f;
-        std::uint32_t layer_mask = 0;
-        Aabb region{{0.0f, 0.0f, 0.0f}, {-1.0f, -1.0f, -1.0f}}; // holds no point
-        if (count > 0) {
-            std::uint64_t seen = 0;
-            std::uint32_t median = 0, largest = 0;
-            const auto present = [&](std::uint32_t e) { return (sizes.present[e / 32] >> (e % 32)) & 1u; };
-            const std::uint32_t samples = (count + 7) / 8;
-            for (std::uint32_t e = 0; e < float_octaves; ++e) {
-                if (sizes.sampled[e]) {
-                    if (seen < (samples + 1) / 2) median = e;
-                    seen += sizes.sampled[e];
-                }
-                if (present(e)) largest = e;
-            }
-            // c0 must be a normal float; bins 254 and 255 (2^127 and up, or infinite) have no float end.
-            grid.base_octave = std::clamp<std::uint32_t>(median, 1, 253);
-            grid.params.cell_size0 = float_octave_end(grid.base_octave - 1);
-            grid.params.inv_cell_size0 = 1.0f / grid.params.cell_size0;
-            grid.params.layer_count =
-                static_cast<int>(std::min<std::uint32_t>(largest - std::min(largest, grid.base_octave) + 1, max_grid_layers));
-            for (std::uint32_t e = 0; e < float_octaves; ++e)
-                if (present(e)) layer_mask |= 1u << locate_layer_of_octave(grid, e);
-            for (int a = 0; a < 3; ++a) {
-                const float lo = ordered_to_float(sizes.region.lo[a]), hi = ordered_to_float(sizes.region.hi[a]);
-                (&region.lo.x)[a] = within > 0.0 ? grown_down(lo, within) : lo;
-                (&region.hi.x)[a] = within > 0.0 ? grown_up(hi, within) : hi;
-            }
-            grid.params.origin = region.lo;
-        }
         // Hashed: at least a slot per point on each layer; a slot's number (up to 32 layers' slots) in 31 bits.
         grid.slot_bits = 10;
-        while ((std::uint64_t{1} << grid.slot_bits) < n && grid.slot_bits < 26) ++grid.slot_bits;
+        while ((std::uint64_t{1} << grid.slot_bits) < point_count_ && grid.slot_bits < 26) ++grid.slot_bits;
+        if (count == 0) return out;
+        const auto present = [](const std::uint32_t* bits, std::uint32_t e) { return (bits[e / 32] >> (e % 32)) & 1u; };
+        std::uint64_t seen = 0;
+        std::uint32_t median = 0, largest = 0;
+        const std::uint32_t samples = (count + 7) / 8;
+        for (std::uint32_t e = 0; e < float_octaves; ++e) {
+            if (sizes.sampled[e]) {
+                if (seen < (samples + 1) / 2) median = e;
+                seen += sizes.sampled[e];
+            }
+            if (present(sizes.present, e) || present(sizes.grown_present, e)) largest = e;
+        }
+        // c0 must be a normal float; bins 254 and 255 (2^127 and up, or infinite) have no float end.
+        grid.base_octave = std::clamp<std::uint32_t>(median, 1, 253);
+        grid.params.cell_size0 = float_octave_end(grid.base_octave - 1);
+        grid.params.inv_cell_size0 = 1.0f / grid.params.cell_size0;
+        grid.params.layer_count =
+            static_cast<int>(std::min<std::uint32_t>(largest - std::min(largest, grid.base_octave) + 1, max_grid_layers));
+        for (std::uint32_t e = 0; e < float_octaves; ++e) {
+            if (present(sizes.present, e)) out.layers |= 1u << locate_layer_of_octave(grid, e);
+            if (present(sizes.grown_present, e)) out.grown_layers |= 1u << locate_layer_of_octave(grid, e);
+        }
+        for (int a = 0; a < 3; ++a) {
+            (&out.region.lo.x)[a] = ordered_to_float(sizes.region.lo[a]);
+            (&out.region.hi.x)[a] = ordered_to_float(sizes.region.hi[a]);
+        }
+        return out;
+    }
+
+    /// Grids the points in `region` that `skip` (null: none) does not mark, one key on each layer of
+    /// `layer_mask`.
+    LocatePointsView grid_points(Exec& exec, const TetSizes& sizes, std::uint32_t layer_mask, const Aabb& region,
+                                 const std::uint32_t* skip) {
+        const std::size_t n = point_count_;
+        LocateGrid grid = sizes.grid;
+        grid.params.origin = region.lo;
         std::uint32_t layers = 0;
         for (int layer = 0; layer < grid.params.layer_count; ++layer) layers += (layer_mask >> layer) & 1u;
         // Dense where its table is not much larger than a hashed one (a slot per point and per tet),
         // with cells along x a quarter of c_l where those fit: a tet's rows then scan little beyond
         // its box, at no cost per cell.
-        const std::uint64_t dense_room =
-            std::min<std::uint64_t>(std::max<std::uint64_t>(std::uint64_t{layers} << grid.slot_bits, count) * 4, 0x7fffffffull);
+        const std::uint64_t dense_room = std::min<std::uint64_t>(
+            std::max<std::uint64_t>(std::uint64_t{layers} << grid.slot_bits, std::uint64_t{frame_tets_}) * 4, 0x7fffffffull);
+        std::uint64_t dense_slots = 0;
         for (const int refine : {2, 0}) {
             grid.refine[0] = refine;
-            std::uint64_t dense_slots = 0;
+            dense_slots = 0;
             for (int layer = 0; layer < grid.params.layer_count && dense_slots <= dense_room; ++layer) {
                 if (!((layer_mask >> layer) & 1u)) continue;
                 grid.layer_slots[layer] = static_cast<std::uint32_t>(dense_slots);
@@ -216,10 +231,7 @@ private:
                 dense_slots += cells;
             }
             grid.dense = dense_slots <= dense_room;
-            if (grid.dense) {
-                dense_total_ = dense_slots;
-                break;
-            }
+            if (grid.dense) break;
         }
         if (!grid.dense) {
             grid.refine[0] = 0;
@@ -227,12 +239,13 @@ private:
             for (int layer = 0; layer < grid.params.layer_count; ++layer)
                 if ((layer_mask >> layer) & 1u) grid.layer_slots[layer] = rank++ << grid.slot_bits;
         }
-        const std::uint64_t slots = grid.dense ? dense_total_ : std::uint64_t{layers} << grid.slot_bits;
+        const std::uint64_t slots = grid.dense ? dense_slots : std::uint64_t{layers} << grid.slot_bits;
 
         const std::uint64_t keys = std::uint64_t{n} * layers;
         if (keys >= 0xffffffffull) throw Error("locate: too many grid entries for 32-bit offsets");
         point_keys_.resize_discard(std::max<std::uint64_t>(keys, 1));
-        exec.for_each(n, LocatePointKeysKernel{points_in_, grid, region, layer_mask, layers, slots << 32, point_keys_.data()});
+        exec.for_each(n, LocatePointKeysKernel{points_in_, grid, region, layer_mask, layers, skip, slots << 32, point_keys_.data()});
+        LocateCounters* c = counters_.data();
         const unsigned long long sorted = keys;
         exec.upload(&c->point_keys, &sorted, 1);
         // By slot alone: the keys were written in the points' order, which the sort keeps within a slot.
@@ -272,7 +285,7 @@ private:
 
     /// The hits, sorted by point: the tets that hold each point, then, for `within`, the nearest tet of
     /// each point that none holds.
-    void find_hits(Exec& exec, const LocateTetsView& tets, const LocatePointsView& points, const LocateRequest& request) {
+    void find_hits(Exec& exec, const LocateTetsView& tets, const TetSizes& sizes, const LocateRequest& request) {
         const std::size_t n = point_count_;
         const double within = request.options.within;
         unsigned long long* hits = &counters_.data()->hits;
@@ -281,6 +294,7 @@ private:
             fill(exec, held_, 0u);
         }
         reserve_hits(exec, n + 1024, 0);
+        const LocatePointsView points = grid_points(exec, sizes, sizes.layers, sizes.region, nullptr);
         for (;;) {
             constexpr std::uint32_t run = Exec::tuning::search_tets_per_item;
             exec.for_each(TetRuns<run>::count(request.tet_count),
@@ -297,9 +311,13 @@ private:
             best_tet_.resize_discard(n);
             fill(exec, best_distance_, ~std::uint64_t{0});
             fill(exec, best_tet_, 0xffffffffu);
+            // The points no tet holds, gridded again alone, in the region of the grown boxes: most
+            // tets then find none near them.
+            const Aabb grown = grown_box(sizes.region, within);
+            const LocatePointsView unheld = grid_points(exec, sizes, sizes.grown_layers, grown, held_.data());
             for (std::uint32_t* ties : {static_cast<std::uint32_t*>(nullptr), best_tet_.data()})
                 exec.for_each(request.tet_count,
-                              LocateNearestKernel{tets, points, within, held_.data(), best_distance_.data(), ties});
+                              LocateNearestKernel{tets, unheld, within, held_.data(), best_distance_.data(), ties});
             // At most one hit more per point.
             reserve_hits(exec, hit_count_ + n, hit_count_);
             nearest_closest_.resize_discard(3 * n);
@@ -386,7 +404,7 @@ private:
     buffer<LocateCounters> counters_;
     unsigned long long hit_count_ = 0;
     std::size_t point_count_ = 0;
-    std::uint64_t dense_total_ = 0;
+    std::uint32_t frame_tets_ = 0; ///< the located tets of this call
     Outputs outputs_{}; ///< what device_results() hands out
 };
 

@@ -35,8 +35,9 @@ struct LocateCounters {
     unsigned long long point_keys;      ///< the points' grid keys (the count their sort reads)
     std::uint32_t first_non_finite_point;
     OrderedBox region;                       ///< the located tets' boxes
-    std::uint32_t sampled[float_octaves];    ///< histogram of every eighth tet's box extent (float_octave)
-    std::uint32_t present[float_octaves / 32]; ///< bit e: some tet's extent, or grown extent, is in bin e
+    std::uint32_t sampled[float_octaves];          ///< histogram of every eighth tet's box extent (float_octave)
+    std::uint32_t present[float_octaves / 32];     ///< bit e: some tet's extent is in bin e
+    std::uint32_t grown_present[float_octaves / 32]; ///< bit e: some tet's box grown by `within` is
 };
 
 /// @brief The largest side of a box (infinite where the sides overflow float: such a tet goes to the
@@ -128,8 +129,8 @@ struct LocateTetBoxesKernel {
     std::uint32_t first;
     double within; ///< 0: no grown boxes
     LocateCounters* counters;
-    KDET_HD void mark_present(std::uint32_t octave) const {
-        std::uint32_t* word = &counters->present[octave / 32];
+    KDET_HD static void mark_present(std::uint32_t* bits, std::uint32_t octave) {
+        std::uint32_t* word = &bits[octave / 32];
         const std::uint32_t bit = 1u << (octave % 32);
         if (!(atomic_load_acquire(word) & bit)) atomic_fetch_or(word, bit);
     }
@@ -139,8 +140,8 @@ struct LocateTetBoxesKernel {
         const Aabb box = tet_box(v);
         const std::uint32_t octave = float_octave(box_extent(box));
         if (i % 8 == 0) atomic_fetch_add_gathered(&counters->sampled[octave], 1u);
-        mark_present(octave);
-        if (within > 0.0) mark_present(float_octave(box_extent(grown_box(box, within))));
+        mark_present(counters->present, octave);
+        if (within > 0.0) mark_present(counters->grown_present, float_octave(box_extent(grown_box(box, within))));
         const float lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
         for (int a = 0; a < 3; ++a) {
             atomic_lower_to(&counters->region.lo[a], float_to_ordered(lo[a]));
@@ -151,19 +152,20 @@ struct LocateTetBoxesKernel {
 
 /// @brief Per point: its keys, one per layer the tets use (slot << 32 | point, at point * layers +
 /// j), or, for a point outside the region that the tets' boxes (grown by `within`) cover, which no
-/// tet can hold or be near, `no_point_key` in each: sorted after every other key.
+/// tet can hold or be near, or one `skip` marks, `no_point_key` in each: sorted after every other key.
 struct LocatePointKeysKernel {
     const vec3* points;
     LocateGrid grid;
     Aabb region;
     std::uint32_t layer_mask;
     std::uint32_t layers; ///< set bits of layer_mask
+    const std::uint32_t* skip; ///< per point, or null
     std::uint64_t no_point_key;
     std::uint64_t* keys;
     KDET_HD void operator()(std::uint64_t i) const {
         const vec3 p = points[i];
         std::uint64_t* out = keys + i * layers;
-        if (!box_holds(region, p)) {
+        if (!box_holds(region, p) || (skip && skip[i])) {
             for (std::uint32_t j = 0; j < layers; ++j) out[j] = no_point_key;
             return;
         }
