@@ -151,7 +151,7 @@ private:
     /// What gridding the points needs from the located tets: their region and, for their boxes (and
     /// those grown by `within`), the layers those go to.
     struct TetSizes {
-        LocateGrid grid; ///< c0 and the layers; hash and slot_bits set, the rest per point grid
+        LocateGrid grid{}; ///< c0 and the layers; hash and slot_bits set, the rest per point grid
         std::uint32_t layers = 0, grown_layers = 0; ///< masks
         Aabb region{{0.0f, 0.0f, 0.0f}, {-1.0f, -1.0f, -1.0f}}; ///< the boxes' (none: holds no point)
     };
