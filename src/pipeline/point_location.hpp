@@ -1,12 +1,13 @@
 #pragma once
 /// @file point_location.hpp
 /// @brief Point location's kernels (Locator, locate_driver.hpp, drives them): the query points in a
-/// hashed grid, then per located tet the points in its box tested exactly and the hits described
-/// there, then, for `within`, the nearest tet of each point that none holds, then the hits sorted by
-/// point and indexed.
+/// grid, then per located tet the points in its box tested exactly and the hits described there,
+/// then, for `within`, the points no tet holds in a grid of their own and the nearest tet of each,
+/// then the hits sorted by point and indexed.
 ///
 /// The points are gridded, not the tets: each point is one key (slot << 32 | point) per layer that
-/// some tet uses, sorted, and a table gives each slot's run. A tet reads only the cells of its own
+/// some tet uses, sorted, and a table gives each slot's run (dense rows of cells where the region's
+/// cells are few, LocateGrid::dense; hashed cells otherwise). A tet reads only the cells of its own
 /// layer that its box overlaps, so it meets each point in its box once, with its vertices loaded and
 /// its orientation computed once for all of them. Cell sizes are powers of two (layer l: c0 * 2^l),
 /// and a tet's layer depends only on the binary exponent of its box's extent: a tet whose extent lies
