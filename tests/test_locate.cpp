@@ -193,6 +193,7 @@ std::size_t expect_nearest_matches_brute_force(const TetMesh& mesh, const std::v
         vec3 v[4];
         float_tet(mesh, r.tets[h], v);
         const double tolerance = 1e-7 * test::extent_of(mesh);
+        EXPECT_EQ(r.tets[h], best_tet) << "point " << p << " within " << within;
         EXPECT_LE(point_query::closest_on_tet_boundary(v, q).distance, best + tolerance) << "point " << p;
         EXPECT_NEAR(r.distances[h], best, tolerance) << "point " << p;
         EXPECT_GT(r.distances[h], 0.0);
@@ -293,6 +294,28 @@ TEST(Locate, WithinGivesNearestTet) {
     const TetMesh mesh = test::random_soup(300, 10.0, 2.0, 11);
     const std::vector<double> xyz = test::locate_query_points(mesh, 50, 1500, 6);
     for (double within : {0.05, 0.5, 30.0}) EXPECT_GT(expect_nearest_matches_brute_force(mesh, xyz, within), 0u) << within;
+}
+
+TEST(Locate, NearestTiesAndFarPoints) {
+    // Points off a box mesh's corners, edges and faces (a corner vertex is as near to each tet that
+    // shares it: the lowest id wins the tie), points a hundred times the mesh's size away, and a
+    // `within` that reaches them all: the search's cost follows the tets near each point, and its
+    // answer is brute force's.
+    const TetMesh mesh = make_box_mesh(5, 4, 3, 0.5);
+    std::vector<double> xyz;
+    for (const double x : {-0.5, 0.0, 1.25, 2.5, 3.0})
+        for (const double y : {-1.0, 0.0, 1.0, 2.0, 2.5})
+            for (const double z : {-0.25, 0.0, 0.75, 1.5, 2.0}) xyz.insert(xyz.end(), {x, y, z});
+    std::mt19937 random(21);
+    std::uniform_real_distribution<double> far(-150.0, 150.0);
+    for (int i = 0; i < 300; ++i) xyz.insert(xyz.end(), {far(random), far(random), far(random)});
+    const LocateResult inside = locate(mesh, xyz);
+    std::size_t points_held = 0;
+    for (std::size_t p = 0; p < inside.point_count; ++p) points_held += inside.offsets[p + 1] > inside.offsets[p];
+    EXPECT_GT(points_held, 0u);
+    // Each point that no tet holds gets one.
+    EXPECT_EQ(expect_nearest_matches_brute_force(mesh, xyz, 1e30), xyz.size() / 3 - points_held);
+    EXPECT_GT(expect_nearest_matches_brute_force(mesh, xyz, 0.5), 0u);
 }
 
 TEST(Locate, DetectorObjectsAndMovedPositions) {

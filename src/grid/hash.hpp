@@ -4,6 +4,8 @@
 /// Each maps a cell (x, y, z, layer) and a probe number to a 32-bit hash; table_slot maps that to a
 /// slot of the power-of-two table. The probe number enters the hash, so a miss rehashes as in the thesis.
 
+#include "geometry/vec3.hpp"
+
 #include <kdet/config.hpp>
 #include <kdet/options.hpp>
 
@@ -56,6 +58,17 @@ KDET_HD inline std::uint32_t spread_bits_3(std::uint32_t v) {
 }
 
 } // namespace hash_detail
+
+/// @brief The Morton code (10 bits an axis, x lowest) of p's place in the box from lo to hi, clamped
+/// to the box (a side without extent, or one that overflows float, puts every point at its low end).
+KDET_HD inline std::uint32_t morton_code_in_box(vec3 p, vec3 lo, vec3 hi) {
+    const auto quantize = [](float x, float low, float high) {
+        const float scaled = high > low ? (x - low) / (high - low) * 1023.0f : 0.0f;
+        return scaled > 0.0f ? static_cast<std::uint32_t>(scaled < 1023.0f ? scaled : 1023.0f) : 0u;
+    };
+    return hash_detail::spread_bits_3(quantize(p.x, lo.x, hi.x)) | (hash_detail::spread_bits_3(quantize(p.y, lo.y, hi.y)) << 1) |
+           (hash_detail::spread_bits_3(quantize(p.z, lo.z, hi.z)) << 2);
+}
 
 /// @brief A cell's hash before its probe number is mixed in. Each hash here is a function of the cell's
 /// part and the probe number, so a lookup computes the cell's part once, however many slots it

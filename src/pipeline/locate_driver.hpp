@@ -96,7 +96,7 @@ public:
 
     std::size_t memory_bytes() const {
         return points_.capacity_bytes() + point_keys_.capacity_bytes() + slot_start_.capacity_bytes() + sorted_points_.capacity_bytes() +
-               held_.capacity_bytes() + best_distance_.capacity_bytes() + best_tet_.capacity_bytes() + nearest_closest_.capacity_bytes() +
+               held_.capacity_bytes() + tree_boxes_.capacity_bytes() + nearest_closest_.capacity_bytes() +
                nearest_distance_.capacity_bytes() + hit_keys_.capacity_bytes() +
                hits_.capacity_bytes() + hit_keys_grown_.capacity_bytes() + hits_grown_.capacity_bytes() + offsets_.capacity_bytes() +
                objects_.capacity_bytes() + tets_.capacity_bytes() + barycentrics_.capacity_bytes() + closest_points_.capacity_bytes() +
@@ -148,11 +148,11 @@ private:
             throw Error("locate_on_device: point " + std::to_string(bad) + " has a non-finite coordinate (or one beyond float range)");
     }
 
-    /// What gridding the points needs from the located tets: their region and, for their boxes (and
-    /// those grown by `within`), the layers those go to.
+    /// What gridding the points needs from the located tets: their region and the layers their boxes
+    /// go to.
     struct TetSizes {
         LocateGrid grid{}; ///< c0 and the layers; hash and slot_bits set, the rest per point grid
-        std::uint32_t layers = 0, grown_layers = 0; ///< masks
+        std::uint32_t layers = 0; ///< mask
         Aabb region{{0.0f, 0.0f, 0.0f}, {-1.0f, -1.0f, -1.0f}}; ///< the boxes' (none: holds no point)
     };
 
@@ -161,7 +161,7 @@ private:
     TetSizes size_tets(Exec& exec, const LocateTetsView& tets, const LocateRequest& request, HashFunction hash) {
         const std::uint32_t count = request.tet_count;
         LocateCounters* c = counters_.data();
-        exec.for_each(count, LocateTetBoxesKernel{tets.positions, tets.tets, tets.first, request.options.within, c});
+        exec.for_each(count, LocateTetBoxesKernel{tets.positions, tets.tets, tets.first, c});
         const LocateCounters sizes = read_counters(exec);
         TetSizes out;
         LocateGrid& grid = out.grid;
@@ -182,7 +182,7 @@ private:
                 if (seen < (samples + 1) / 2) median = e;
                 seen += sizes.sampled[e];
             }
-            if (present(sizes.present, e) || present(sizes.grown_present, e)) largest = e;
+            if (present(sizes.present, e)) largest = e;
         }
         // c0 must be a normal float; bins 254 and 255 (2^127 and up, or infinite) have no float end.
         grid.base_octave = std::clamp<std::uint32_t>(median, 1, 253);
@@ -190,10 +190,8 @@ private:
         grid.params.inv_cell_size0 = 1.0f / grid.params.cell_size0;
         grid.params.layer_count =
             static_cast<int>(std::min<std::uint32_t>(largest - std::min(largest, grid.base_octave) + 1, max_grid_layers));
-        for (std::uint32_t e = 0; e < float_octaves; ++e) {
+        for (std::uint32_t e = 0; e < float_octaves; ++e)
             if (present(sizes.present, e)) out.layers |= 1u << locate_layer_of_octave(grid, e);
-            if (present(sizes.grown_present, e)) out.grown_layers |= 1u << locate_layer_of_octave(grid, e);
-        }
         for (int a = 0; a < 3; ++a) {
             (&out.region.lo.x)[a] = ordered_to_float(sizes.region.lo[a]);
             (&out.region.hi.x)[a] = ordered_to_float(sizes.region.hi[a]);
@@ -201,11 +199,11 @@ private:
         return out;
     }
 
-    /// Grids the points in `region` that `skip` (null: none) does not mark, one key on each layer of
-    /// `layer_mask`.
-    LocatePointsView grid_points(Exec& exec, const TetSizes& sizes, std::uint32_t layer_mask, const Aabb& region,
-                                 const std::uint32_t* skip) {
+    /// Grids the points in the tets' region, one key on each layer the tets use.
+    LocatePointsView grid_points(Exec& exec, const TetSizes& sizes) {
         const std::size_t n = point_count_;
+        const Aabb& region = sizes.region;
+        const std::uint32_t layer_mask = sizes.layers;
         LocateGrid grid = sizes.grid;
         grid.params.origin = region.lo;
         std::uint32_t layers = 0;
@@ -244,7 +242,7 @@ private:
         const std::uint64_t keys = std::uint64_t{n} * layers;
         if (keys >= 0xffffffffull) throw Error("locate: too many grid entries for 32-bit offsets");
         point_keys_.resize_discard(std::max<std::uint64_t>(keys, 1));
-        exec.for_each(n, LocatePointKeysKernel{points_in_, grid, region, layer_mask, layers, skip, slots << 32, point_keys_.data()});
+        exec.for_each(n, LocatePointKeysKernel{points_in_, grid, region, layer_mask, layers, slots << 32, point_keys_.data()});
         LocateCounters* c = counters_.data();
         const unsigned long long sorted = keys;
         exec.upload(&c->point_keys, &sorted, 1);
@@ -283,6 +281,41 @@ private:
         return HitAppender{hit_keys_.data(), hits_.data(), std::min(hit_keys_.size(), hits_.size()), &counters_.data()->hits};
     }
 
+    /// The tree of the located tets' boxes at their current positions (nearest_tree.hpp).
+    NearestTreeView build_tree(Exec& exec, const LocateTetsView& tets, std::uint32_t count) {
+        NearestTreeView tree{};
+        tree.levels = nearest_tree_shape(count, tree.level_begin);
+        tree.first = tets.first;
+        tree.count = count;
+        tree_boxes_.resize_discard(std::max<std::uint32_t>(tree.level_begin[tree.levels], 1));
+        tree.boxes = tree_boxes_.data();
+        if (tree.levels == 0) return tree;
+        exec.for_each(tree.level_begin[1], NearestLeafBoxesKernel{tets.positions, tets.tets, tets.first, count, tree_boxes_.data()});
+        for (int level = 1; level < tree.levels; ++level) {
+            const std::uint32_t below = tree.level_begin[level - 1];
+            exec.for_each(tree.level_begin[level + 1] - tree.level_begin[level],
+                          NearestParentBoxesKernel{tree_boxes_.data() + below, tree.level_begin[level] - below,
+                                                   tree_boxes_.data() + tree.level_begin[level]});
+        }
+        return tree;
+    }
+
+    /// The points in the order of their nearest searches (NearestSearchOrderKernel), in the point
+    /// keys' buffer (the points' grid is read by then): ordered within the tets' region grown by
+    /// `within`, or by the region's extent where `within` is larger.
+    const std::uint64_t* nearest_search_order(Exec& exec, const Aabb& region, double within) {
+        const std::size_t n = point_count_;
+        const float grow = static_cast<float>(std::min<double>(within, box_extent(region)));
+        const Aabb box{region.lo - vec3{grow, grow, grow}, region.hi + vec3{grow, grow, grow}};
+        point_keys_.resize_discard(std::max<std::size_t>(n, 1));
+        exec.for_each(n, NearestSearchOrderKernel{points_in_, held_.data(), box, point_keys_.data()});
+        LocateCounters* c = counters_.data();
+        const unsigned long long count = n;
+        exec.upload(&c->point_keys, &count, 1);
+        exec.sort_by_high_word(point_keys_.data(), point_keys_.size(), &c->point_keys, high_word_key_bits(held_point_order + 1));
+        return point_keys_.data();
+    }
+
     /// The hits, sorted by point: the tets that hold each point, then, for `within`, the nearest tet of
     /// each point that none holds.
     void find_hits(Exec& exec, const LocateTetsView& tets, const TetSizes& sizes, const LocateRequest& request) {
@@ -294,7 +327,7 @@ private:
             fill(exec, held_, 0u);
         }
         reserve_hits(exec, n + 1024, 0);
-        const LocatePointsView points = grid_points(exec, sizes, sizes.layers, sizes.region, nullptr);
+        const LocatePointsView points = grid_points(exec, sizes);
         for (;;) {
             constexpr std::uint32_t run = Exec::tuning::search_tets_per_item;
             exec.for_each(TetRuns<run>::count(request.tet_count),
@@ -307,23 +340,15 @@ private:
             exec.upload(hits, &none, 1);
         }
         if (within > 0.0) {
-            best_distance_.resize_discard(n);
-            best_tet_.resize_discard(n);
-            fill(exec, best_distance_, ~std::uint64_t{0});
-            fill(exec, best_tet_, 0xffffffffu);
-            // The points no tet holds, gridded again alone, in the region of the grown boxes: most
-            // tets then find none near them.
-            const Aabb grown = grown_box(sizes.region, within);
-            const LocatePointsView unheld = grid_points(exec, sizes, sizes.grown_layers, grown, held_.data());
-            for (std::uint32_t* ties : {static_cast<std::uint32_t*>(nullptr), best_tet_.data()})
-                exec.for_each(request.tet_count,
-                              LocateNearestKernel{tets, unheld, within, held_.data(), best_distance_.data(), ties});
+            const NearestTreeView tree = build_tree(exec, tets, request.tet_count);
+            const float scale = std::max(max_abs(sizes.region.lo), max_abs(sizes.region.hi));
+            const std::uint64_t* order = nearest_search_order(exec, sizes.region, within);
             // At most one hit more per point.
             reserve_hits(exec, hit_count_ + n, hit_count_);
             nearest_closest_.resize_discard(3 * n);
             nearest_distance_.resize_discard(n);
-            exec.for_each(n, LocateNearestHitsKernel{tets, points_in_, best_tet_.data(), hit_appender(), nearest_closest_.data(),
-                                                     nearest_distance_.data()});
+            exec.for_each(n, LocateNearestKernel{tets, tree, points_in_, within, scale, order, hit_appender(), nearest_closest_.data(),
+                                                 nearest_distance_.data()});
             exec.download(&hit_count_, hits, 1);
         }
         if (hit_count_ >= 0xffffffffull) throw Error("locate: too many hits (" + std::to_string(hit_count_) + ") for 32-bit indices");
@@ -393,8 +418,7 @@ private:
     buffer<std::uint32_t> slot_start_; ///< LocateSlotStartsKernel's
     buffer<vec3> sorted_points_; ///< per sorted point key
     buffer<std::uint32_t> held_;          ///< per point, for `within`
-    buffer<std::uint64_t> best_distance_; ///< per point, for `within`
-    buffer<std::uint32_t> best_tet_;      ///< per point, for `within`
+    buffer<Aabb> tree_boxes_;             ///< for `within`: NearestTreeView's
     buffer<double> nearest_closest_, nearest_distance_; ///< per point, for `within`
     buffer<std::uint64_t> hit_keys_, hit_keys_grown_;
     buffer<LocateHit> hits_, hits_grown_;

@@ -2,7 +2,7 @@
 /// @file point_location.hpp
 /// @brief Point location's kernels (Locator, locate_driver.hpp, drives them): the query points in a
 /// grid, then per located tet the points in its box tested exactly and the hits described there,
-/// then, for `within`, the points no tet holds in a grid of their own and the nearest tet of each,
+/// then, for `within`, the nearest tet of each point no tet holds from a tree of the tets' boxes,
 /// then the hits sorted by point and indexed.
 ///
 /// The points are gridded, not the tets: each point is one key (slot << 32 | point) per layer that
@@ -18,14 +18,15 @@
 #include "exec/atomic.hpp"
 #include "geometry/point_tet.hpp"
 #include "grid/grid_math.hpp"
+#include "grid/hash.hpp"
 #include "pipeline/bounding_boxes.hpp"
+#include "pipeline/nearest_tree.hpp"
 #include "pipeline/pair_keys.hpp"
 #include "pipeline/tet_runs.hpp"
 
 #include <kdet/options.hpp>
 
 #include <cstdint>
-#include <cstring>
 
 namespace kdet {
 
@@ -38,7 +39,6 @@ struct LocateCounters {
     OrderedBox region;                       ///< the located tets' boxes
     std::uint32_t sampled[float_octaves];          ///< histogram of every eighth tet's box extent (float_octave)
     std::uint32_t present[float_octaves / 32];     ///< bit e: some tet's extent is in bin e
-    std::uint32_t grown_present[float_octaves / 32]; ///< bit e: some tet's box grown by `within` is
 };
 
 /// @brief The largest side of a box (infinite where the sides overflow float: such a tet goes to the
@@ -50,25 +50,6 @@ KDET_HD inline float box_extent(const Aabb& b) {
 KDET_HD inline bool box_holds(const Aabb& b, vec3 p) {
     // One branch for the six comparisons: most points a tet scans are outside its box.
     return (p.x >= b.lo.x) & (p.x <= b.hi.x) & (p.y >= b.lo.y) & (p.y <= b.hi.y) & (p.z >= b.lo.z) & (p.z <= b.hi.z);
-}
-
-/// @brief The float below (down) or above x - d or x + d in double: a box that holds every point
-/// within d of x.
-KDET_HD inline float grown_down(float x, double d) {
-    const double target = static_cast<double>(x) - d;
-    float f = static_cast<float>(target);
-    if (static_cast<double>(f) > target) f = next_float_down(f);
-    return f;
-}
-KDET_HD inline float grown_up(float x, double d) {
-    const double target = static_cast<double>(x) + d;
-    float f = static_cast<float>(target);
-    if (static_cast<double>(f) < target) f = next_float_up(f);
-    return f;
-}
-KDET_HD inline Aabb grown_box(const Aabb& b, double d) {
-    return Aabb{{grown_down(b.lo.x, d), grown_down(b.lo.y, d), grown_down(b.lo.z, d)},
-                {grown_up(b.hi.x, d), grown_up(b.hi.y, d), grown_up(b.hi.z, d)}};
 }
 
 /// @brief The points' grid: cells of layer l are c0 * 2^l with c0 = 2^(base_octave - 127), the lower
@@ -120,15 +101,13 @@ KDET_HD inline std::uint32_t locate_slot(const LocateGrid& g, std::uint32_t x, s
     return g.layer_slots[layer] + table_slot(hash_cell(g.hash, make_cell(x, y, z, layer), 0u), g.slot_bits);
 }
 
-/// @brief Per located tet (stored tets first .. first + count): the bins of its box's extent and of
-/// the box grown by `within` (which decide the layers that points are gridded on), the histogram of a
-/// sample of the extents (which only sizes the cells: a count per tet contended for a few bins'
-/// counters) and the region of the boxes.
+/// @brief Per located tet (stored tets first .. first + count): the bin of its box's extent (which
+/// decides the layer its points are gridded on), the histogram of a sample of the extents (which only
+/// sizes the cells: a count per tet contended for a few bins' counters) and the region of the boxes.
 struct LocateTetBoxesKernel {
     const vec3* positions;
     const TetIndices* tets;
     std::uint32_t first;
-    double within; ///< 0: no grown boxes
     LocateCounters* counters;
     KDET_HD static void mark_present(std::uint32_t* bits, std::uint32_t octave) {
         std::uint32_t* word = &bits[octave / 32];
@@ -142,7 +121,6 @@ struct LocateTetBoxesKernel {
         const std::uint32_t octave = float_octave(box_extent(box));
         if (i % 8 == 0) atomic_fetch_add_gathered(&counters->sampled[octave], 1u);
         mark_present(counters->present, octave);
-        if (within > 0.0) mark_present(counters->grown_present, float_octave(box_extent(grown_box(box, within))));
         const float lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
         for (int a = 0; a < 3; ++a) {
             atomic_lower_to(&counters->region.lo[a], float_to_ordered(lo[a]));
@@ -152,21 +130,20 @@ struct LocateTetBoxesKernel {
 };
 
 /// @brief Per point: its keys, one per layer the tets use (slot << 32 | point, at point * layers +
-/// j), or, for a point outside the region that the tets' boxes (grown by `within`) cover, which no
-/// tet can hold or be near, or one `skip` marks, `no_point_key` in each: sorted after every other key.
+/// j), or, for a point outside the region that the tets' boxes cover, which no tet can hold,
+/// `no_point_key` in each: sorted after every other key.
 struct LocatePointKeysKernel {
     const vec3* points;
     LocateGrid grid;
     Aabb region;
     std::uint32_t layer_mask;
     std::uint32_t layers; ///< set bits of layer_mask
-    const std::uint32_t* skip; ///< per point, or null
     std::uint64_t no_point_key;
     std::uint64_t* keys;
     KDET_HD void operator()(std::uint64_t i) const {
         const vec3 p = points[i];
         std::uint64_t* out = keys + i * layers;
-        if (!box_holds(region, p) || (skip && skip[i])) {
+        if (!box_holds(region, p)) {
             for (std::uint32_t j = 0; j < layers; ++j) out[j] = no_point_key;
             return;
         }
@@ -374,60 +351,72 @@ struct LocateContainingKernel {
     }
 };
 
-/// @brief The bits of a distance (not negative): ordered as the distances are.
-KDET_HD inline std::uint64_t distance_bits(double d) {
-    std::uint64_t bits;
-    memcpy(&bits, &d, sizeof bits);
-    return bits;
-}
+/// @brief A NearestSearchOrderKernel key's high word for a point that some tet holds: past every
+/// Morton code, so those points sort last.
+constexpr std::uint32_t held_point_order = 1u << 30;
 
-/// @brief Per located tet, for `within`, in two passes: the first lowers best_distance[i] of every
-/// point i that no tet holds to the tet's distance when it is at most `within`; the second (with
-/// best_tet) lowers best_tet[i] to the caller's global id of each tet at that least distance (the
-/// smaller id wins a tie).
-struct LocateNearestKernel {
-    LocateTetsView scene;
-    LocatePointsView points;
-    double within;
+/// @brief Per point, for `within`: (Morton code of its place in `box`) << 32 | point, or, for a point
+/// some tet holds, held_point_order << 32 | point. Sorted, neighbouring points search one after the
+/// other and find the tree's nodes and tets where the one before left them.
+struct NearestSearchOrderKernel {
+    const vec3* points;
     const std::uint32_t* held;
-    std::uint64_t* best_distance; ///< per point: distance_bits, all ones for none
-    std::uint32_t* best_tet;      ///< per point; null in the first pass
-    KDET_HD void operator()(std::uint64_t t) const {
-        const std::uint32_t stored = scene.first + static_cast<std::uint32_t>(t);
-        vec3 v[4];
-        load_stored_tet(scene, stored, v);
-        for_each_point_in_box(points, grown_box(tet_box(v), within), [&](std::uint32_t i, vec3 p) {
-            if (held[i]) return;
-            const double d = point_query::closest_on_tet_boundary(v, p).distance;
-            if (!(d <= within)) return;
-            if (!best_tet)
-                atomic_lower_to(&best_distance[i], distance_bits(d));
-            else if (distance_bits(d) == best_distance[i])
-                atomic_min(&best_tet[i], scene.user_id[stored]);
-        });
+    Aabb box;
+    std::uint64_t* keys;
+    KDET_HD void operator()(std::uint64_t i) const {
+        const std::uint32_t code = held[i] ? held_point_order : morton_code_in_box(points[i], box.lo, box.hi);
+        keys[i] = static_cast<std::uint64_t>(code) << 32 | i;
     }
 };
 
-/// @brief Per point with a nearest tet (LocateNearestKernel): its hit, and the tet's closest point
-/// and distance.
-struct LocateNearestHitsKernel {
+/// @brief Per point that no tet holds, for `within`: the located tet nearest it, at most `within`
+/// away (the least computed distance, the smaller global id on a tie), from the tree of the located
+/// tets, and its hit, closest point and distance.
+///
+/// The search skips a node or tet whose box lies farther than the best distance so far, plus
+/// `slack`: a computed distance to a tet's boundary falls short of the true one (and so of the
+/// distance to its box) by a few roundings of the coordinates' size at most, so no tet that could
+/// win is skipped.
+struct LocateNearestKernel {
     LocateTetsView scene;
+    NearestTreeView tree;
     const vec3* points;
-    const std::uint32_t* best_tet;
+    double within;
+    float scale; ///< the largest magnitude of the tets' coordinates
+    const std::uint64_t* order; ///< NearestSearchOrderKernel's keys, sorted
     HitAppender out;
     double* closest;  ///< 3 per point
     double* distance; ///< per point
-    KDET_HD void operator()(std::uint64_t i) const {
-        if (best_tet[i] == 0xffffffffu) return;
-        const std::uint32_t stored = scene.stored_id[best_tet[i]];
-        vec3 v[4];
-        load_stored_tet(scene, stored, v);
-        const point_query::PointInTet where = point_query::closest_on_tet_boundary(v, points[i]);
-        out.push(static_cast<std::uint32_t>(i), make_hit(scene, stored, where));
-        closest[3 * i] = where.closest.x;
-        closest[3 * i + 1] = where.closest.y;
-        closest[3 * i + 2] = where.closest.z;
-        distance[i] = where.distance;
+    KDET_HD void operator()(std::uint64_t k) const {
+        if (key_first(order[k]) == held_point_order) return;
+        const std::uint32_t i = key_second(order[k]);
+        const vec3 p = points[i];
+        const narrow::dvec3 q = narrow::widen(p);
+        const double size = max_f(scale, max_abs(p));
+        const double slack = 0x1p-30 * size;
+        double best = within;
+        std::uint32_t best_id = 0xffffffffu, best_stored = 0;
+        point_query::PointInTet best_where{};
+        for_each_tet_within_reach(tree, q, [&] { return best + slack; }, [&](std::uint32_t stored) {
+            vec3 v[4];
+            load_stored_tet(scene, stored, v);
+            const double reach = best + slack;
+            if (squared_distance_to_box(tet_box(v), q) > reach * reach) return;
+            const point_query::PointInTet where = point_query::closest_on_tet_boundary(v, p);
+            const std::uint32_t id = scene.user_id[stored];
+            if (where.distance < best || (where.distance == best && id < best_id)) {
+                best = where.distance;
+                best_id = id;
+                best_stored = stored;
+                best_where = where;
+            }
+        });
+        if (best_id == 0xffffffffu) return;
+        out.push(i, make_hit(scene, best_stored, best_where));
+        closest[3 * std::uint64_t{i}] = best_where.closest.x;
+        closest[3 * std::uint64_t{i} + 1] = best_where.closest.y;
+        closest[3 * std::uint64_t{i} + 2] = best_where.closest.z;
+        distance[i] = best_where.distance;
     }
 };
 
@@ -438,7 +427,7 @@ struct LocateDescribeKernel {
     const LocateHit* hits;
     const vec3* points;
     const std::uint32_t* held;      ///< per point, or null: every hit's tet holds its point
-    const double* nearest_closest;  ///< LocateNearestHitsKernel's, for the points no tet holds
+    const double* nearest_closest;  ///< LocateNearestKernel's, for the points no tet holds
     const double* nearest_distance;
     std::uint32_t* objects;
     std::uint32_t* tets;

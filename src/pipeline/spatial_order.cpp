@@ -22,17 +22,11 @@ std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::u
         lo_x = std::min(lo_x, c.x), lo_y = std::min(lo_y, c.y), lo_z = std::min(lo_z, c.z);
         hi_x = std::max(hi_x, c.x), hi_y = std::max(hi_y, c.y), hi_z = std::max(hi_z, c.z);
     }
-    auto quantize = [](float x, float low, float high) {
-        const float scaled = high > low ? (x - low) / (high - low) * 1023.0f : 0.0f;
-        return static_cast<std::uint32_t>(std::clamp(scaled, 0.0f, 1023.0f));
-    };
     std::vector<std::uint64_t> keys(tet_count);
 #pragma omp parallel for num_threads(threads) if (n > host_parallel_elements)
     for (std::ptrdiff_t t = 0; t < n; ++t) {
         const vec3 c = centroid[static_cast<std::size_t>(t)];
-        const std::uint32_t code = hash_detail::spread_bits_3(quantize(c.x, lo_x, hi_x)) |
-                                   (hash_detail::spread_bits_3(quantize(c.y, lo_y, hi_y)) << 1) |
-                                   (hash_detail::spread_bits_3(quantize(c.z, lo_z, hi_z)) << 2);
+        const std::uint32_t code = morton_code_in_box(c, vec3{lo_x, lo_y, lo_z}, vec3{hi_x, hi_y, hi_z});
         keys[static_cast<std::size_t>(t)] = (static_cast<std::uint64_t>(code) << 32) | static_cast<std::uint64_t>(t);
     }
     std::vector<std::uint64_t> scratch(tet_count);
