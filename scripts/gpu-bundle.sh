@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Packs what the GPU checks of the CUDA backend need on the `device` machine, which has the CUDA
 # toolkit and CMake but none of kdet's other dependencies and no network: the CUDA build for sm_90
-# (made here: kdet, the tests, the sort-and-sweep peer, the margin benchmark where CGAL is found and,
-# where ../shared/third_party/cuBQL lies beside the repository, the cuBQL peer), the shared libraries they need beyond the
-# C/C++ runtimes, the models and the prepared meshes of the thesis scenes. The bundle is a git-ignored
-# folder that the device tool carries.
+# (made here: kdet, the tests, the sort-and-sweep peer, the point location benchmark, the margin
+# benchmark where CGAL is found and, where ../shared/third_party/cuBQL lies beside the repository, the
+# cuBQL peer), the shared libraries they need beyond the C/C++ runtimes, the models and the prepared
+# meshes of the thesis scenes. The bundle is a git-ignored folder that the device tool carries.
 #
 # usage: scripts/gpu-bundle.sh [COMMIT ...]
 #   builds build-gpu/ (preset cuda) and fills .gpu-bundle/; each COMMIT's kdet is built too (from a
@@ -26,7 +26,7 @@ mkdir -p "$(dirname "$exclude")"
 grep -qx '/.gpu-bundle/' "$exclude" 2>/dev/null || echo '/.gpu-bundle/' >>"$exclude"
 (cd "$repo" && cmake --preset cuda -B "$build" >/dev/null)
 # The cuBQL peer exists where CMake found cuBQL (bench/CMakeLists.txt).
-targets=(kdet_cli kdet_tests kdet_gpu_vs_sweep static_environment)
+targets=(kdet_cli kdet_tests kdet_gpu_vs_sweep static_environment locate_profile)
 # (grep reads the whole list: with -q it would stop early, and make would fail on the broken pipe.)
 cmake --build "$build" --target help | grep ' kdet_gpu_vs_cubql$' >/dev/null && targets+=(kdet_gpu_vs_cubql)
 cmake --build "$build" --target help | grep ' kdet_margin_vs_cgal$' >/dev/null && targets+=(kdet_margin_vs_cgal)
@@ -41,6 +41,7 @@ cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bu
 [[ ! " ${targets[*]} " == *" kdet_gpu_vs_cubql "* ]] || cp "$build/bench/kdet_gpu_vs_cubql" "$bundle/"
 [[ ! " ${targets[*]} " == *" kdet_margin_vs_cgal "* ]] || cp "$build/bench/kdet_margin_vs_cgal" "$bundle/"
 cp "$build/bench/static_environment" "$bundle/kdet_static_environment"
+cp "$build/bench/locate_profile" "$bundle/kdet_locate_profile"
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"
   # Kept, like the build folder, at the same path every time: the build's CMake cache names its

@@ -17,6 +17,9 @@
 #            resolution 4, self-collision off and on, kdet at margin 0, 1 % and 10 % of the median edge
 #            side by side, frames 60-64; the CGAL peer checks every frame's pairs once (untimed); its CSV
 #            also comes back as $OUT/margin.csv (for bench/results/gpu-DEVICE/margin-COMMIT.csv)
+#   locate   point location on the CPU and the GPU in one process, answers compared bit for bit
+#            (bench/locate_profile.cpp --backend both): 1M points in a 998,250-tet mesh, all held, and
+#            in a box 1.2 times the mesh's with `within` a tet's size and ten
 #   profile  each kernel's GPU time in two frames of five cases (Nsight Compute), the heaviest case's
 #            occupancy, divergence and cache hits, and the bucket
 #            capacity and block size against the automatic choice on armadillos r4
@@ -32,11 +35,11 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="${KDET_GPU_BUNDLE:-$repo/.gpu-bundle}"
 out="${OUT:-$repo/exports/gpu-session}"
 deadline="${KDET_GPU_DEADLINE:-500}"
-(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|scenes|margin|profile|compare|matrix ..." >&2; exit 2; }
+(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|scenes|margin|locate|profile|compare|matrix ..." >&2; exit 2; }
 for part in "$@"; do
   case "$part" in
-  tests | sanitizers | r4 | scaling | peer | cubql | scenes | margin | profile | compare | matrix) ;;
-  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, scenes, margin, profile, compare, matrix)" >&2; exit 2 ;;
+  tests | sanitizers | r4 | scaling | peer | cubql | scenes | margin | locate | profile | compare | matrix) ;;
+  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, scenes, margin, locate, profile, compare, matrix)" >&2; exit 2 ;;
   esac
 done
 work="$(mktemp -d)"
@@ -142,6 +145,12 @@ for part in "$@"; do
     step margin 300 "$bin/kdet_margin_vs_cgal" --backend cuda --peer-runs 0 --frames 60:64 --runs 3 --csv "$work/margin.csv"
     [[ ! -f "$work/margin.csv" ]] || cp "$work/margin.csv" "$out/margin.csv"
     ;;
+  locate)
+    for case in "held 55 1000000 10 0 0" "within-0.02 55 1000000 10 0.02 0.1" "within-0.2 55 1000000 3 0.2 0.1"; do
+      read -r name arguments <<<"$case"
+      step "locate-$name" 120 "$bin/kdet_locate_profile" $arguments --backend both
+    done
+    ;;
   profile)
     for case in "armadillos-r4-self-yes armadillos -r 4 -s yes --frames 80:81" \
       "armadillos-r4-self-no armadillos -r 4 -s no --frames 80:81" \
@@ -200,6 +209,9 @@ tar -C "$work" --exclude=models --exclude=cache --exclude=bin -czf "$out/gpu-ses
 [[ -f "$work/peer.log" ]] && tail -15 "$work/peer.log"
 [[ -f "$work/cubql.log" ]] && tail -15 "$work/cubql.log"
 [[ -f "$work/margin.log" ]] && grep '^|' "$work/margin.log"
+for log in "$work"/locate-*.log; do
+  [[ -f "$log" ]] && sed "s|^|$(basename "$log" .log): |" "$log"
+done
 grep -h "FAILED\|PASSED\|ERROR SUMMARY\|RACECHECK SUMMARY" "$work"/*.log 2>/dev/null | sort | uniq -c | head -40
 cat "$out/steps.txt"
 [[ -f "$work/bench/summary.md" ]] && grep '^|' "$work/bench/summary.md"
