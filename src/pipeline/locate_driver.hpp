@@ -2,8 +2,9 @@
 /// @file locate_driver.hpp
 /// @brief Locator: point location over a detector's tets at their current positions, written once over
 /// an execution layer (the kernels are in point_location.hpp). Each call grids the points anew, then
-/// each located tet at its current position reads the points in its box; a buffer that was too small
-/// grows to what its step counted and the step runs again.
+/// each located tet at its current position reads the points in its box, and, for `within`, each
+/// point that none holds searches a tree of the tets' boxes built anew (nearest_tree.hpp); a buffer
+/// that was too small grows to what its step counted and the step runs again.
 
 #include "pipeline/capacity.hpp"
 #include "pipeline/gather_positions.hpp"
