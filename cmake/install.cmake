@@ -1,7 +1,8 @@
 # Install rules: `cmake --install build --prefix P` gives
 #   P/lib/libkdet.a (or .so), P/include/kdet/*.hpp       the library and its public headers only
 #   P/lib/cmake/kdet/kdet{Config,ConfigVersion,Targets}*  find_package(kdet 0.1 CONFIG REQUIRED) -> kdet::kdet
-#   P/lib/libkdet_mpi.a, P/lib/cmake/kdet/kdetMpiTargets*  with MPI: find_package(kdet COMPONENTS mpi) -> kdet::mpi
+#   P/lib/libkdet_mpi.a, P/lib/cmake/kdet/kdetMpiTargets*, kdet_find_mpi.cmake
+#                                                        with MPI: find_package(kdet COMPONENTS mpi) -> kdet::mpi
 #   P/bin/kdet, P/share/kdet/python/*.py                  the command and the scripts of `kdet plot`
 # The benchmark harness (kdet::scenes), the tests and the private headers of src/ are not installed.
 # Components: development (library, headers, package), tool (the command); the Python package installs
@@ -33,6 +34,8 @@ if(TARGET kdet_mpi)
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
     RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT development)
   install(EXPORT kdetMpiTargets NAMESPACE kdet:: DESTINATION ${KDET_INSTALL_CMAKEDIR} COMPONENT development)
+  install(FILES ${CMAKE_CURRENT_LIST_DIR}/find_mpi.cmake RENAME kdet_find_mpi.cmake DESTINATION ${KDET_INSTALL_CMAKEDIR}
+    COMPONENT development)
 endif()
 
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/kdetConfig.cmake.in ${PROJECT_BINARY_DIR}/kdetConfig.cmake
