@@ -45,3 +45,15 @@ def test_embed_surface_carries_every_point(models):
     assert shared > total // 2
     deviation = float(re.search(r"mapped point (\S+)", lines[1]).group(1))
     assert deviation < 1e-6
+
+
+def test_contact_margin_warns_before_the_contact(models):
+    lines = run("contact_margin.py", models).splitlines()
+    frames = [tuple(map(int, re.search(r"(\d+) pairs within the margin, (\d+) overlapping", line).groups()))
+              for line in lines if line.startswith("frame")]
+    assert len(frames) == 12 and frames[0] == (0, 0)
+    first = next(i for i, (pairs, _) in enumerate(frames) if pairs)
+    # Close but apart first (the margin warns), then overlapping.
+    assert frames[first][1] == 0 < frames[first][0]
+    assert frames[-1][1] > 0
+    assert lines[-1].endswith("the same as the last frame")
