@@ -5,7 +5,9 @@
 //     build/bench/locate_profile 55 1000000 10 0 0 --backend both
 //
 // A box of cubes^3 cubes split into six tets each, inner vertices moved at random by up to a fifth of a
-// cube, and uniform points in the box grown by SPREAD on every side, located with `within` = WITHIN.
+// cube, and uniform points in the box grown by SPREAD on every side, located with `within` = WITHIN;
+// with --apart D, a second copy of the mesh D along x holds every second point (a sparse region: the
+// points' grid is hashed).
 // Without --backend, each run is one kdet::locate on the CPU (detector, grid and queries); its wall and
 // process CPU time (every thread's: on a shared machine the wall clock also counts the wait for a core)
 // and hit count are printed, with a checksum of the answers to compare builds. With --backend, each
@@ -100,7 +102,7 @@ bool same_answers(const kdet::LocateResult& a, const kdet::LocateResult& b) {
 [[noreturn]] void usage(const char* problem) {
     std::fprintf(stderr,
                  "locate_profile: %s\nusage: locate_profile [CUBES [POINTS [RUNS [WITHIN [SPREAD]]]]] [--backend cpu|cuda|both] "
-                 "[--threads N] (counts at least 1, distances not negative)\n",
+                 "[--threads N] [--apart D] (counts at least 1, distances not negative)\n",
                  problem);
     std::exit(2);
 }
@@ -118,12 +120,16 @@ int main(int argc, char** argv) {
     std::vector<const char*> positional;
     std::vector<kdet::Backend> backends;
     int threads = 0;
+    double apart = 0.0;
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
-        if (arg == "--backend" || arg == "--threads") {
+        if (arg == "--backend" || arg == "--threads" || arg == "--apart") {
             if (a + 1 >= argc) usage((arg + " needs a value").c_str());
             const std::string value = argv[++a];
-            if (arg == "--threads") {
+            if (arg == "--apart") {
+                apart = number(value.c_str(), "--apart");
+                if (apart < 0) usage("--apart must not be negative");
+            } else if (arg == "--threads") {
                 const double n = number(value.c_str(), "--threads");
                 if (n < 1 || n != static_cast<int>(n)) usage("--threads must be a whole number, at least 1");
                 threads = static_cast<int>(n);
@@ -152,11 +158,19 @@ int main(int argc, char** argv) {
         runs != static_cast<int>(runs) || options.within < 0.0 || spread < 0.0)
         usage("counts must be whole numbers of at least 1 and distances not negative");
     std::mt19937_64 random(7);
-    const kdet::TetMesh mesh = jittered_box(static_cast<int>(cubes), random);
+    kdet::TetMesh mesh = jittered_box(static_cast<int>(cubes), random);
+    if (apart > 0.0) {
+        // A second copy `apart` along x, with every second point: a region of many empty cells.
+        const auto vertices = static_cast<std::uint32_t>(mesh.num_vertices());
+        const std::size_t coordinates = mesh.positions.size(), corners = mesh.tets.size();
+        for (std::size_t i = 0; i < coordinates; ++i) mesh.positions.push_back(mesh.positions[i] + (i % 3 == 0 ? apart : 0.0));
+        for (std::size_t i = 0; i < corners; ++i) mesh.tets.push_back(mesh.tets[i] + vertices);
+    }
     std::uniform_real_distribution<float> coordinate(-static_cast<float>(spread), 1.0f + static_cast<float>(spread));
     const auto points_count = static_cast<std::size_t>(count);
     std::vector<float> points(3 * points_count);
     for (float& v : points) v = coordinate(random);
+    for (std::size_t i = 3; apart > 0.0 && i < points.size(); i += 6) points[i] += static_cast<float>(apart);
     const kdet::PositionsView view{points.data(), false, points_count, 3, 1};
     kdet::DetectorOptions detector_options;
     detector_options.threads = threads;

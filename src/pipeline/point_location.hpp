@@ -7,13 +7,14 @@
 ///
 /// The points are gridded, not the tets: each point is one key (slot << 32 | point) per layer that
 /// some tet uses, sorted, and a table gives each slot's run (dense rows of cells where the region's
-/// cells are few, LocateGrid::dense; hashed cells otherwise). A tet reads only the cells of its own
-/// layer that its box overlaps, so it meets each point in its box once, with its vertices loaded and
-/// its orientation computed once for all of them. Cell sizes are powers of two (layer l: c0 * 2^l),
-/// and a tet's layer depends only on the binary exponent of its box's extent: a tet whose extent lies
-/// in [c_l, 2 c_l) goes to layer l and spans at most three cells per axis there. Cells whose hashes
-/// share a slot only add candidates: a point is taken from a cell only if it lies in the tet's box
-/// and that is its own cell on the layer (each layer has slots of its own).
+/// cells are few, LocateGrid::dense; hashed blocks of cells along x otherwise). A tet reads only the
+/// cells of its own layer that its box overlaps, so it meets each point in its box once, with its
+/// vertices loaded and its orientation computed once for all of them. Cell sizes are powers of two
+/// (layer l: c0 * 2^l, along x a quarter of that unless a dense table cannot hold those), and a tet's
+/// layer depends only on the binary exponent of its box's extent: a tet whose extent lies in
+/// [c_l, 2 c_l) goes to layer l and spans at most three cells of c_l per axis there. Blocks whose hashes
+/// share slots only add candidates: a point is taken from a hashed block only if it lies in the
+/// tet's box and that is its own block on the layer (each layer has slots of its own).
 
 #include "exec/atomic.hpp"
 #include "geometry/point_tet.hpp"
@@ -52,19 +53,26 @@ KDET_HD inline bool box_holds(const Aabb& b, vec3 p) {
     return (p.x >= b.lo.x) & (p.x <= b.hi.x) & (p.y >= b.lo.y) & (p.y <= b.hi.y) & (p.z >= b.lo.z) & (p.z <= b.hi.z);
 }
 
+/// @brief A hashed grid's cells go to its table in blocks of this many neighbours along x: the hash
+/// of (x / block, y, z, layer) picks a block of slots, and the cells of a block take its slots in
+/// order, so that a tet's cells along x are one or two runs of points, as in a dense row.
+constexpr std::uint32_t locate_block_bits = 7;
+constexpr std::uint32_t locate_block_cells = 1u << locate_block_bits;
+
 /// @brief The points' grid: cells of layer l are c0 * 2^l with c0 = 2^(base_octave - 127), the lower
 /// end of float_octave bin base_octave (the median of the tets' extents). Each layer the tets use has
 /// slots of its own, from layer_slots[l] on: a slot holds one layer's points. Where the region's cells
 /// on those layers are few (`dense`), a cell's slot is its index in the region, x fastest, so that a
 /// tet's cells along x are neighbours in the table and their points in the sorted keys; otherwise
-/// the cell's hash picks one of 2^slot_bits.
+/// the hash of the cell's block (locate_block_bits) picks one of 2^slot_bits / locate_block_cells
+/// blocks of slots.
 struct LocateGrid {
     GridParams params;
     std::uint32_t base_octave;
     HashFunction hash;
     std::uint32_t slot_bits;
     bool dense;
-    int refine[3]; ///< cells along axis a are 2^refine[a] times thinner than c_l (a dense grid's rows along x)
+    int refine[3]; ///< cells along axis a are 2^refine[a] times thinner than c_l (the rows along x)
     std::uint32_t layer_slots[max_grid_layers];
     std::uint32_t cells[max_grid_layers][2]; ///< dense: the region's cells along x and y per layer
 };
@@ -98,7 +106,9 @@ KDET_HD inline CellRange locate_cell_range(const LocateGrid& g, const Aabb& box,
 /// @brief The table slot of a cell of a layer the tets use.
 KDET_HD inline std::uint32_t locate_slot(const LocateGrid& g, std::uint32_t x, std::uint32_t y, std::uint32_t z, int layer) {
     if (g.dense) return g.layer_slots[layer] + (z * g.cells[layer][1] + y) * g.cells[layer][0] + x;
-    return g.layer_slots[layer] + table_slot(hash_cell(g.hash, make_cell(x, y, z, layer), 0u), g.slot_bits);
+    const std::uint32_t block = table_slot(hash_cell(g.hash, make_cell(x >> locate_block_bits, y, z, layer), 0u),
+                                           g.slot_bits - locate_block_bits);
+    return g.layer_slots[layer] + (block << locate_block_bits) + (x & (locate_block_cells - 1));
 }
 
 /// @brief Per located tet (stored tets first .. first + count): the bin of its box's extent (which
@@ -214,42 +224,44 @@ KDET_HD inline void for_each_point_in_box(const LocatePointsView& g, const Aabb&
             if (box_holds(box, g.points[i])) visit(i, g.points[i]);
         return;
     }
-    if (g.grid.dense) {
-        // The points in the box are gathered without a branch (most of a row's are outside, at random)
-        // and visited a batch at a time.
-        constexpr std::uint32_t batch = 16;
-        std::uint32_t held[batch];
-        std::uint32_t count = 0;
-        const auto visit_held = [&]() {
-            for (std::uint32_t j = 0; j < count; ++j) visit(key_second(g.keys[held[j]]), g.sorted[held[j]]);
-            count = 0;
-        };
-        const std::uint32_t nx = g.grid.cells[layer][0], ny = g.grid.cells[layer][1];
-        for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
-            for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
-                const std::uint32_t row = g.grid.layer_slots[layer] + (z * ny + y) * nx;
-                const std::uint32_t end = g.start[row + r.hi[0] + 1];
-                for (std::uint32_t k = g.start[row + r.lo[0]]; k < end; ++k) {
-                    held[count] = k;
-                    count += box_holds(box, g.sorted[k]) ? 1u : 0u;
-                    if (count == batch) visit_held();
-                }
-            }
-        visit_held();
-        return;
-    }
-    for_each_cell(r, [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-        const std::uint32_t slot = locate_slot(g.grid, x, y, z, layer);
-        for (std::uint32_t k = g.start[slot], end = g.start[slot + 1]; k < end; ++k) {
-            const vec3 p = g.sorted[k];
-            if (!box_holds(box, p)) continue;
-            // Its own cell, not one whose hash shares the slot.
-            if (locate_cell(g.grid, p.x, 0, layer) != x || locate_cell(g.grid, p.y, 1, layer) != y || locate_cell(g.grid, p.z, 2, layer) != z)
-                continue;
-            visit(key_second(g.keys[k]), p);
+    // The points in the box are gathered without a branch (most of a run's are outside, at random)
+    // and visited a batch at a time. In a hashed grid a point counts only in its own block: another
+    // block whose hash shares the slots adds candidates, not hits.
+    constexpr std::uint32_t batch = 16;
+    std::uint32_t held[batch];
+    std::uint32_t count = 0;
+    const auto visit_held = [&]() {
+        for (std::uint32_t j = 0; j < count; ++j) visit(key_second(g.keys[held[j]]), g.sorted[held[j]]);
+        count = 0;
+    };
+    // The points of slots first .. last, those that `own` keeps.
+    const auto scan = [&](std::uint32_t first, std::uint32_t last, const auto& own) {
+        const std::uint32_t end = g.start[last + 1];
+        for (std::uint32_t k = g.start[first]; k < end; ++k) {
+            held[count] = k;
+            count += box_holds(box, g.sorted[k]) && own(g.sorted[k]) ? 1u : 0u;
+            if (count == batch) visit_held();
         }
-        return true;
-    });
+    };
+    for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+        for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
+            if (g.grid.dense) {
+                const std::uint32_t row = g.grid.layer_slots[layer] + (z * g.grid.cells[layer][1] + y) * g.grid.cells[layer][0];
+                scan(row + r.lo[0], row + r.hi[0], [](vec3) { return true; });
+                continue;
+            }
+            for (std::uint32_t block = r.lo[0] >> locate_block_bits; block <= r.hi[0] >> locate_block_bits; ++block) {
+                const std::uint32_t from = block << locate_block_bits > r.lo[0] ? block << locate_block_bits : r.lo[0];
+                const std::uint32_t block_end = (block << locate_block_bits) | (locate_block_cells - 1);
+                const std::uint32_t to = block_end < r.hi[0] ? block_end : r.hi[0];
+                const std::uint32_t first = locate_slot(g.grid, from, y, z, layer);
+                scan(first, first + (to - from), [&](vec3 p) {
+                    return (locate_cell(g.grid, p.x, 0, layer) >> locate_block_bits) == block && locate_cell(g.grid, p.y, 1, layer) == y &&
+                           locate_cell(g.grid, p.z, 2, layer) == z;
+                });
+            }
+        }
+    visit_held();
 }
 
 /// @brief The located tets as the kernels read them.
