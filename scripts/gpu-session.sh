@@ -54,7 +54,8 @@ for packed in "$bundle"/kdet*.xz; do
   program="$bin/$(basename "$packed" .xz)"
   xz -dc "$packed" >"$program" && chmod +x "$program"
 done
-export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+[[ ! -f "$bundle/lib.tar.xz" ]] || tar -C "$work" -xJf "$bundle/lib.tar.xz"
+export LD_LIBRARY_PATH="$work/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export KDET_DATA_DIR="$work/models" KDET_CACHE_DIR="$work/cache"
 kdet="$bin/kdet"
 tests="$bin/kdet_tests"
@@ -224,7 +225,7 @@ for part in "$@"; do
 done
 
 ls "$work/bench"/*.csv >/dev/null 2>&1 && python3 "$repo/python/kdet_summary.py" "$work/bench" >/dev/null 2>&1
-tar -C "$work" --exclude=models --exclude=cache --exclude=bin --exclude=openmpi -czf "$out/gpu-session.tar.gz" .
+tar -C "$work" --exclude=models --exclude=cache --exclude=bin --exclude=openmpi --exclude=lib -czf "$out/gpu-session.tar.gz" .
 [[ -f "$work/peer.log" ]] && tail -15 "$work/peer.log"
 [[ -f "$work/cubql.log" ]] && tail -15 "$work/cubql.log"
 [[ -f "$work/margin.log" ]] && grep '^|' "$work/margin.log"
