@@ -234,9 +234,8 @@ private:
         }
         if (!grid.dense) {
             grid.refine[0] = 2;
-            // Four slots a point: the cells along x are a quarter of c_l, so a layer's occupied blocks
-            // outnumber the points' slots / locate_block_cells, and the blocks that share slots
-            // would multiply the points each run scans.
+            // Four slots a point, so that fewer blocks share slots: a shared block adds the other
+            // block's points in the same cells to each run that scans them.
             for (int more = 0; more < 2 && (std::uint64_t{layers} << (grid.slot_bits + 1)) <= 0x80000000ull; ++more) ++grid.slot_bits;
             std::uint32_t rank = 0;
             for (int layer = 0; layer < grid.params.layer_count; ++layer)
