@@ -205,34 +205,40 @@ std::size_t expect_nearest_matches_brute_force(const TetMesh& mesh, const std::v
 }
 
 TEST(Locate, PreparedFacesGiveTheExactOrientations) {
-    // TetFaces decides each face's orientation from rows computed once per tet; its signs must be
-    // orient3d's with the point in place of the vertex, on the faces' planes (vertices and edge
-    // midpoints of a power-of-two lattice, exactly coplanar) and a float step off them too.
+    // TetFaces decides each face's orientation from rows computed once per tet and a rounding bound
+    // computed once for the tet's box; its signs must be orient3d's with the point in place of the
+    // vertex, for points of the box on the faces' planes (vertices and edge midpoints of a power-of-two
+    // lattice, exactly coplanar) and a float step off them too.
     std::mt19937 random(9);
     std::uniform_int_distribution<int> lattice(-8, 8);
     std::uniform_real_distribution<float> scale(-30.0f, 30.0f);
-    std::size_t zeros = 0;
+    std::size_t zeros = 0, tested = 0;
     for (int trial = 0; trial < 4000; ++trial) {
         const float unit = std::ldexp(1.0f, static_cast<int>(scale(random)));
         vec3 v[4];
         for (vec3& q : v) q = vec3{unit * static_cast<float>(lattice(random)), unit * static_cast<float>(lattice(random)),
                                    unit * static_cast<float>(lattice(random))};
         const point_query::TetFaces faces(v);
+        const Aabb box = tet_box(v);
         for (int n = 0; n < 8; ++n) {
             const vec3& a = v[random() % 4];
             const vec3& b = v[random() % 4];
             vec3 p{(a.x + b.x) * 0.5f, (a.y + b.y) * 0.5f, (a.z + b.z) * 0.5f};
             if (n % 2) p.y = n % 4 == 1 ? next_float_up(p.y) : next_float_down(p.y);
+            if (!box_holds(box, p)) continue; // the bound is for the points of the box
+            double values[4];
+            faces.face_values(p, values);
+            ++tested;
             for (int k = 0; k < 4; ++k) {
                 vec3 w[4];
                 point_query::replace_vertex(v, k, p, w);
                 const int expected = point_query::orient3d_sign(w[0], w[1], w[2], w[3]);
-                double value = 0.0;
-                ASSERT_EQ(faces.face_sign(v, k, p, value), expected) << trial << " " << n << " " << k;
+                ASSERT_EQ(faces.decided_sign(v, k, p, values[k]), expected) << trial << " " << n << " " << k;
                 zeros += expected == 0;
             }
         }
     }
+    EXPECT_GT(tested, 20000u);
     EXPECT_GT(zeros, 1000u); // the points on a face's plane were tested
 }
 

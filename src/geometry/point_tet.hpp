@@ -30,21 +30,26 @@ struct PointTetSigns {
     double det[4];
 };
 
-/// @brief A tet's faces prepared for testing many points: the orientation with p in place of vertex k
-/// is sign[k] det(e1, e2, p - base[k]) for two edges e1, e2 of face k from its vertex base[k], so their
-/// double cross product and the rows' part of narrow::sign_det3's bound are computed once per tet. Per
-/// point it is then sign_det3's own computation: a dot product, decided where it exceeds its bound,
-/// else the exact sign.
+/// @brief A tet's faces prepared for testing many points of its box: the orientation with p in place
+/// of vertex k is det(e1, e2, p - base[k]) for two edges e1, e2 of face k from its vertex base[k]
+/// (after an odd permutation of its rows for faces 0 and 2, folded into the normal's sign), so their
+/// double cross product is computed once per tet. Per point it is then narrow::sign_det3's own
+/// computation, a dot product decided where it exceeds its bound, else the exact sign; the bound's
+/// factor max|p - base[k]| is bounded once for every point of the box by the box's largest side (the
+/// differences of coordinates within it, rounded, are no larger), so it too is computed once.
 struct TetFaces {
     // Per face k, side by side so that the four are computed together.
     double base_x[4], base_y[4], base_z[4];
     double normal_x[4], normal_y[4], normal_z[4];
-    double bound[4];
-    double sign[4]; ///< -1 where orient3d with p at k has these rows after an odd permutation of its points
+    double error[4]; ///< the double value's rounding bound for any point of the tet's box
+    TetFaces() = default;
     KDET_HD explicit TetFaces(const vec3 v[4]) {
         // Face k's rows: v[first[k]] - v[from[k]], v[second[k]] - v[from[k]], p - v[from[k]].
         const int from[4] = {1, 0, 0, 0}, first[4] = {2, 2, 1, 1}, second[4] = {3, 3, 3, 2};
-        const double odd[4] = {-1.0, 1.0, -1.0, 1.0};
+        const bool odd[4] = {true, false, true, false};
+        const Aabb box = tet_box(v);
+        const double side =
+            narrow::max_d(double{box.hi.x} - double{box.lo.x}, narrow::max_d(double{box.hi.y} - double{box.lo.y}, double{box.hi.z} - double{box.lo.z}));
         for (int k = 0; k < 4; ++k) {
             const dvec3 base = narrow::widen(v[from[k]]);
             const dvec3 e1 = narrow::operator-(narrow::widen(v[first[k]]), base);
@@ -53,44 +58,35 @@ struct TetFaces {
             base_x[k] = base.x;
             base_y[k] = base.y;
             base_z[k] = base.z;
-            normal_x[k] = normal.x;
-            normal_y[k] = normal.y;
-            normal_z[k] = normal.z;
-            bound[k] = narrow::k_double_det_bound * narrow::norm1(e1) * narrow::norm1(e2);
-            sign[k] = odd[k];
+            normal_x[k] = odd[k] ? -normal.x : normal.x;
+            normal_y[k] = odd[k] ? -normal.y : normal.y;
+            normal_z[k] = odd[k] ? -normal.z : normal.z;
+            error[k] = narrow::k_double_det_bound * narrow::norm1(e1) * narrow::norm1(e2) * side;
         }
     }
-    /// Per face k, the orientation of v with vertex k replaced by p, in double, and its rounding
-    /// bound: plain loops over the faces, which a compiler runs two or four faces at a time.
-    KDET_HD void face_values(vec3 p, double value[4], double error[4]) const {
+    /// Per face k, the orientation of v with vertex k replaced by p (a point of the tet's box), in
+    /// double: plain loops over the faces, which a compiler runs two or four faces at a time.
+    KDET_HD void face_values(vec3 p, double value[4]) const {
         double rx[4], ry[4], rz[4];
         for (int k = 0; k < 4; ++k) {
             rx[k] = double{p.x} - base_x[k];
             ry[k] = double{p.y} - base_y[k];
             rz[k] = double{p.z} - base_z[k];
         }
-        for (int k = 0; k < 4; ++k) value[k] = sign[k] * (normal_x[k] * rx[k] + normal_y[k] * ry[k] + normal_z[k] * rz[k]);
-        for (int k = 0; k < 4; ++k) error[k] = bound[k] * narrow::max_d(fabs(rx[k]), narrow::max_d(fabs(ry[k]), fabs(rz[k])));
+        for (int k = 0; k < 4; ++k) value[k] = normal_x[k] * rx[k] + normal_y[k] * ry[k] + normal_z[k] * rz[k];
     }
     /// The exact sign of that orientation: the double value where it exceeds its bound.
-    KDET_HD static int decided_sign(const vec3 v[4], int k, vec3 p, double value, double error) {
-        if (value > error) return 1;
-        if (value < -error) return -1;
+    KDET_HD int decided_sign(const vec3 v[4], int k, vec3 p, double value) const {
+        if (value > error[k]) return 1;
+        if (value < -error[k]) return -1;
         vec3 w[4];
         replace_vertex(v, k, p, w);
         return orient3d_sign(w[0], w[1], w[2], w[3]);
     }
-    /// The exact sign for face k alone, and its double value.
-    KDET_HD int face_sign(const vec3 v[4], int k, vec3 p, double& value) const {
-        double values[4], errors[4];
-        face_values(p, values, errors);
-        value = values[k];
-        return decided_sign(v, k, p, values[k], errors[k]);
-    }
 };
 
 /// @brief Whether the closed tet v, whose orientation (orient3d_sign of its vertices) and faces are
-/// given, holds p, exactly. A tet with volume holds p iff no orientation with a
+/// given, holds p, a point of its box, exactly. A tet with volume holds p iff no orientation with a
 /// vertex replaced by p has the opposite sign of the tet's own (zero: p lies on that face's plane).
 /// The four double values come first: one certainly opposite decides without any exact sign.
 /// A tet without volume is decided by the exact tet-tet test against the point as a tet of four equal
@@ -102,22 +98,27 @@ KDET_HD inline bool tet_holds_point(const TetFaces& faces, const vec3 v[4], vec3
         bool exact_stage = false;
         return narrow::exact_intersect(v, point, exact_stage);
     }
-    double error[4];
-    faces.face_values(p, signs.det, error);
+    faces.face_values(p, signs.det);
     bool opposite = false;
-    for (int k = 0; k < 4; ++k) opposite |= signs.tet * signs.det[k] < -error[k];
+    for (int k = 0; k < 4; ++k) opposite |= signs.tet * signs.det[k] < -faces.error[k];
     if (opposite) return false;
     for (int k = 0; k < 4; ++k) {
-        signs.face[k] = TetFaces::decided_sign(v, k, p, signs.det[k], error[k]);
+        signs.face[k] = faces.decided_sign(v, k, p, signs.det[k]);
         if (signs.face[k] == -signs.tet) return false;
     }
     return true;
 }
 
-/// @brief As above, with the tet's orientation and faces computed here (a caller testing many points
-/// against one tet computes them once instead).
+/// @brief As above for any point, with the tet's orientation and faces computed here (a caller
+/// testing many points against one tet computes them once instead).
 KDET_HD inline bool tet_holds_point(const vec3 v[4], vec3 p, PointTetSigns& signs) {
-    return tet_holds_point(TetFaces(v), v, p, orient3d_sign(v[0], v[1], v[2], v[3]), signs);
+    const int orientation = orient3d_sign(v[0], v[1], v[2], v[3]);
+    // The box holds the closed tet: a point outside it is outside the tet.
+    if (!box_holds(tet_box(v), p)) {
+        signs.tet = orientation;
+        return false;
+    }
+    return tet_holds_point(TetFaces(v), v, p, orientation, signs);
 }
 
 /// @brief A point's place relative to a tet, in double: barycentric coordinates (of the point when the

@@ -149,6 +149,11 @@ KDET_HD inline Aabb box_union(const Aabb& a, const Aabb& b) { return {min_v(a.lo
 /// @brief Where both boxes are; lo above hi on some axis when they are apart.
 KDET_HD inline Aabb box_intersection(const Aabb& a, const Aabb& b) { return {max_v(a.lo, b.lo), min_v(a.hi, b.hi)}; }
 
+KDET_HD inline bool box_holds(const Aabb& b, vec3 p) {
+    // One branch for the six comparisons: most points a search meets are outside the box.
+    return (p.x >= b.lo.x) & (p.x <= b.hi.x) & (p.y >= b.lo.y) & (p.y <= b.hi.y) & (p.z >= b.lo.z) & (p.z <= b.hi.z);
+}
+
 KDET_HD inline Aabb tet_box(const vec3 v[4]) {
     Aabb b{min_v(min_v(v[0], v[1]), min_v(v[2], v[3])), max_v(max_v(v[0], v[1]), max_v(v[2], v[3]))};
     return b;

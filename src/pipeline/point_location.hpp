@@ -48,11 +48,6 @@ KDET_HD inline float box_extent(const Aabb& b) {
     return max_f(b.hi.x - b.lo.x, max_f(b.hi.y - b.lo.y, b.hi.z - b.lo.z));
 }
 
-KDET_HD inline bool box_holds(const Aabb& b, vec3 p) {
-    // One branch for the six comparisons: most points a tet scans are outside its box.
-    return (p.x >= b.lo.x) & (p.x <= b.hi.x) & (p.y >= b.lo.y) & (p.y <= b.hi.y) & (p.z >= b.lo.z) & (p.z <= b.hi.z);
-}
-
 /// @brief A hashed grid's cells go to its table in blocks of this many neighbours along x: the hash
 /// of (x / block, y, z, layer) picks a block of slots, and the cells of a block take its slots in
 /// order, so that a tet's cells along x are one or two runs of points, as in a dense row.
