@@ -23,6 +23,7 @@
 
 #include "geometry/point_tet.hpp"
 #include "locate_cases.hpp"
+#include "pipeline/point_location.hpp"
 #include "test_support.hpp"
 
 namespace kdet {
@@ -122,6 +123,47 @@ TEST(Locate, BoxMeshSharedFeatures) {
     }
     EXPECT_GE(most, 12u); // an inner vertex of the Kuhn split
     expect_matches_brute_force(mesh, xyz, "box mesh");
+}
+
+TEST(Locate, GroupsJoinTheTetsOfOneCube) {
+    // The six tets of a cube of a cut grid share its box: a group takes them all, and no tet of the
+    // next cube, whose union with them would be twice as long.
+    const TetMesh mesh = make_box_mesh(2, 1, 1, 1.0);
+    ASSERT_EQ(mesh.num_tets(), 12u);
+    std::vector<Aabb> boxes;
+    for (std::size_t t = 0; t < mesh.num_tets(); ++t) {
+        vec3 v[4];
+        float_tet(mesh, t, v);
+        boxes.push_back(tet_box(v));
+    }
+    const auto cube_of = [](const Aabb& b) { return b.lo.x < 0.5f ? 0 : 1; };
+    for (std::size_t a = 0; a < boxes.size(); ++a)
+        for (std::size_t b = 0; b < boxes.size(); ++b)
+            EXPECT_EQ(locate_group_takes(boxes[a], boxes[a].hi - boxes[a].lo, boxes[b]), cube_of(boxes[a]) == cube_of(boxes[b]))
+                << a << " " << b;
+    // A flat box joins a box as wide when the union stays within a quarter more of the widest side.
+    const Aabb square{{0, 0, 0}, {1, 1, 0}};
+    EXPECT_TRUE(locate_group_takes(square, square.hi - square.lo, Aabb{{0, 0, 0.2f}, {1, 1, 0.2f}}));
+    EXPECT_FALSE(locate_group_takes(square, square.hi - square.lo, Aabb{{0, 0, 0.4f}, {1, 1, 0.4f}}));
+}
+
+TEST(Locate, GroupsOfNearlySharedBoxesLoseNoPoint) {
+    // A grid with its vertices moved a little: the boxes of a cube's tets differ but still group, so a
+    // group reads the points of its union, and each tet must keep exactly those it holds, also those
+    // on the faces, edges and corners it shares and just outside its own box.
+    TetMesh mesh = make_box_mesh(5, 4, 3, 0.5);
+    std::mt19937 random(17);
+    std::uniform_real_distribution<double> jitter(-0.04, 0.04);
+    for (double& x : mesh.positions) x += jitter(random);
+    std::vector<double> xyz = test::locate_query_points(mesh, mesh.num_tets(), 3000, 6);
+    for (std::size_t t = 0; t < mesh.num_tets(); ++t) {
+        vec3 v[4];
+        float_tet(mesh, t, v);
+        const Aabb b = tet_box(v);
+        for (const vec3 corner : {b.lo, b.hi, vec3{next_float_down(b.lo.x), b.lo.y, b.lo.z}, vec3{b.hi.x, next_float_up(b.hi.y), b.hi.z}})
+            for (const float c : {corner.x, corner.y, corner.z}) xyz.push_back(c);
+    }
+    expect_matches_brute_force(mesh, xyz, "jittered grid");
 }
 
 TEST(Locate, AnswersFollowThePointsWhateverTheirOrder) {

@@ -229,14 +229,24 @@ KDET_HD inline void for_each_point_in_box(const LocatePointsView& g, const Aabb&
         for (std::uint32_t j = 0; j < count; ++j) visit(key_second(g.keys[held[j]]), g.sorted[held[j]]);
         count = 0;
     };
-    // The points of slots first .. last, those that `own` keeps.
+    // The points of slots first .. last, those that `own` keeps. The loop's state is in locals:
+    // through the references the lambdas share, the compiler reloaded it at every point.
     const auto scan = [&](std::uint32_t first, std::uint32_t last, const auto& own) {
+        const vec3* sorted = g.sorted;
+        const Aabb b = box;
+        std::uint32_t n = count;
         const std::uint32_t end = g.start[last + 1];
         for (std::uint32_t k = g.start[first]; k < end; ++k) {
-            held[count] = k;
-            count += box_holds(box, g.sorted[k]) && own(g.sorted[k]) ? 1u : 0u;
-            if (count == batch) visit_held();
+            const vec3 p = sorted[k];
+            held[n] = k;
+            n += box_holds(b, p) && own(p) ? 1u : 0u;
+            if (n == batch) {
+                count = n;
+                visit_held();
+                n = 0;
+            }
         }
+        count = n;
     };
     for (std::uint32_t z = r.lo[2]; z <= r.hi[2]; ++z)
         for (std::uint32_t y = r.lo[1]; y <= r.hi[1]; ++y) {
@@ -328,32 +338,86 @@ struct HitBatch {
     }
 };
 
+/// @brief A located tet as a group's scan tests it: its vertices, box, orientation and faces.
+struct LocateMember {
+    vec3 v[4];
+    Aabb box;
+    int orientation;
+    point_query::TetFaces faces;
+    std::uint32_t stored;
+    LocateMember() = default;
+    KDET_HD LocateMember(const LocateTetsView& scene, std::uint32_t stored_tet) : stored(stored_tet) {
+        load_stored_tet(scene, stored_tet, v);
+        box = tet_box(v);
+        orientation = point_query::orient3d_sign(v[0], v[1], v[2], v[3]);
+        faces = point_query::TetFaces(v);
+    }
+};
+
+/// @brief Whether a group's scan may take `box` too: the union of its boxes stays, on every axis,
+/// within a quarter more than the largest side along it (or than a quarter of the largest side of
+/// all, for flat boxes). Tets that share a box (the tets of one cube of a cut grid) or nearly so
+/// are then scanned once for all, and a group never reads many points that none of its boxes holds.
+KDET_HD inline bool locate_group_takes(const Aabb& group, vec3 largest_sides, const Aabb& box) {
+    const Aabb joint = box_union(group, box);
+    const vec3 joined = joint.hi - joint.lo;
+    const vec3 sides = max_v(largest_sides, box.hi - box.lo);
+    const float floor = 0.25f * max_f(sides.x, max_f(sides.y, sides.z));
+    return (joined.x <= 1.25f * max_f(sides.x, floor)) & (joined.y <= 1.25f * max_f(sides.y, floor)) &
+           (joined.z <= 1.25f * max_f(sides.z, floor));
+}
+
 /// @brief Per run of located tets (TetRuns, Tuning::search_tets_per_item): a hit for every point a
 /// tet holds (exactly), described here, where its vertices and the point's signs are at hand, and
-/// appended with the run's others; with `held`, marks those points.
+/// appended with the run's others; with `held`, marks those points. Consecutive tets whose boxes
+/// nearly coincide (locate_group_takes, at most group_size) read the points of their boxes' union
+/// once, and each tests those its own box holds.
 template <std::uint32_t TetsPerItem>
 struct LocateContainingKernel {
+    static constexpr std::uint32_t group_size = TetsPerItem < 8 ? TetsPerItem : 8;
     LocateTetsView scene;
     LocatePointsView points;
     HitAppender out;
     std::uint32_t* held; ///< per point, or null
     std::uint32_t tet_count;
+    template <class Batch>
+    KDET_HD void scan_group(const LocateMember* group, std::uint32_t members, const Aabb& box, Batch& batch) const {
+        for_each_point_in_box(points, box, [&](std::uint32_t i, vec3 p) {
+            for (std::uint32_t m = 0; m < members; ++m) {
+                const LocateMember& tet = group[m];
+                point_query::PointTetSigns signs;
+                if (!box_holds(tet.box, p) || !point_query::tet_holds_point(tet.faces, tet.v, p, tet.orientation, signs)) continue;
+                batch.push(i, make_hit(scene, tet.stored, point_query::locate_in_tet(tet.v, p, true, signs)));
+                if (held) atomic_store_relaxed(&held[i], 1u);
+            }
+        });
+    }
     KDET_HD void operator()(std::uint64_t run) const {
         HitBatch<TetsPerItem == 1 ? 1 : 8> batch(&out);
-        TetRuns<TetsPerItem>::for_each_tet(static_cast<std::uint32_t>(run), tet_count, [&](std::uint32_t t) {
-            const std::uint32_t stored = scene.first + t;
-            vec3 v[4];
-            load_stored_tet(scene, stored, v);
-            const int orientation = point_query::orient3d_sign(v[0], v[1], v[2], v[3]);
-            const point_query::TetFaces faces(v);
-            for_each_point_in_box(points, tet_box(v), [&](std::uint32_t i, vec3 p) {
-                point_query::PointTetSigns signs;
-                if (!point_query::tet_holds_point(faces, v, p, orientation, signs)) return;
-                batch.push(i, make_hit(scene, stored, point_query::locate_in_tet(v, p, true, signs)));
-                if (held) atomic_store_relaxed(&held[i], 1u);
+        if constexpr (group_size == 1) {
+            TetRuns<TetsPerItem>::for_each_tet(static_cast<std::uint32_t>(run), tet_count, [&](std::uint32_t t) {
+                const LocateMember tet(scene, scene.first + t);
+                scan_group(&tet, 1, tet.box, batch);
+                return true;
             });
-            return true;
-        });
+        } else {
+            LocateMember group[group_size];
+            std::uint32_t members = 0;
+            Aabb box{};
+            vec3 sides{};
+            TetRuns<TetsPerItem>::for_each_tet(static_cast<std::uint32_t>(run), tet_count, [&](std::uint32_t t) {
+                const LocateMember tet(scene, scene.first + t);
+                if (members == group_size || (members && !locate_group_takes(box, sides, tet.box))) {
+                    scan_group(group, members, box, batch);
+                    members = 0;
+                }
+                box = members ? box_union(box, tet.box) : tet.box;
+                sides = members ? max_v(sides, tet.box.hi - tet.box.lo) : tet.box.hi - tet.box.lo;
+                group[members++] = tet;
+                return true;
+            });
+            if (members) scan_group(group, members, box, batch);
+        }
         batch.flush();
     }
 };
