@@ -6,33 +6,36 @@
 
 #include <algorithm>
 #include <limits>
+#include <memory>
 
 namespace kdet {
 
 std::vector<std::uint32_t> spatial_tet_order(const vec3* positions, const std::uint32_t* tets, std::size_t tet_count, int threads) {
     const auto n = static_cast<std::ptrdiff_t>(tet_count);
-    std::vector<vec3> centroid(tet_count);
+    // Computed twice rather than stored: a second pass over the caller's tets and their vertices
+    // costs less than writing and reading back an array of centroids in fresh memory.
+    const auto centroid = [&](std::ptrdiff_t t) {
+        const std::uint32_t* v = tets + 4 * t;
+        return (positions[v[0]] + positions[v[1]] + positions[v[2]] + positions[v[3]]) * 0.25f;
+    };
     const float inf = std::numeric_limits<float>::infinity();
     float lo_x = inf, lo_y = inf, lo_z = inf, hi_x = -inf, hi_y = -inf, hi_z = -inf;
 #pragma omp parallel for num_threads(threads) if (n > host_parallel_elements) reduction(min : lo_x, lo_y, lo_z) reduction(max : hi_x, hi_y, hi_z)
     for (std::ptrdiff_t t = 0; t < n; ++t) {
-        const std::uint32_t* v = tets + 4 * t;
-        const vec3 c = (positions[v[0]] + positions[v[1]] + positions[v[2]] + positions[v[3]]) * 0.25f;
-        centroid[static_cast<std::size_t>(t)] = c;
+        const vec3 c = centroid(t);
         lo_x = std::min(lo_x, c.x), lo_y = std::min(lo_y, c.y), lo_z = std::min(lo_z, c.z);
         hi_x = std::max(hi_x, c.x), hi_y = std::max(hi_y, c.y), hi_z = std::max(hi_z, c.z);
     }
-    std::vector<std::uint64_t> keys(tet_count);
+    // Left uninitialised: each key is written once, and zeroing fresh memory first costs a pass.
+    const std::unique_ptr<std::uint64_t[]> keys(new std::uint64_t[tet_count]), scratch(new std::uint64_t[tet_count]);
 #pragma omp parallel for num_threads(threads) if (n > host_parallel_elements)
     for (std::ptrdiff_t t = 0; t < n; ++t) {
-        const vec3 c = centroid[static_cast<std::size_t>(t)];
-        const std::uint32_t code = morton_code_in_box(c, vec3{lo_x, lo_y, lo_z}, vec3{hi_x, hi_y, hi_z});
+        const std::uint32_t code = morton_code_in_box(centroid(t), vec3{lo_x, lo_y, lo_z}, vec3{hi_x, hi_y, hi_z});
         keys[static_cast<std::size_t>(t)] = (static_cast<std::uint64_t>(code) << 32) | static_cast<std::uint64_t>(t);
     }
-    std::vector<std::uint64_t> scratch(tet_count);
     // By the codes alone: the keys were made in increasing t, and the sort is stable, so tets of equal
     // codes keep their order as the whole key would order them (three passes of 11 bits instead of six).
-    radix_sort(keys.data(), tet_count, 62, scratch.data(), threads, 32);
+    radix_sort(keys.get(), tet_count, 62, scratch.get(), threads, 32);
     std::vector<std::uint32_t> order(tet_count);
 #pragma omp parallel for num_threads(threads) schedule(static) if (n > host_parallel_elements)
     for (std::ptrdiff_t i = 0; i < n; ++i) order[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(keys[static_cast<std::size_t>(i)] & 0xffffffffu);
