@@ -386,7 +386,9 @@ struct LocateContainingKernel {
             for (std::uint32_t m = 0; m < members; ++m) {
                 const LocateMember& tet = group[m];
                 point_query::PointTetSigns signs;
-                if (!box_holds(tet.box, p) || !point_query::tet_holds_point(tet.faces, tet.v, p, tet.orientation, signs)) continue;
+                // A lone member's box is the scanned box, which already holds p.
+                if (members > 1 && !box_holds(tet.box, p)) continue;
+                if (!point_query::tet_holds_point(tet.faces, tet.v, p, tet.orientation, signs)) continue;
                 batch.push(i, make_hit(scene, tet.stored, point_query::locate_in_tet(tet.v, p, true, signs)));
                 if (held) atomic_store_relaxed(&held[i], 1u);
             }
