@@ -20,6 +20,7 @@
 #include <cstdio>
 #endif
 
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
@@ -163,6 +164,33 @@ TEST(OptionTable, KdetCollideAcceptsAndRefusesEveryOptionItShowsAsTheLibraryDoes
         EXPECT_EQ(refused.exit_code, 2);
         EXPECT_EQ(refused.out, "kdet collide: " + refusal(o, flag, bad) + "\n");
     }
+}
+
+TEST(OptionTable, KdetLocateTakesTheOptionsPointLocationReadsAndRefusesTheOthers) {
+    test::use_default_data_dir();
+    const std::string mesh = data_path("octopus-low.mesh");
+    const std::string out = (std::filesystem::temp_directory_path() / "kdet-option-table-locate.txt").string();
+    const std::string call = "locate " + mesh + " " + mesh + " --out " + out + " ";
+    const std::string help = kdet_cli("locate --help").out;
+    for (const OptionInfo& o : option_table()) {
+        const std::string flag = o.flag;
+        if (!o.shown_on(front_end_locate)) {
+            if (flag.empty()) continue;
+            // A frame's option would change nothing here: refused, not ignored.
+            const CliRun refused = kdet_cli(call + flag + " " + valid_text(o));
+            EXPECT_EQ(refused.exit_code, 2) << flag << ": " << refused.out;
+            EXPECT_EQ(help.find(flag + " "), std::string::npos) << flag;
+            continue;
+        }
+        EXPECT_NE(help.find(flag + " "), std::string::npos) << flag;
+        const CliRun good = kdet_cli(call + flag + " " + valid_text(o));
+        EXPECT_EQ(good.exit_code, 0) << flag << ": " << good.out;
+        const std::string bad = invalid_text(o);
+        const CliRun refused = kdet_cli(call + flag + " " + bad);
+        EXPECT_EQ(refused.exit_code, 2);
+        EXPECT_EQ(refused.out, "kdet locate: " + refusal(o, flag, bad) + "\n");
+    }
+    EXPECT_GE(shown_on(front_end_locate, 4).size(), 4u);
 }
 #endif
 

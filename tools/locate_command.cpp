@@ -72,10 +72,10 @@ int run_locate(int argc, char** argv) {
     parser.flag("--help", help);
     parser.option("--out", "FILE", [&](const std::string& v) { out_path = v; });
     parser.option("--within", "D", [&](const std::string& v) { locate_options.within = parse_within(v); });
-    parser.detector_options(options, front_end_cli);
+    parser.detector_options(options, front_end_locate);
     parser.parse(argc, argv, 2);
     if (help) {
-        std::cout << locate_help << detector_options_help(front_end_cli);
+        std::cout << locate_help << detector_options_help(front_end_locate);
         return exit_ok;
     }
     if (inputs.size() < 2) throw UsageError("locate: expected a mesh and a points file (see 'kdet locate --help')");

@@ -31,6 +31,7 @@ enum FrontEnd : unsigned {
     front_end_view = 1u << 2,   ///< `kdet view`'s command line (long flag)
     front_end_panel = 1u << 3,  ///< the viewer's side panel
     front_end_python = 1u << 4, ///< a keyword of kdet.Detector and the key of Detector.options
+    front_end_locate = 1u << 5, ///< `kdet locate` (long flag): the options point location reads
 };
 
 /// @brief One option of DetectorOptions as every front end sees it.

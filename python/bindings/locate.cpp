@@ -7,6 +7,7 @@
 #include <kdet/error.hpp>
 #include <kdet/locate.hpp>
 #include <kdet/mesh.hpp>
+#include <kdet/option_table.hpp>
 
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/string.h>
@@ -76,6 +77,22 @@ double within_of(nb::handle within) {
     if (!PyFloat_Check(within.ptr()) && !(PyLong_Check(within.ptr()) && !PyBool_Check(within.ptr())))
         throw nb::type_error(("within: expected a float or None, got " + type_label(within)).c_str());
     return nb::cast<double>(within);
+}
+
+/// Refuses the keywords of a detection frame (margin, method, ...), which one-off point location
+/// would ignore; unknown ones are left to the options' own message.
+void refuse_frame_keywords(const nb::kwargs& keywords) {
+    for (auto [key, value] : keywords) {
+        const std::string name = nb::cast<std::string>(key);
+        const OptionInfo* o = find_option(name);
+        if (name == "cuda_stream" || (o && name == o->name && !o->shown_on(front_end_locate))) {
+            std::string taken;
+            for (const OptionInfo& option : option_table())
+                if (option.shown_on(front_end_locate) && option.shown_on(front_end_python))
+                    taken += std::string(taken.empty() ? "" : ", ") + option.name;
+            throw nb::type_error(("locate: keyword '" + name + "' does not apply to point location (it takes " + taken + ")").c_str());
+        }
+    }
 }
 
 } // namespace
@@ -148,6 +165,7 @@ void bind_locate(nb::module_& m, DetectorOptions (*options_from)(const nb::kwarg
     m.def(
         "locate",
         [options_from](const TetMesh& mesh, nb::handle points, nb::handle within, const nb::kwargs& keywords) {
+            refuse_frame_keywords(keywords);
             const DetectorOptions detector_options = options_from(keywords);
             LocateOptions options;
             options.within = within_of(within);

@@ -123,6 +123,13 @@ def test_errors_name_the_argument():
         kdet.locate(mesh, "points")
     with pytest.raises(kdet.Error, match="object id 3"):
         kdet.Detector().locate(np.zeros((1, 3)), object=3)
+    # A frame's options would change nothing: refused by name, not ignored.
+    for keyword in ("margin", "method", "contacts"):
+        with pytest.raises(TypeError, match=f"keyword '{keyword}' does not apply to point location"):
+            kdet.locate(mesh, np.zeros((1, 3)), **{keyword: kdet.Detector().options[keyword]})
+    with pytest.raises(TypeError, match="unexpected keyword argument 'nope'"):
+        kdet.locate(mesh, np.zeros((1, 3)), nope=1)
+    assert len(kdet.locate(mesh, np.zeros((1, 3)), threads=1, hash="fnv-1a").offsets) == 2
 
 
 @pytest.mark.skipif(not kdet.cuda_available(), reason="no CUDA device")

@@ -148,10 +148,10 @@ constexpr long long no_limit = std::numeric_limits<long long>::max();
 
 template <class Enum, Enum DetectorOptions::*member>
 OptionInfo choice(const char* name, const char* field, const char* flag, const char* bench_flag, const char* label,
-                  const char* value_name, const char* help) {
+                  const char* value_name, const char* help, unsigned front_ends) {
     using F = ChoiceField<Enum, member>;
     return OptionInfo{name, field, flag, bench_flag, label, value_name, help, OptionType::choice, 0, 0, nullptr,
-                      every_front_end, &F::get, &F::put, &F::names, &F::read_name};
+                      front_ends, &F::get, &F::put, &F::names, &F::read_name};
 }
 
 template <class Number, Number DetectorOptions::*member>
@@ -187,17 +187,19 @@ constexpr const char* real_expected = "a finite number >= 0";
 const std::vector<OptionInfo>& option_table() {
     using O = DetectorOptions;
     static const std::vector<OptionInfo> table = {
-        choice<Backend, &O::backend>("backend", "backend", "--backend", "--backend", "backend", "B", ""),
-        choice<Method, &O::method>("method", "method", "--method", "-c", "method", "M", ""),
+        choice<Backend, &O::backend>("backend", "backend", "--backend", "--backend", "backend", "B", "",
+                                     every_front_end | front_end_locate),
+        choice<Method, &O::method>("method", "method", "--method", "-c", "method", "M", "", every_front_end),
         choice<NarrowPhase, &O::narrow_phase>("test", "narrow_phase", "--test", "-o", "narrow phase", "T",
-                                              "narrow phase"),
-        choice<HashFunction, &O::hash>("hash", "hash", "--hash", "-h", "hash", "H", "grid hash"),
+                                              "narrow phase", every_front_end),
+        choice<HashFunction, &O::hash>("hash", "hash", "--hash", "-h", "hash", "H", "grid hash",
+                                       every_front_end | front_end_locate),
         number<int, &O::threads>("threads", "--threads", "--threads", "threads", "CPU threads (default: all)",
-                                 OptionType::integer, 1, 1024, nullptr, every_front_end),
+                                 OptionType::integer, 1, 1024, nullptr, every_front_end | front_end_locate),
         number<int, &O::block_size>("block_size", "--block-size", "-g", "block size",
                                     "CUDA threads per block (default 128)", OptionType::integer, 1, 1024, nullptr,
                                     // `kdet bench -g` takes the thesis's sizes only, a few of these.
-                                    every_front_end & ~front_end_bench),
+                                    (every_front_end & ~front_end_bench) | front_end_locate),
         number<std::uint32_t, &O::bucket_capacity>(
             "bucket_capacity", "--bucket-capacity", "--bucket-capacity", "bucket capacity",
             "tet ids per grid bucket before an overflow bucket is chained, 1-4096\n"

@@ -131,5 +131,6 @@ def locate(mesh: MeshLike, points: Any, within: Union[float, None] = None, **opt
     tet holds gets the nearest tet at distance <= d. The hits of point p are rows
     offsets[p]:offsets[p + 1] of the result's arrays (tets, barycentrics, closest_points, distances).
 
-    options are Detector's keyword arguments (backend, threads, ...)."""
+    options are those of Detector's keyword arguments that point location reads (backend, hash,
+    threads, block_size); a detection frame's (margin, method, ...) raise a TypeError."""
     return _kdet.locate(_as_tet_mesh(mesh, "mesh"), points, within, **options)
