@@ -179,10 +179,8 @@ void bind_locate(nb::module_& m, DetectorOptions (*options_from)(const nb::kwarg
             return host_result(std::move(r));
         },
         "mesh"_a, "points"_a, "within"_a = nb::none(), "options"_a,
-        "For each point ((n, 3) float32/float64), every tet of mesh whose closed set holds it, decided exactly "
-        "for the float32 coordinates, with barycentric coordinates; with within=d a point no tet holds gets "
-        "the nearest tet at distance <= d. Returns a LocateResult of NumPy arrays; options are Detector's "
-        "keywords.");
+        "For each point, every tet of mesh whose closed set holds it (kdet.locate, which reads any mesh, says "
+        "more); options are the keywords of Detector that OPTIONS marks 'locate'.");
 }
 
 } // namespace kdet::python

@@ -405,6 +405,7 @@ nb::dict options_table() {
         entry["help"] = o.help;
         entry["flag"] = o.shown_on(front_end_cli) ? nb::cast(o.flag) : nb::none();
         entry["bench_flag"] = o.shown_on(front_end_bench) ? nb::cast(o.bench_flag) : nb::none();
+        entry["locate"] = o.shown_on(front_end_locate);
         table[o.name] = entry;
     }
     return table;

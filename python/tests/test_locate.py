@@ -132,6 +132,19 @@ def test_errors_name_the_argument():
     assert len(kdet.locate(mesh, np.zeros((1, 3)), threads=1, hash="fnv-1a").offsets) == 2
 
 
+def test_locate_takes_the_keywords_the_table_marks_and_its_docstring_names_them():
+    mesh = box_mesh()
+    taken = [name for name, entry in kdet.OPTIONS.items() if entry["locate"]]
+    assert "threads" in taken and "margin" not in taken
+    assert f'marks "locate": {", ".join(taken)}.' in " ".join(kdet.locate.__doc__.split())
+    for name, value in kdet.Detector().options.items():
+        if name in taken:
+            assert len(kdet.locate(mesh, np.zeros((1, 3)), **{name: value}).offsets) == 2
+        else:
+            with pytest.raises(TypeError, match=f"keyword '{name}' does not apply"):
+                kdet.locate(mesh, np.zeros((1, 3)), **{name: value})
+
+
 @pytest.mark.skipif(not kdet.cuda_available(), reason="no CUDA device")
 def test_gpu_locate_matches_cpu():
     mesh = box_mesh()

@@ -25,7 +25,7 @@ The benchmark scenes of `kdet bench` (scene_names(): tearing, heap, drape, ...),
 
 Two tets collide when their closed sets share a point; tets of one object that share a vertex are
 adjacent and never reported. OPTIONS describes every keyword of Detector (and of collide()): its
-type, default, choices or range, help, and its flags on the command line. Names are those of
+type, default, choices or range, help, its flags on the command line, and whether locate() reads it. Names are those of
 BACKENDS, METHODS, TESTS and HASHES (any case, '-' or '_'). Bad input raises kdet.Error (a ValueError) with the library's one-line message;
 wrong types raise TypeError naming the argument.
 """
@@ -131,6 +131,10 @@ def locate(mesh: MeshLike, points: Any, within: Union[float, None] = None, **opt
     tet holds gets the nearest tet at distance <= d. The hits of point p are rows
     offsets[p]:offsets[p + 1] of the result's arrays (tets, barycentrics, closest_points, distances).
 
-    options are those of Detector's keyword arguments that point location reads (backend, hash,
-    threads, block_size); a detection frame's (margin, method, ...) raise a TypeError."""
+    options are the keyword arguments of Detector that point location reads, those OPTIONS marks
+    "locate": {keywords}. A detection frame's (margin, method, ...) raise a TypeError."""
     return _kdet.locate(_as_tet_mesh(mesh, "mesh"), points, within, **options)
+
+
+if locate.__doc__:  # None under python -OO
+    locate.__doc__ = locate.__doc__.format(keywords=", ".join(n for n, entry in OPTIONS.items() if entry["locate"]))
