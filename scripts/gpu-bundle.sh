@@ -83,12 +83,13 @@ for program in "$bundle"/kdet*; do
     xargs -r cp -Ln -t "$bundle/lib/"
 done
 # The device tool carries 64 MiB with the working tree: the programs go without their symbols (Nsight
-# Compute names the kernels from the device code) and packed with xz, about a third of their size
-# (scripts/gpu-session.sh unpacks them; by hand there: `xz -dc .gpu-bundle/kdet.xz >/tmp/kdet`). With
-# many older builds, drop what a call does not run (the peers, the tests) until `du` below and the
-# tree fit.
+# Compute names the kernels from the device code) and in one xz archive, whose 64 MiB window holds
+# the library's code that every program links once: a quarter of packing each alone (24 -> 5.9 MB
+# at 9082c18). scripts/gpu-session.sh unpacks it; by hand there:
+# `tar -C /tmp -xJf .gpu-bundle/programs.tar.xz kdet`. With many older builds, drop what a call does
+# not run (the peers, the tests) until `du` below and the tree fit.
 strip "$bundle"/kdet*
-xz -T0 -6 "$bundle"/kdet*
+(cd "$bundle" && tar -cf - kdet* | xz -T0 -9 >programs.tar.xz && rm kdet*)
 git -C "$repo" log -1 --format='built at commit %H %s' >"$bundle/commit.txt"
 git -C "$repo" status --short --untracked-files=no >>"$bundle/commit.txt"
 tar -C "$data_dir" -cJf "$bundle/models.tar.xz" .

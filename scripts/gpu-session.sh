@@ -50,10 +50,7 @@ bin="$work/bin" # the bundle's programs, unpacked
 mkdir -p "$out" "$work/models" "$work/cache" "$work/bench" "$bin"
 tar -C "$work/models" -xJf "$bundle/models.tar.xz"
 tar -C "$work/cache" -xJf "$bundle/cache.tar.xz"
-for packed in "$bundle"/kdet*.xz; do
-  program="$bin/$(basename "$packed" .xz)"
-  xz -dc "$packed" >"$program" && chmod +x "$program"
-done
+tar -C "$bin" -xJf "$bundle/programs.tar.xz"
 [[ ! -f "$bundle/lib.tar.xz" ]] || tar -C "$work" -xJf "$bundle/lib.tar.xz"
 export LD_LIBRARY_PATH="$work/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export KDET_DATA_DIR="$work/models" KDET_CACHE_DIR="$work/cache"
