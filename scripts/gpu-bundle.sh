@@ -84,8 +84,8 @@ for program in "$bundle"/kdet*; do
 done
 # The device tool carries 64 MiB with the working tree: the programs go without their symbols (Nsight
 # Compute names the kernels from the device code) and in one xz archive, whose 64 MiB window holds
-# the library's code that every program links once: a quarter of packing each alone (24 -> 5.9 MB
-# at 9082c18). scripts/gpu-session.sh unpacks it; by hand there:
+# the library's code that every program links once (sizes: docs/performance.md).
+# scripts/gpu-session.sh unpacks it; by hand there:
 # `tar -C /tmp -xJf .gpu-bundle/programs.tar.xz kdet`. With many older builds, drop what a call does
 # not run (the peers, the tests) until `du` below and the tree fit.
 strip "$bundle"/kdet*
