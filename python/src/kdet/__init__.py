@@ -25,9 +25,10 @@ The benchmark scenes of `kdet bench` (scene_names(): tearing, heap, drape, ...),
 
 Two tets collide when their closed sets share a point; tets of one object that share a vertex are
 adjacent and never reported. OPTIONS describes every keyword of Detector (and of collide()): its
-type, default, choices or range, help, its flags on the command line, and whether locate() reads it. Names are those of
-BACKENDS, METHODS, TESTS and HASHES (any case, '-' or '_'). Bad input raises kdet.Error (a ValueError) with the library's one-line message;
-wrong types raise TypeError naming the argument.
+type, default, choices or range, help, its flags on the command line, and whether locate() reads
+it. Names are those of BACKENDS, METHODS, TESTS and HASHES (any case, '-' or '_'). Bad input raises
+kdet.Error (a ValueError) with the library's one-line message; wrong types raise TypeError naming
+the argument.
 """
 
 from __future__ import annotations
