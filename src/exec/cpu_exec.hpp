@@ -24,44 +24,57 @@ namespace kdet {
 
 namespace host_memory {
 
-struct Free {
-    void operator()(void* p) const { std::free(p); }
-};
-
-/// Uninitialised memory for `count` objects of `size` bytes aligned to `alignment` (a power of two);
-/// throws std::bad_alloc when it cannot. Plain pages, no huge-page advice: since layer 0's cells hold
-/// dozens of tets the frames gain little from it, where a one-off query's first touch of fresh memory
-/// took far longer with it in a VM that returns free memory to its host (docs/performance.md).
-inline void* allocate(std::size_t count, std::size_t size, std::size_t alignment) {
-    if (count > std::numeric_limits<std::size_t>::max() / size) throw std::bad_alloc();
-    const std::size_t bytes = count * size;
-    void* p = nullptr;
-    if (alignment > alignof(std::max_align_t)) {
-        p = std::aligned_alloc(alignment, (std::max<std::size_t>(bytes, 1) + alignment - 1) / alignment * alignment);
-    } else {
-        p = std::malloc(bytes == 0 ? 1 : bytes);
+/// @brief The heap: HostBuffer's memory unless it is given another source (the tests give one).
+struct Heap {
+    /// Uninitialised memory for `count` objects of `size` bytes aligned to `alignment` (a power of
+    /// two); throws std::bad_alloc when it cannot. Plain pages, no huge-page advice: since layer 0's
+    /// cells hold dozens of tets the frames gain little from it, where a one-off query's first touch of
+    /// fresh memory took far longer with it in a VM that returns free memory to its host
+    /// (docs/performance.md).
+    static void* allocate(std::size_t count, std::size_t size, std::size_t alignment) {
+        if (count > std::numeric_limits<std::size_t>::max() / size) throw std::bad_alloc();
+        const std::size_t bytes = count * size;
+        void* p = nullptr;
+        if (alignment > alignof(std::max_align_t)) {
+            p = std::aligned_alloc(alignment, (std::max<std::size_t>(bytes, 1) + alignment - 1) / alignment * alignment);
+        } else {
+            p = std::malloc(bytes == 0 ? 1 : bytes);
+        }
+        if (!p) throw std::bad_alloc();
+        return p;
     }
-    if (!p) throw std::bad_alloc();
-    return p;
-}
+    static void release(void* p, std::size_t /*bytes*/) { std::free(p); }
+};
 
 } // namespace host_memory
 
 /// @brief Growable array that keeps its memory between frames; contents are not preserved on growth.
 /// Elements are left uninitialised (every buffer of the pipeline is written before it is read).
-template <class T>
+/// `Memory` provides allocate(count, size, alignment), throwing std::bad_alloc, and release(p, bytes).
+template <class T, class Memory = host_memory::Heap>
 class HostBuffer {
     static_assert(std::is_trivially_default_constructible<T>::value && std::is_trivially_destructible<T>::value,
                   "HostBuffer holds plain data: its memory is neither constructed nor destroyed");
 
 public:
+    HostBuffer() = default;
+    HostBuffer(const HostBuffer&) = delete;
+    HostBuffer& operator=(const HostBuffer&) = delete;
+    HostBuffer(HostBuffer&& other) noexcept { swap(other); }
+    HostBuffer& operator=(HostBuffer&& other) noexcept {
+        swap(other);
+        return *this;
+    }
+    ~HostBuffer() { Memory::release(data_, capacity_ * sizeof(T)); }
+
     /// @brief Makes room for n elements; discards the old contents when it has to reallocate.
     /// A failed allocation (std::bad_alloc) leaves the buffer empty, never a size without memory.
     void resize_discard(std::size_t n) {
         if (n > capacity_) {
-            data_.reset();
+            Memory::release(data_, capacity_ * sizeof(T));
+            data_ = nullptr;
             size_ = capacity_ = 0;
-            data_.reset(static_cast<T*>(host_memory::allocate(n, sizeof(T), alignof(T))));
+            data_ = static_cast<T*>(Memory::allocate(n, sizeof(T), alignof(T)));
             capacity_ = n;
         }
         size_ = n;
@@ -78,17 +91,17 @@ public:
     }
     /// @brief Exchanges the memory of two buffers (growing one while keeping its contents).
     void swap(HostBuffer& other) noexcept {
-        data_.swap(other.data_);
+        std::swap(data_, other.data_);
         std::swap(size_, other.size_);
         std::swap(capacity_, other.capacity_);
     }
-    T* data() { return data_.get(); }
-    const T* data() const { return data_.get(); }
+    T* data() { return data_; }
+    const T* data() const { return data_; }
     std::size_t size() const { return size_; }
     std::size_t capacity_bytes() const { return capacity_ * sizeof(T); }
 
 private:
-    std::unique_ptr<T, host_memory::Free> data_;
+    T* data_ = nullptr;
     std::size_t size_ = 0;
     std::size_t capacity_ = 0;
 };
