@@ -1,6 +1,7 @@
 // Positions handed over in the backend's memory and results left there. On the CPU backend the
 // backend's memory is host memory, so the same calls are checked here on every machine.
 
+#include "device_like_exec.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -60,6 +61,7 @@ TEST(DeviceApi, ResultsLeftInBackendMemoryEqualTheHostResults) {
     EXPECT_EQ(r.counts.colliding_tets, expected.counts.colliding_tets);
 
     const DeviceResults dr = device.device_results();
+    const device_like::BackendMemoryReadable readable;
     ASSERT_EQ(dr.pair_count, expected.pairs.size());
     ASSERT_EQ(dr.tet_count, a.num_tets() + b.num_tets());
     ASSERT_NE(dr.contacts, nullptr);
@@ -126,9 +128,12 @@ TEST(DeviceApi, NonFinitePositionsInBackendMemoryAreRejectedByTheNextFrameAndNev
     // Handing them over waits for nothing; the frame that checks them says which vertex is bad.
     detector.set_positions_on_device(id, xyz.data(), b.num_vertices());
     expect_error_naming([&] { detector.detect(); }, "object 1: vertex 7 of the positions given on the device");
-    DeviceResults discarded = detector.device_results();
-    EXPECT_EQ(discarded.pair_count, 0u);
-    for (std::size_t t = 0; t < discarded.tet_count; ++t) ASSERT_EQ(discarded.colliding[t], 0u) << t;
+    {
+        DeviceResults discarded = detector.device_results();
+        const device_like::BackendMemoryReadable readable;
+        EXPECT_EQ(discarded.pair_count, 0u);
+        for (std::size_t t = 0; t < discarded.tet_count; ++t) ASSERT_EQ(discarded.colliding[t], 0u) << t;
+    }
     // The rejected positions never became current: the detector still sees the last good ones.
     EXPECT_EQ(detector.detect().pairs, before);
 

@@ -5,6 +5,7 @@
 #include "exec/tuning.hpp"
 #include "near_touching.hpp"
 #include "pipeline/pipeline.hpp"
+#include "device_like_exec.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -681,12 +682,15 @@ TEST(Detector, DetectAsyncWaitsForNothingAndFinishWaitsOnce) {
         if (to_host) {
             EXPECT_EQ(r.pairs, expected.pairs);
         }
-        const DeviceResults device = detector.device_results();
-        ASSERT_EQ(device.pair_count, expected.pairs.size());
-        for (std::size_t k = 0; k < device.pair_count; ++k) {
-            const TetPair& p = expected.pairs[k];
-            EXPECT_EQ(device.pair_keys[k], (std::uint64_t{detector.first_tet(p.object_a) + p.tet_a} << 32) |
-                                               (detector.first_tet(p.object_b) + p.tet_b));
+        {
+            const DeviceResults device = detector.device_results();
+            const device_like::BackendMemoryReadable readable;
+            ASSERT_EQ(device.pair_count, expected.pairs.size());
+            for (std::size_t k = 0; k < device.pair_count; ++k) {
+                const TetPair& p = expected.pairs[k];
+                EXPECT_EQ(device.pair_keys[k], (std::uint64_t{detector.first_tet(p.object_a) + p.tet_a} << 32) |
+                                                   (detector.first_tet(p.object_b) + p.tet_b));
+            }
         }
         // A second detect_async() finishes the first before it starts: no frame goes unchecked.
         detector.detect_async();
@@ -827,6 +831,7 @@ TEST(Detector, FlagsClearWhenObjectsSeparateAfterColliding) {
         EXPECT_EQ(r.counts.colliding_tets, 0u);
         for (const auto& flags : r.colliding) EXPECT_EQ(std::count(flags.begin(), flags.end(), 1), 0);
         const DeviceResults device = detector.device_results();
+        const device_like::BackendMemoryReadable readable;
         EXPECT_EQ(std::count_if(device.colliding, device.colliding + device.tet_count,
                                 [](std::uint32_t f) { return f != 0; }),
                   0);

@@ -1,5 +1,6 @@
 // The order in which the pipeline stores tets, and that results still use the caller's numbering.
 
+#include "device_like_exec.hpp"
 #include "test_support.hpp"
 
 #include "geometry/tet_intersect.hpp"
@@ -133,6 +134,7 @@ TEST(SpatialOrder, PairsFlagsAndContactsUseTheCallersNumbering) {
                   static_cast<std::uint64_t>(std::count(r.colliding[0].begin(), r.colliding[0].end(), 1) +
                                              std::count(r.colliding[1].begin(), r.colliding[1].end(), 1)));
         const DeviceResults device = detector.device_results();
+        const device_like::BackendMemoryReadable readable;
         ASSERT_EQ(device.pair_count, expected.size());
         for (std::size_t k = 0; k < expected.size(); ++k)
             EXPECT_EQ(device.pair_keys[k], (std::uint64_t{expected[k].tet_a} << 32) |

@@ -2,6 +2,7 @@
 // brute force on the meshes as they are now, on any buffer size, and on the GPU as on the CPU.
 
 #include "filter_support.hpp"
+#include "device_like_exec.hpp"
 #include "test_support.hpp"
 
 #include <kdet/detector.hpp>
@@ -78,6 +79,7 @@ std::pair<TetMesh, TetMesh> split(const TetMesh& mesh, std::mt19937& rng) {
 /// A frame's pairs read from DeviceResults (host memory on the CPU backend) through first_tet().
 std::vector<TetPair> pairs_through_first_tet(const Detector& detector, const Objects& objects) {
     const DeviceResults device = detector.device_results();
+    const device_like::BackendMemoryReadable readable;
     std::vector<TetPair> pairs;
     const std::vector<ObjectId> ids = objects.live();
     const auto locate = [&](std::uint32_t global, std::uint32_t& object, std::uint32_t& tet) {

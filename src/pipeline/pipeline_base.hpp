@@ -155,6 +155,10 @@ public:
 };
 
 std::unique_ptr<PipelineBase> make_cpu_pipeline(const DetectorOptions& options);
+/// @brief A test seam: while set, make_cpu_pipeline() returns what `factory` builds (nullptr restores
+/// the CPU backend's own), so that the tests can run every Detector over another execution layer.
+using PipelineFactory = std::unique_ptr<PipelineBase> (*)(const DetectorOptions&);
+void set_cpu_pipeline_factory(PipelineFactory factory);
 /// @brief Throws kdet::Error when kdet was built without CUDA or no CUDA device is present.
 std::unique_ptr<PipelineBase> make_cuda_pipeline(const DetectorOptions& options);
 
