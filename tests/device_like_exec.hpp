@@ -5,8 +5,8 @@
 /// execution layer's calls (a kernel, a sort, an upload or download) runs, and it says its memory is
 /// not the host's, so that the pipeline takes the paths it takes on CUDA. Host code of the pipeline
 /// that reads or writes a buffer directly, or reads a landed download after the staging was reused,
-/// then fails on the CPU, where without a GPU it would pass unseen. Not caught: a kernel given host
-/// memory, which a GPU cannot read.
+/// then fails on the CPU, where without a GPU it would pass unseen; a stage that reads what no stage
+/// wrote likely answers otherwise. Not caught: a kernel given host memory, which a GPU cannot read.
 
 #include "exec/cpu_exec.hpp"
 
@@ -162,12 +162,21 @@ private:
 /// backend) directly, where a CUDA user would copy them out first.
 using BackendMemoryReadable = GuardedArena::Opened;
 
-/// @brief HostBuffer's memory from the guarded arena (page-aligned, so any alignment holds).
+/// @brief HostBuffer's memory from the guarded arena (page-aligned, so any alignment holds). Fresh
+/// device memory holds whatever was there before, where the heap's large blocks come zeroed: a
+/// buffer of up to 256 MiB starts filled with a pattern, so that a stage that reads what no stage
+/// wrote gives other answers here (larger ones stay untouched, uncommitted, as tests of memory
+/// limits ask for them).
 struct GuardedMemory {
     static void* allocate(std::size_t count, std::size_t size, std::size_t /*alignment*/) {
         if (count > static_cast<std::size_t>(-1) / size) throw std::bad_alloc();
-        void* p = GuardedArena::instance().allocate(count * size);
+        const std::size_t bytes = count * size;
+        void* p = GuardedArena::instance().allocate(bytes);
         if (!p) throw std::bad_alloc();
+        if (bytes <= std::size_t{256} << 20) {
+            const GuardedArena::Opened opened;
+            std::memset(p, 0xA5, bytes);
+        }
         return p;
     }
     static void release(void* p, std::size_t bytes) { GuardedArena::instance().release(p, bytes); }

@@ -100,6 +100,19 @@ TEST(DeviceLikeMemory, HostCodeTouchingABufferOutsideALayerCallDies) {
     EXPECT_DEATH({ std::printf("%u\n", static_cast<unsigned>(data[3])); }, "host code touched device-like memory");
 }
 
+TEST(DeviceLikeMemory, AFreshBufferHoldsAPatternNotZeros) {
+    skip_without_arena();
+    const DeviceLikeExec exec{DetectorOptions{}};
+    for (int round = 0; round < 2; ++round) { // the second reuses the pages the first gave back
+        GuardedBuffer<std::uint32_t> buffer;
+        buffer.resize_discard(5000);
+        std::vector<std::uint32_t> host(buffer.size());
+        exec.download(host.data(), buffer.data(), host.size());
+        EXPECT_EQ(std::count(host.begin(), host.end(), 0xA5A5A5A5u), 5000) << round;
+        exec.for_each(host.size(), [data = buffer.data()](std::uint64_t i) { data[i] = 0; });
+    }
+}
+
 TEST(DeviceLikeMemory, ALandedDownloadIsReadBeforeTheNextDownload) {
     skip_without_arena();
     const DeviceLikeExec exec{DetectorOptions{}};
