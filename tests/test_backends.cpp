@@ -5,6 +5,7 @@
 
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
+#include <kdet/locate.hpp>
 #include <kdet/scenes.hpp>
 
 #include <gtest/gtest.h>
@@ -166,6 +167,37 @@ TEST_F(CudaBackend, ThesisSceneFramesMatchTheCpu) {
 }
 
 #if defined(KDET_HAS_CUDA)
+TEST_F(CudaBackend, PageableHostMemoryGivenAsTheDevicesIsRefusedWhereTheGpuCannotReadIt) {
+    const TetMesh a = test::random_soup(2000, 3.0, 1.0, 101), b = test::moved(a, 0.3, 0.2, 0.0, 0.0);
+    DetectorOptions o;
+    o.backend = Backend::cuda;
+    Detector detector(o);
+    detector.add_object(a);
+    const ObjectId ib = detector.add_object(b);
+    const std::vector<float> xyz(b.positions.begin(), b.positions.end()); // pageable: std::vector's
+    const std::vector<double> points(a.positions.begin(), a.positions.begin() + 30);
+    const PositionsView host_points{points.data(), true, 10};
+    const FrameResult expected = detector.detect();
+    ASSERT_FALSE(expected.pairs.empty());
+    const LocateResult expected_hits = detector.locate(host_points, all_objects);
+    int device = 0, pageable_access = 0;
+    ASSERT_EQ(cudaGetDevice(&device), cudaSuccess);
+    ASSERT_EQ(cudaDeviceGetAttribute(&pageable_access, cudaDevAttrPageableMemoryAccess, device), cudaSuccess);
+    if (pageable_access) { // HMM or ATS: the GPU reads it, and it is used as any device memory
+        detector.set_positions_on_device(ib, xyz.data(), b.num_vertices());
+        EXPECT_EQ(detector.detect().pairs, expected.pairs);
+        EXPECT_EQ(detector.locate_on_device(host_points, all_objects, {}).tets, expected_hits.tets);
+        return;
+    }
+    const std::string positions_error = test::error_message([&] { detector.set_positions_on_device(ib, xyz.data(), b.num_vertices()); });
+    EXPECT_NE(positions_error.find("set_positions_on_device: the positions lie in pageable host memory"), std::string::npos)
+        << positions_error;
+    const std::string points_error = test::error_message([&] { detector.locate_on_device(host_points, all_objects, {}); });
+    EXPECT_NE(points_error.find("locate_on_device: the points lie in pageable host memory"), std::string::npos)
+        << points_error;
+    EXPECT_EQ(detector.detect().pairs, expected.pairs); // the detector carries on as before
+}
+
 TEST_F(CudaBackend, DevicePositionsAndDeviceResultsNeverPassThroughTheHost) {
     const TetMesh a = test::random_soup(3000, 5.0, 2.0, 97), b = test::random_soup(3000, 5.0, 2.0, 98);
     DetectorOptions o;

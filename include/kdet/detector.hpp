@@ -96,7 +96,7 @@ public:
     /// detection uses none of the positions given this way, keeps the objects' previous ones, and its
     /// detect() or finish() throws kdet::Error naming the object and vertex. Throws at once on a wrong
     /// vertex count, null data, strides whose extent overflows, or (Backend::cuda) memory of another
-    /// CUDA device than the detector's.
+    /// CUDA device than the detector's, or pageable host memory on a GPU that cannot read it.
     /// The first form takes x y z float per vertex; the second any layout, float32 or float64 (a
     /// strided or float64 array is gathered into float32 by the backend, on the same stream).
     void set_positions_on_device(ObjectId object, const float* positions, std::size_t vertex_count);

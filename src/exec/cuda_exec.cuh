@@ -424,17 +424,29 @@ public:
             cuda_check(cudaMemcpyAsync(destination, source, n * sizeof(T), cudaMemcpyDeviceToDevice, stream_),
                        "device copy");
     }
-    /// @brief Throws kdet::Error when `data`, handed in as device memory, belongs to another CUDA
-    /// device than the current one, whose kernels would fault on it; `what` names it in the message.
+    /// @brief Throws kdet::Error when `data`, handed in as device memory, is memory the current
+    /// device's kernels would fault on: another CUDA device's, or pageable host memory where the
+    /// device cannot read it (no HMM or ATS); `what` names it in the message.
     void check_readable(const void* data, const char* what) const {
         cudaPointerAttributes attributes{};
         if (cudaPointerGetAttributes(&attributes, data) != cudaSuccess) {
             cudaGetLastError(); // not memory CUDA knows: clear the error, the copy reports its own
             return;
         }
-        if (attributes.type != cudaMemoryTypeDevice && attributes.type != cudaMemoryTypeManaged) return;
         int device = 0;
         cuda_check(cudaGetDevice(&device), "cudaGetDevice");
+        if (attributes.type == cudaMemoryTypeUnregistered) {
+            int pageable_access = 0;
+            cuda_check(cudaDeviceGetAttribute(&pageable_access, cudaDevAttrPageableMemoryAccess, device),
+                       "cudaDeviceGetAttribute");
+            if (!pageable_access)
+                throw Error(std::string(what) +
+                            " lie in pageable host memory, which this GPU cannot read: hand host memory to "
+                            "set_positions() or locate(), or allocate it with cudaMalloc, cudaMallocManaged or "
+                            "cudaMallocHost");
+            return;
+        }
+        if (attributes.type != cudaMemoryTypeDevice && attributes.type != cudaMemoryTypeManaged) return;
         if (attributes.device != device)
             throw Error(std::string(what) + " lie in the memory of CUDA device " + std::to_string(attributes.device) +
                         ", the detector runs on device " + std::to_string(device));
