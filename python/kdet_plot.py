@@ -267,8 +267,15 @@ def plot_folder(folder: str, out: str) -> list[str]:
     return written
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """Usage mistakes in one line and exit 2, as every kdet command reports them."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: {message} (see '{self.prog} --help')\n")
+
+
 def main() -> int:
-    parser = argparse.ArgumentParser(description="Figures from the CSV files of kdet bench.")
+    parser = OneLineParser(prog="kdet plot", description="Figures from the CSV files of kdet bench.")
     parser.add_argument("folder", help="folder with the CSV files of kdet bench")
     parser.add_argument("--out", help="folder for the PNG files (default: FOLDER/plots)")
     args = parser.parse_args()

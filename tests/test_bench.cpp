@@ -321,7 +321,7 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
                                                   "#frames",           "first frame", "total runs", "#tetsA",
                                                   "#tetsB",            "#verticesA", "#verticesB"};
     const std::vector<std::string> more_keys = {"#objects", "#tets", "backend", "threads", "bucket capacity", "exclusion rings",
-                                                "collision filters", "device", "compiler", "compiler flags",
+                                                "collision filters", "margin", "device", "compiler", "compiler flags",
                                                 "kdet version", "peak memory bytes", "time unit"};
     std::vector<std::string> keys;
     std::map<std::string, std::string> header;
@@ -339,6 +339,7 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     EXPECT_EQ(header["self collisions"], "yes");
     EXPECT_EQ(header["exclusion rings"], "0");
     EXPECT_EQ(header["collision filters"], "on");
+    EXPECT_EQ(header["margin"], "0");
     EXPECT_EQ(header["#frames"], "3");
     EXPECT_EQ(header["first frame"], "1");
     EXPECT_EQ(header["total runs"], "2");
@@ -354,6 +355,16 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     }
     EXPECT_NE(outcome.stem.find("procedural_r1_kdet_sat_djb2_g128_self-yes_cpu_"), std::string::npos) << outcome.stem;
     EXPECT_NE(outcome.stem.find("tets_f1-3"), std::string::npos) << outcome.stem;
+    EXPECT_EQ(outcome.stem.find("margin"), std::string::npos) << outcome.stem;
+
+    // A margin reports more pairs: its runs are named apart and say which margin they took.
+    BenchConfig within = config;
+    within.options.margin = 0.05f;
+    const BenchOutcome near = run_benchmark(within, *scene, progress);
+    EXPECT_NE(near.stem.find("tets_f1-3_margin0.05"), std::string::npos) << near.stem;
+    const std::map<std::string, std::string> near_header(near.header.begin(), near.header.end());
+    EXPECT_EQ(near_header.at("margin"), "0.05");
+    EXPECT_GT(value_of(near.runs[0][0], "collision pairs"), value_of(outcome.runs[0][0], "collision pairs"));
 
     config.options.method = Method::brute_force_loop;
     config.first_frame = 0;

@@ -226,7 +226,11 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
     const std::string bunny = data_path("bunny.mesh");
     const std::string bad_mesh = (dir / "bad.mesh").string();
     const BadCall calls[] = {
-        {"collide --frobnicate", 2, "unknown option '--frobnicate'"},
+        {"collide --frobnicate", 2, "unknown option '--frobnicate' (see 'kdet collide --help')"},
+        {"collide BUNNY BUNNY --within 1", 2, "kdet collide: unknown option '--within'"},
+        {"collide BUNNY BUNNY --margin 0x10", 2, "invalid value '0x10' for --margin"},
+        {"collide BUNNY BUNNY --threads ' 2'", 2, "invalid value ' 2' for --threads"},
+        {"locate BUNNY BUNNY --out x.txt --margin 0.1", 2, "kdet locate: unknown option '--margin'"},
         {"collide a.mesh b.mesh --method fastest", 2, "invalid value 'fastest' for --method"},
         {"collide a.mesh b.mesh --threads 0", 2, "--threads"},
         {"collide a.mesh b.mesh --threads", 2, "'--threads' needs a value"},
@@ -247,8 +251,13 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
         {"bench --backend gpu", 2, "invalid value 'gpu' for --backend"},
         {"bench --threads 0", 2, "invalid value '0' for --threads"},
         {"bench --bucket-capacity 5000", 2, "invalid value '5000' for --bucket-capacity"},
-        {"bench --frames 5:2", 2, "invalid value '5:2' for --frames"},
-        {"bench --tets 300 --scene-frames 9 --frames 3:9", 2, "for --frames: scene 'procedural' has frames 0 to 8"},
+        {"bench --frames 5:2", 2, "kdet bench: invalid value '5:2' for --frames"},
+        {"bench --tets 300 --scene-frames 9 --frames 3:9", 2,
+         "kdet bench: invalid value '3:9' for --frames: scene 'procedural' has frames 0 to 8"},
+        {"bench -d ''", 2, "kdet bench: invalid value '' for -d"},
+        {"bench /nonexistent/x.scene", 1, "kdet: error: /nonexistent/x.scene: cannot open scene file"},
+        {"bench /nonexistent/x.kdetrec", 1, "kdet: error: /nonexistent/x.kdetrec: cannot open file"},
+        {"prepare dragon", 2, "kdet prepare: invalid value 'dragon' for MODEL"},
         {"bench --tets 5", 2, "--tets"},
         {"bench nosuchscene", 2, "unknown scene 'nosuchscene'"},
         {"bench nosuchscene --tets 500", 2, "--tets applies to the procedural scene only"},

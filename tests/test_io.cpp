@@ -574,6 +574,22 @@ TEST(IoErrors, NoTetrahedra) {
     expect_file_error([&] { kdet::read_tetgen(ele); }, ele, 1, "no tetrahedra");
 }
 
+TEST(ReadPoints, AMeshFileGivesItsVerticesWhateverItsTets) {
+    TempDir dir;
+    kdet::TetMesh flat;  // one tet with its four corners in a plane
+    flat.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    flat.tets = {0, 1, 2, 3};
+    const std::string stem = dir.file_path("flat"), medit = dir.file_path("flat.mesh");
+    kdet::write_tetgen(flat, stem);
+    kdet::write_medit(flat, medit);
+    EXPECT_THROW(kdet::read_tet_mesh(medit), kdet::Error);
+    for (const std::string& path : {stem, stem + ".node", stem + ".ele", medit})
+        EXPECT_EQ(kdet::read_points(path), flat.positions) << path;
+    // A name that is neither a file nor a TetGen stem is read as a points file, and cannot be opened.
+    EXPECT_NE(error_message([&] { kdet::read_points(dir.file_path("none")); }).find("none: cannot open file"),
+              std::string::npos);
+}
+
 TEST(IoErrors, AbsurdAndNegativeCounts) {
     TempDir dir;
     // Far more vertices than the file holds: reported as truncation without reserving that much memory.

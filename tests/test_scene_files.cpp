@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <ostream>
@@ -55,6 +56,27 @@ TEST(SceneFile, ErrorsNameFileAndLine) {
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n"), "s.scene:3: object 'a' has no 'mesh' or 'file'");
     EXPECT_EQ(parse_error("kdet-scene 1\nobject a\n mesh bunny\n"), "s.scene:3: the scene sets no 'frames'");
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 2\nobject a\n twist w\n"), "s.scene:4: 'w' is not an axis (x, y or z)");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 2\nobject a\n squash y\n key 1 squash 0.95\n"),
+              "s.scene:5: squash 0.95 is outside (-1, 0.9)");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 2\nobject a\n squash y\n key 1 move 0 0 0 squash -1\n"),
+              "s.scene:5: squash -1 is outside (-1, 0.9)");
+}
+
+TEST(SceneFile, MistakesFoundWhilePlayingNameFileAndLine) {
+    const fs::path dir = fresh_dir("playing");
+    write_tetgen(make_box_mesh(2, 2, 2, 0.1), (dir / "box").string());
+    std::ofstream(dir / "far.scene") << "kdet-scene 1\nframes 3\nobject a\n file box.node\nobject b\n"
+                                        " file box.node\n key 0 move 0 0 0\n key 2 move 1e300 0 0\n";
+    const auto far = read_scene_file((dir / "far.scene").string());
+    std::vector<float> positions;
+    far->positions(1, 0, positions);
+    const std::string path = (dir / "far.scene").string();
+    EXPECT_EQ(error_message([&] { far->positions(1, 2, positions); }),
+              path + ":5: object 'b' at frame 2 has a coordinate beyond float's range (+-3.4e38)");
+    fs::create_directories(dir / "folder.scene");
+    EXPECT_EQ(error_message([&] { read_scene_file((dir / "folder.scene").string()); }),
+              (dir / "folder.scene").string() + ": cannot open scene file (it is a directory)");
+    fs::remove_all(dir);
 }
 
 TEST(SceneFile, KeysInterpolateSmoothly) {
@@ -182,6 +204,45 @@ TEST(RecordedScene, BinaryRecordingPlaysBackExactly) {
     // A cut-off file is refused when opened.
     fs::resize_file(path, fs::file_size(path) - 5);
     EXPECT_THROW(read_recording(path), Error);
+    fs::remove_all(dir);
+}
+
+std::string recording_error(const std::string& path) {
+    try {
+        read_recording(path);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+TEST(RecordedScene, CountsTheFileCannotHoldAreRefusedBeforeAnythingIsReserved) {
+    // Without the check against the file's size, these counts reserve 64 GB for the tets, 103 GB for
+    // the positions: std::bad_alloc (no file named) or the machine's memory, not this message.
+    const fs::path dir = fresh_dir("absurd-recording");
+    const auto write = [&](const std::string& name, std::uint32_t frames, std::uint32_t vertices, std::uint32_t tets) {
+        std::string bytes = "KDETREC1";
+        const auto put = [&](std::uint32_t v) {
+            for (int i = 0; i < 4; ++i) bytes += static_cast<char>((v >> (8 * i)) & 0xff);
+        };
+        put(1), put(frames), put(vertices), put(tets);
+        bytes += '\0';
+        for (std::uint32_t corner = 0; corner < 4; ++corner) put(corner);
+        put(0); // no object pairs
+        const float corners[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+        bytes.append(reinterpret_cast<const char*>(corners), sizeof corners);
+        const std::string path = (dir / name).string();
+        std::ofstream(path, std::ios::binary) << bytes;
+        return path;
+    };
+    const std::string sound = write("sound.kdetrec", 1, 4, 1);
+    EXPECT_EQ(recording_error(sound), "no error");
+    const std::string tets = write("tets.kdetrec", 1, 4, 0xffffffffu);
+    EXPECT_EQ(recording_error(tets), tets + ": byte 93: file ends inside the tets of object 0");
+    const std::string vertices = write("vertices.kdetrec", 1, 0xffffffffu, 1);
+    EXPECT_EQ(recording_error(vertices), vertices + ": byte 93: file ends inside the last frame");
+    const std::string frames = write("frames.kdetrec", 0x7fffffffu, 4, 1);
+    EXPECT_EQ(recording_error(frames), frames + ": byte 93: file ends inside the last frame");
     fs::remove_all(dir);
 }
 

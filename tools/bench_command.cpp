@@ -34,10 +34,12 @@ std::unique_ptr<Scene> open_bench_scene(const BenchConfig& config) {
     try {
         scene = open_scene(config.scene, config.request);
     } catch (const Error& e) {
-        throw UsageError(std::string("bench: ") + e.what());
+        // An unknown name is a mistake on the command line; a scene that cannot be read is bad input.
+        if (!names_a_scene(config.scene)) throw UsageError(std::string("bench: ") + e.what());
+        throw;
     }
     if (config.first_frame >= scene->num_frames() || config.last_frame >= scene->num_frames())
-        throw UsageError("invalid value '" + std::to_string(config.first_frame) + ":" + std::to_string(config.last_frame) +
+        throw UsageError("bench: invalid value '" + std::to_string(config.first_frame) + ":" + std::to_string(config.last_frame) +
                          "' for --frames: scene '" + scene->name() + "' has frames 0 to " +
                          std::to_string(scene->num_frames() - 1));
     return scene;

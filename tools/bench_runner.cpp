@@ -1,6 +1,7 @@
 #include "bench_runner.hpp"
 
 #include <kdet/detector.hpp>
+#include <kdet/option_table.hpp>
 
 #include <omp.h>
 
@@ -45,6 +46,8 @@ std::size_t all_tets(const Scene& scene) {
     return tets;
 }
 
+std::string margin_text(const DetectorOptions& options) { return find_option("margin")->text(options); }
+
 std::string stem_of(const BenchConfig& config, const Scene& scene, int last_frame) {
     const std::size_t tets = all_tets(scene);
     std::string stem = scene.name() + "_r" + std::to_string(config.request.resolution) + "_" +
@@ -56,6 +59,7 @@ std::string stem_of(const BenchConfig& config, const Scene& scene, int last_fram
         stem += "_f" + std::to_string(config.first_frame) + "-" + std::to_string(last_frame);
     if (config.rings > 0) stem += "_rings" + std::to_string(config.rings);
     if (!config.filters) stem += "_filters-off";
+    if (config.options.margin > 0) stem += "_margin" + margin_text(config.options);
     return stem;
 }
 
@@ -85,6 +89,7 @@ std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene
             {"bucket capacity", o.bucket_capacity ? std::to_string(o.bucket_capacity) : "automatic"},
             {"exclusion rings", std::to_string(config.rings)},
             {"collision filters", config.filters ? "on" : "off"},
+            {"margin", margin_text(o)},
             {"device", detector.device_name()},
             {"compiler", compiler()},
             {"compiler flags", KDET_BENCH_CXX_FLAGS},

@@ -25,7 +25,7 @@ void CommandLine::option(const std::string& name, const std::string& value_name,
     // prepare -r`) sees them all, and `kdet bench` knows which procedural-only flag came first. An empty
     // FILE is refused: an empty path reads as "not asked for", so the output asked for would silently not
     // be written.
-    const std::string no_file = value_name == "FILE" ? command_ + ": option '" + name + "' needs a value <FILE>" : "";
+    const std::string no_file = value_name == "FILE" ? "option '" + name + "' needs a value <FILE>" : "";
     app_->add_option(name, [on_value = std::move(on_value), no_file](const CLI::results_t& values) {
             for (const std::string& v : values) {
                 if (v.empty() && !no_file.empty()) throw UsageError(no_file);
@@ -79,16 +79,20 @@ void CommandLine::parse(int argc, char** argv, int first) {
         throw UsageError(command_ + ": " + e.what());
     } catch (const Error& e) {
         throw UsageError(command_ + ": " + e.what());
+    } catch (const UsageError& e) {
+        // From a value's own check, which does not know the command.
+        throw UsageError(command_ + ": " + e.what());
     }
+    // An unknown flag first: the value after it would otherwise read as a surplus argument.
+    const std::vector<std::string> extras = app_->remaining();
+    for (const std::string& extra : extras)
+        if (extra.size() > 1 && extra[0] == '-' && extra != "--")
+            throw UsageError(command_ + ": unknown option '" + extra.substr(0, extra.find('=')) + "' (see 'kdet " +
+                             command_ + " --help')");
     if (positionals_ && positionals_->size() > max_positionals_)
         throw UsageError(command_ + ": unexpected argument '" + (*positionals_)[max_positionals_] + "'");
-    for (const std::string& extra : app_->remaining()) {
-        if (extra == "--") continue; // what follows it was taken as positional arguments
-        if (extra.size() > 1 && extra[0] == '-')
-            throw UsageError(command_ + ": unknown option '" + extra.substr(0, extra.find('=')) + "' (see '" + command_ +
-                             " --help')");
-        throw UsageError(command_ + ": unexpected argument '" + extra + "'");
-    }
+    for (const std::string& extra : extras)
+        if (extra != "--") throw UsageError(command_ + ": unexpected argument '" + extra + "'");
 }
 
 } // namespace kdet::cli

@@ -22,7 +22,8 @@ const char* collide_help = R"(usage: kdet collide A [B] [options]
 
 Reports the colliding tetrahedron pairs between meshes A and B, or inside A with --self
 (with --margin D, every pair at most D apart).
-A and B are TetGen meshes (name, name.node or name.ele) or MEDIT .mesh files.
+A and B are tet meshes: TetGen (name, name.node or name.ele), MEDIT .mesh, Gmsh .msh (2.2 or 4.1)
+or legacy VTK .vtk (4.x or 5.1); these two ASCII or binary.
 Tetrahedra of one mesh that share a vertex are adjacent and never reported.
 
 options:

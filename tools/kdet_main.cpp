@@ -41,7 +41,15 @@ int main(int argc, char** argv) {
         std::cerr << usage;
         return exit_usage;
     }
-    const std::string command = argv[1];
+    std::string command = argv[1];
+    // `kdet help collide` as `kdet collide --help`.
+    char help_flag[] = "--help";
+    char* help_argv[] = {argv[0], argc > 2 ? argv[2] : nullptr, help_flag, nullptr};
+    if (command == "help" && argc == 3) {
+        argc = 3;
+        argv = help_argv;
+        command = argv[1];
+    }
     try {
         if (command == "collide") return run_collide(argc, argv);
         if (command == "bench") return run_bench(argc, argv);

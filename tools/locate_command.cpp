@@ -6,9 +6,8 @@
 #include <kdet/locate.hpp>
 #include <kdet/option_table.hpp>
 
-#include <cmath>
+#include <cfloat>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <iostream>
 
@@ -34,11 +33,7 @@ options:
 
 /// @brief --within's value: a finite distance >= 0, the whole text a number.
 double parse_within(const std::string& text) {
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value) || value < 0)
-        throw UsageError("locate: " + invalid_value_message("--within", text, "a finite distance >= 0"));
-    return value;
+    return parse_number("--within", text, 0.0, DBL_MAX, "a finite distance >= 0");
 }
 
 void write_hits(const std::string& path, const LocateResult& r, bool with_distance) {

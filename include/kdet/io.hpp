@@ -59,7 +59,8 @@ TetMesh read_vtk(const std::string& path, const ReadOptions& options = {});
 TriangleMesh read_surface(const std::string& path);
 
 /// @brief Reads query points: a text file of `x y z` lines (`#` starts a comment), or any tet mesh file
-/// read_tet_mesh() reads (by its extension), whose vertices are the points. Returns x y z per point.
+/// read_tet_mesh() reads (by its extension, or a TetGen stem with its .node beside it), whose vertices
+/// are the points (its tets may be degenerate). Returns x y z per point.
 /// Throws kdet::Error naming the file and line for a malformed line or a coordinate that is not
 /// finite or beyond float range.
 std::vector<double> read_points(const std::string& path);

@@ -96,6 +96,10 @@ std::string join_names(const std::vector<std::string>& names);
 /// SHOWN: expected an integer in [lo, hi]".
 long long parse_integer(const std::string& shown, const std::string& text, long long lo, long long hi);
 
+/// @brief Reads a whole decimal number in [lo, hi] ("2", "-0.5", "1e-3"; not hex, inf, nan or blanks),
+/// or throws kdet::Error "invalid value 'TEXT' for SHOWN: expected EXPECTED".
+double parse_number(const std::string& shown, const std::string& text, double lo, double hi, const std::string& expected);
+
 /// @brief Returns @p text when it is one of @p accepted (exactly), or throws kdet::Error "invalid value
 /// 'TEXT' for SHOWN: expected a, b or c".
 std::string parse_choice(const std::string& shown, const std::string& text, const std::vector<std::string>& accepted);

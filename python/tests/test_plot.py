@@ -56,3 +56,17 @@ def test_plot_of_a_folder_without_csv_files_fails_with_one_line(cli: Path, tmp_p
     done = run([str(cli), "plot", str(tmp_path)])
     assert done.returncode != 0
     assert done.stderr.strip() == f"kdet plot: {tmp_path}: no kdet bench CSV files"
+
+
+@pytest.mark.parametrize("arguments", [[], ["FOLDER", "--frobnicate"], ["FOLDER", "--out"]])
+def test_plot_usage_mistakes_give_one_line_and_exit_2(cli: Path, tmp_path: Path, arguments: list[str]) -> None:
+    done = run([str(cli), "plot"] + [str(tmp_path) if a == "FOLDER" else a for a in arguments])
+    assert done.returncode == 2
+    assert len(done.stderr.splitlines()) == 1, done.stderr
+    assert done.stderr.startswith("kdet plot: ") and done.stderr.rstrip().endswith("(see 'kdet plot --help')")
+
+
+def test_plot_help_names_the_command(cli: Path) -> None:
+    done = run([str(cli), "plot", "--help"])
+    assert done.returncode == 0
+    assert done.stdout.startswith("usage: kdet plot ")

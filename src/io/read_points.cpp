@@ -3,6 +3,7 @@
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -18,13 +19,17 @@ bool ends_with(const std::string& text, const std::string& suffix) {
 bool is_mesh_file(const std::string& path) {
     for (const char* extension : {".mesh", ".msh", ".vtk", ".node", ".ele"})
         if (ends_with(path, extension)) return true;
-    return false;
+    std::error_code ignored;
+    return !std::filesystem::exists(path, ignored) && std::filesystem::is_regular_file(path + ".node", ignored);
 }
 
 } // namespace
 
 std::vector<double> read_points(const std::string& path) {
-    if (is_mesh_file(path)) return read_tet_mesh(path).positions;
+    // Only the vertices are read as points: a degenerate tet is no mistake of theirs.
+    ReadOptions vertices_only;
+    vertices_only.allow_degenerate = true;
+    if (is_mesh_file(path)) return read_tet_mesh(path, vertices_only).positions;
     io::TextFile file(path);
     std::vector<double> xyz;
     std::vector<io::Token> tokens;

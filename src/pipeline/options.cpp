@@ -261,11 +261,46 @@ std::string invalid_value_message(const std::string& shown, const std::string& t
     return "invalid value '" + echoed + "' for " + shown + ": expected " + expected;
 }
 
+namespace {
+
+/// Whether @p text is a decimal number as people write one: an optional sign, digits with an optional
+/// point, an optional exponent. strtod alone also takes hex, inf, nan and leading blanks.
+bool is_decimal(const std::string& text, bool allow_fraction) {
+    std::size_t i = 0, digits = 0;
+    const auto skip_digits = [&] {
+        std::size_t n = 0;
+        for (; i < text.size() && text[i] >= '0' && text[i] <= '9'; ++i) ++n;
+        return n;
+    };
+    if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+    digits += skip_digits();
+    if (allow_fraction && i < text.size() && text[i] == '.') {
+        ++i;
+        digits += skip_digits();
+    }
+    if (digits == 0) return false;
+    if (allow_fraction && i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+        ++i;
+        if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+        if (skip_digits() == 0) return false;
+    }
+    return i == text.size();
+}
+
+} // namespace
+
+double parse_number(const std::string& shown, const std::string& text, double lo, double hi, const std::string& expected) {
+    errno = 0;
+    const double value = is_decimal(text, true) ? std::strtod(text.c_str(), nullptr) : NAN;
+    if (errno == ERANGE || !(value >= lo && value <= hi)) throw Error(invalid_value_message(shown, text, expected));
+    return value;
+}
+
 long long parse_integer(const std::string& shown, const std::string& text, long long lo, long long hi) {
     errno = 0;
     char* end = nullptr;
     const long long value = std::strtoll(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || errno == ERANGE || value < lo || value > hi)
+    if (!is_decimal(text, false) || *end != '\0' || errno == ERANGE || value < lo || value > hi)
         throw Error(invalid_value_message(shown, text, "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]"));
     return value;
 }
@@ -325,13 +360,7 @@ void OptionInfo::parse(const std::string& text, DetectorOptions& options, const 
         break;
     }
     case OptionType::integer: value = parse_integer(shown, text, min, max); break;
-    case OptionType::real: {
-        char* end = nullptr;
-        const double number = std::strtod(text.c_str(), &end);
-        if (text.empty() || *end != '\0' || !(number >= 0.0) || number > FLT_MAX)
-            throw Error(invalid_value_message(shown, text, expected()));
-        return set_real(options, number);
-    }
+    case OptionType::real: return set_real(options, parse_number(shown, text, 0.0, FLT_MAX, expected()));
     }
     put(options, value);
 }

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -155,6 +156,9 @@ public:
         fd_ = ::open(path.c_str(), O_RDONLY);
         if (fd_ < 0) throw Error(path + ": cannot open file");
         try {
+            struct stat status {};
+            if (::fstat(fd_, &status) != 0 || !S_ISREG(status.st_mode)) throw Error(path + ": not a regular file");
+            file_size_ = static_cast<std::uint64_t>(status.st_size);
             read_header();
         } catch (...) {
             ::close(fd_);
@@ -187,8 +191,15 @@ public:
     bool checks_self(std::size_t object) const override { return object < self_.size() && self_[object]; }
 
 private:
+    /// @brief Fails naming @p what when the file ends before @p offset + @p size, before anything is
+    /// allocated for a count that the file cannot hold.
+    void check_extent(std::uint64_t offset, std::uint64_t size, const std::string& what) const {
+        if (offset > file_size_ || size > file_size_ - offset)
+            throw Error(path_ + ": byte " + std::to_string(file_size_) + ": file ends inside " + what);
+    }
     /// @brief Reads @p size bytes at @p offset; fails naming @p what when the file is shorter.
     std::vector<unsigned char> read_at(std::uint64_t offset, std::size_t size, const std::string& what) const {
+        check_extent(offset, size, what);
         std::vector<unsigned char> bytes(size);
         std::size_t done = 0;
         while (done < size) {
@@ -223,7 +234,7 @@ private:
             at += 16ull * tets;
             mesh.tets.resize(4ull * tets);
             for (std::size_t i = 0; i < mesh.tets.size(); ++i) mesh.tets[i] = get_u32(&bytes[4 * i]);
-            mesh.positions.resize(3ull * vertices);
+            vertex_counts_.push_back(vertices);
             object_offset_.push_back(frame_bytes_);
             frame_bytes_ += 12ull * vertices;
             meshes_.push_back(std::move(mesh));
@@ -237,20 +248,22 @@ private:
             pairs_.emplace_back(std::min<std::size_t>(a, b), std::max<std::size_t>(a, b));
         }
         data_offset_ = at;
+        // The last frame must be there too: a cut-off file fails now, not half-way through a run.
+        const std::uint64_t data_bytes = file_size_ - std::min(file_size_, data_offset_);
+        if (frame_bytes_ > 0 && static_cast<std::uint64_t>(frames_) > data_bytes / frame_bytes_)
+            check_extent(data_offset_, data_bytes + 1, "the last frame");
         for (std::size_t o = 0; o < meshes_.size(); ++o) {
             std::vector<double> rest;
             positions(o, 0, rest);
             meshes_[o].positions = rest;
             validate_tet_mesh(meshes_[o], path_ + ": object " + std::to_string(o), {true});
         }
-        // The last frame must be there too: a cut-off file fails now, not half-way through a run.
-        read_at(data_offset_ + frame_bytes_ * static_cast<std::uint64_t>(frames_) - 1, 1, "the last frame");
     }
 
     void read_frame(std::size_t object, int frame, std::vector<float>& out) const {
-        const TetMesh& mesh = rest_mesh(object);
+        if (object >= meshes_.size()) throw Error("scene " + name_ + " has no object " + std::to_string(object));
         check_frame(name_, frame, frames_);
-        const std::size_t count = mesh.positions.size();
+        const std::size_t count = 3 * static_cast<std::size_t>(vertex_counts_[object]);
         const std::vector<unsigned char> bytes =
             read_at(data_offset_ + frame_bytes_ * static_cast<std::uint64_t>(frame) + object_offset_[object], 4 * count,
                     "frame " + std::to_string(frame));
@@ -267,8 +280,8 @@ private:
     std::vector<TetMesh> meshes_;
     std::vector<bool> self_;
     std::vector<std::pair<std::size_t, std::size_t>> pairs_;
-    std::vector<std::uint64_t> object_offset_;
-    std::uint64_t frame_bytes_ = 0, data_offset_ = 0;
+    std::vector<std::uint64_t> vertex_counts_, object_offset_;
+    std::uint64_t frame_bytes_ = 0, data_offset_ = 0, file_size_ = 0;
 };
 
 } // namespace

@@ -99,6 +99,10 @@ void parse_key(const Statement& s, ObjectSpec& object) {
         Key key;
         key.frame = frame;
         for (std::size_t k = 0; k < width; ++k) key.value[k] = s.number(i + 1 + k);
+        // 0.9 keeps an object squashed to a tenth of its height and widened three times; -1 would
+        // stretch it without end.
+        if (channel == Channel::squash && !(key.value[0] > -1.0 && key.value[0] < 0.9))
+            s.fail("squash " + s.words[i + 1] + " is outside (-1, 0.9)");
         std::vector<Key>& keys = object.keys[static_cast<std::size_t>(channel)];
         if (!keys.empty() && keys.back().frame >= frame)
             s.fail("keys of '" + s.words[i] + "' must have increasing frames (" + s.words[1] + " after " +
@@ -173,6 +177,7 @@ SceneSpec parse_scene(const std::string& text, const std::string& source) {
     if (statements[0].words[1] != "1") statements[0].fail("unknown scene format version '" + statements[0].words[1] + "'");
 
     SceneSpec spec;
+    spec.source = source;
     std::vector<const Statement*> collision_statements;  // resolved once every object is known
     for (std::size_t i = 1; i < statements.size(); ++i) {
         const Statement& s = statements[i];

@@ -8,6 +8,7 @@
 #include <kdet/io.hpp>
 #include <kdet/scenes.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -34,7 +35,17 @@ std::vector<std::string> scene_names() {
     return names;
 }
 
+bool names_a_scene(const std::string& argument) {
+    const std::vector<std::string> names = scene_names();
+    if (std::find(names.begin(), names.end(), argument) != names.end()) return true;
+    if (ends_with(argument, ".scene") || ends_with(argument, ".kdetrec")) return true;
+    std::error_code ignored;
+    return std::filesystem::is_directory(argument, ignored);
+}
+
 std::unique_ptr<Scene> read_scene_file(const std::string& path, const SceneRequest& request) {
+    std::error_code ignored;
+    if (std::filesystem::is_directory(path, ignored)) throw Error(path + ": cannot open scene file (it is a directory)");
     std::ifstream in(path);
     if (!in) throw Error(path + ": cannot open scene file");
     std::ostringstream text;
@@ -51,10 +62,11 @@ std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& r
     if (name == "graded") return make_graded_scene(request.resolution);
     for (const auto& [builtin, text] : scenes::builtin_scene_files())
         if (name == builtin) return play(scenes::parse_scene(text, "scenes/" + builtin + ".scene"), builtin, request, ".");
-    std::error_code ignored;
-    if (ends_with(name, ".scene")) return read_scene_file(name, request);
-    if (ends_with(name, ".kdetrec")) return read_recording(name);
-    if (std::filesystem::is_directory(name, ignored)) return read_frame_folder(name);
+    if (names_a_scene(name)) {
+        if (ends_with(name, ".scene")) return read_scene_file(name, request);
+        if (ends_with(name, ".kdetrec")) return read_recording(name);
+        return read_frame_folder(name);
+    }
     std::string known;
     for (const std::string& n : scene_names()) known += (known.empty() ? "" : ", ") + n;
     throw Error("unknown scene '" + name + "' (known scenes: " + known +

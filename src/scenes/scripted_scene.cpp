@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 namespace kdet::scenes {
 namespace {
@@ -95,10 +96,6 @@ ScriptedScene::ScriptedScene(SceneSpec spec, int resolution, const std::string& 
             rest.half[a] = 0.5 * (hi[a] - lo[a]);
         }
         rest_.push_back(rest);
-        for (const Key& key : object.keys[static_cast<std::size_t>(Channel::squash)])
-            if (!(key.value[0] > -1.0 && key.value[0] < 0.9))
-                throw Error(spec_.name + ": object '" + object.name + "': squash " + std::to_string(key.value[0]) +
-                            " is outside (-1, 0.9)");
     }
 }
 
@@ -153,7 +150,8 @@ void ScriptedScene::write_positions(std::size_t object, int frame, std::vector<R
 
     out.resize(mesh.positions.size());
     const auto num_vertices = static_cast<long long>(mesh.num_vertices());
-#pragma omp parallel for schedule(static)
+    bool in_float_range = true;
+#pragma omp parallel for schedule(static) reduction(&& : in_float_range)
     for (long long v = 0; v < num_vertices; ++v) {
         Vec q;  // relative to the centre of the rest box
         for (int a = 0; a < 3; ++a) q[a] = mesh.positions[3 * v + a] - rest.centre[a];
@@ -178,10 +176,18 @@ void ScriptedScene::write_positions(std::size_t object, int frame, std::vector<R
                 q[a] += wobble * std::sin(pose.wobble_phase + kPi * unit((a + 1) % 3) + 2.1 * a);
         }
         for (int a = 0; a < 3; ++a) q[a] = o.scale * (q[a] + rest.centre[a]);
-        for (int a = 0; a < 3; ++a)
-            out[3 * v + a] = static_cast<Real>(pose.translation[a] + pose.rotation[a][0] * q[0] +
-                                               pose.rotation[a][1] * q[1] + pose.rotation[a][2] * q[2]);
+        for (int a = 0; a < 3; ++a) {
+            const double x = pose.translation[a] + pose.rotation[a][0] * q[0] + pose.rotation[a][1] * q[1] +
+                             pose.rotation[a][2] * q[2];
+            in_float_range = in_float_range && std::abs(x) <= std::numeric_limits<float>::max();
+            out[3 * v + a] = static_cast<Real>(x);
+        }
     }
+    // The detector works in float: a coordinate beyond its range is this file's mistake, named here
+    // rather than as a non-finite vertex of an object index.
+    if (!in_float_range)
+        throw Error(spec_.source + ":" + std::to_string(o.line) + ": object '" + o.name + "' at frame " +
+                    std::to_string(frame) + " has a coordinate beyond float's range (+-3.4e38)");
 }
 
 void ScriptedScene::positions(std::size_t object, int frame, std::vector<float>& out) const {

@@ -44,6 +44,7 @@ struct ObjectSpec {
 
 /// @brief A scene file as written.
 struct SceneSpec {
+    std::string source;                                      ///< the file (or built-in scene) it was read from
     std::string name;
     int frames = 0;
     std::vector<ObjectSpec> objects;

@@ -17,7 +17,7 @@ inline const char* const every_statement_scene = "kdet-scene 1   # version\n"
                                                  "  scale 2.5\n  rotate 90 0 -45\n  translate 0 -1e-3 4E+2\n"
                                                  "object cloth\n\tfile cloth.msh\n  bend x y\n  twist z\n  squash y\n"
                                                  "  wobble 0.05 30\n"
-                                                 "  key 0 move 0 0 0 turn 0 0 0 bend 0 twist 0 squash 1\n"
+                                                 "  key 0 move 0 0 0 turn 0 0 0 bend 0 twist 0 squash 0.5\n"
                                                  "  key 45.5 move 1 2 3 bend 0.5\n  key 89 twist 180 squash 0.25\n"
                                                  "collide floor cloth\nself cloth\n";
 

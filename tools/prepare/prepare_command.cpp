@@ -10,6 +10,7 @@
 #include <kdet/io.hpp>
 #include <kdet/prepare.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -88,12 +89,20 @@ int run_prepare(int argc, char** argv) {
     std::vector<std::string> known;
     for (const ModelInfo& model : thesis_models()) known.push_back(model.name);
     try {
-        for (std::string& model : models) model = parse_choice("prepare", model, known);
+        for (std::string& model : models) model = parse_choice("MODEL", model, known);
     } catch (const Error& e) {
-        throw UsageError(e.what());
+        throw UsageError(std::string("prepare: ") + e.what());
     }
     if (models.empty()) models = known;
     if (resolutions.empty()) resolutions = {1, 2, 3, 4};
+    // Each mesh once, in the order asked for, however often it was named.
+    const auto drop_repeats = [](auto& values) {
+        for (std::size_t i = 0; i < values.size(); ++i)
+            values.erase(std::remove(values.begin() + static_cast<std::ptrdiff_t>(i) + 1, values.end(), values[i]),
+                         values.end());
+    };
+    drop_repeats(models);
+    drop_repeats(resolutions);
 
     std::printf("cache: %s\n%-13s %3s %8s %8s %7s %11s %8s  %s\n", cache_dir().c_str(), "model", "res", "target",
                 "tets", "diff", "diag/alpha", "seconds", "status");

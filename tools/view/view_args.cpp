@@ -7,9 +7,7 @@
 #include <kdet/scenes.hpp>
 
 #include <algorithm>
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
+#include <cfloat>
 #include <filesystem>
 
 namespace kdet::view {
@@ -88,12 +86,8 @@ headless (no window; needs an X display: run under xvfb-run on a machine without
 )";
 
 float parse_float(const std::string& flag, const std::string& text, float lo, float hi) {
-    errno = 0;
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(value) || value < lo || value > hi)
-        throw Error(invalid_value_message(flag, text, "a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]"));
-    return static_cast<float>(value);
+    return static_cast<float>(
+        parse_number(flag, text, lo, hi, "a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]"));
 }
 
 void parse_size(const std::string& text, ViewConfig& config) {
@@ -117,15 +111,6 @@ void parse_camera(const std::string& text, CameraRequest& camera) {
 }
 
 } // namespace
-
-bool names_a_scene(const std::string& argument) {
-    const std::vector<std::string> names = scene_names();
-    if (std::find(names.begin(), names.end(), argument) != names.end()) return true;
-    const std::string extension = std::filesystem::path(argument).extension().string();
-    if (extension == ".scene" || extension == ".kdetrec") return true;
-    std::error_code error;
-    return std::filesystem::is_directory(argument, error);
-}
 
 std::array<float, 4> clip_plane(const DisplaySettings& display, const Bounds& scene_box) {
     std::array<float, 4> plane = {0, 0, 0, 1};
@@ -183,11 +168,8 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
         config.points = v;
     });
     parser.option("--within", "D", [&](const std::string& v) {
-        char* end = nullptr;
-        config.within = std::strtod(v.c_str(), &end);
+        config.within = parse_number("--within", v, 0.0, DBL_MAX, "a finite distance >= 0");
         within_given = true;
-        if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(config.within) || config.within < 0)
-            throw cli::UsageError(invalid_value_message("--within", v, "a finite distance >= 0"));
     });
     parser.flag("--profile", config.profile);
     parser.option("--size", "WxH", [&](const std::string& v) { parse_size(v, config); });

@@ -54,10 +54,6 @@ struct ViewConfig {
     bool help = false;
 };
 
-/// @brief Whether a positional argument names a scene rather than a mesh file: a name open_scene
-/// knows, a scene file or recording, or a folder of frames.
-bool names_a_scene(const std::string& argument);
-
 /// @brief Parses `argv[first..argc)`; throws cli::UsageError naming the flag and what it accepts.
 ViewConfig parse_view_args(int argc, char** argv, int first);
 

@@ -26,18 +26,9 @@ int run_view(int argc, char** argv) {
         throw Error("view: --backend cuda is not available here: " + reason);
     config.options.contacts = view::wants_contacts(config.display, false);
     view::ViewSession session(config.source, config.options, config.self);
-    if (!config.points.empty()) {
-        std::vector<double> points;
-        try {
-            points = read_points(config.points);
-        } catch (const Error& e) {
-            // A points file is an argument of this command: a bad one is a usage error.
-            throw UsageError(std::string("view: ") + e.what());
-        }
-        session.set_points(std::move(points), config.within);
-    }
+    if (!config.points.empty()) session.set_points(read_points(config.points), config.within);
     if (config.frame >= session.num_frames())
-        throw UsageError("invalid value '" + std::to_string(config.frame) + "' for --frame: scene '" +
+        throw UsageError("view: invalid value '" + std::to_string(config.frame) + "' for --frame: scene '" +
                          session.scene().name() + "' has frames 0 to " + std::to_string(session.num_frames() - 1));
     const bool headless = !config.screenshot.empty() || config.profile;
     view::Viewer viewer(session, config, !headless);

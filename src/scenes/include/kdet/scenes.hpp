@@ -170,6 +170,11 @@ std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& r
 /// @brief Names open_scene accepts, for help texts and error messages.
 std::vector<std::string> scene_names();
 
+/// @brief Whether open_scene takes @p argument as a scene (one of scene_names(), a path ending in
+/// ".scene" or ".kdetrec", or a folder) rather than refusing it as an unknown name; such a scene may
+/// still fail to open (a missing or malformed file, a model not prepared).
+bool names_a_scene(const std::string& argument);
+
 /// @brief Reads a scene file (the format of docs/scenes.md): objects with their meshes, placement and
 /// scripted motion (rigid keyframes and smooth deformations), the number of frames and the collisions
 /// checked. Objects without a fixed resolution take `request.resolution`. Throws kdet::Error
