@@ -113,6 +113,27 @@ TEST_P(MemoryLimit, WithoutALimitTheSameFramesAreAnswered) {
     EXPECT_EQ(detector.detect().pairs.size(), pile_pairs);
 }
 
+TEST_P(MemoryLimit, AFrameWithoutPairsNeedsNoRoomEvenUnderALimitBelowTheDetectorsOwn) {
+    // The detector's own buffers take more than this limit leaves: no room for a single candidate. A
+    // frame that has none is answered, as its first frame, after a refused one and when apart again.
+    DetectorOptions options = options_;
+    options.memory_limit = 1000;
+    const TetMesh a = test::identical_tets(pile), b = test::moved(small_neighbour(), 0.0, 100.0, 0.0, 0.0);
+    Detector detector(options);
+    const ObjectId ia = detector.add_object(a);
+    const ObjectId ib = detector.add_object(b);
+    EXPECT_TRUE(detector.detect().pairs.empty());
+    detector.set_self_collision(ia, true);
+    const std::string refused = error_message([&] { detector.detect(); });
+    EXPECT_GT(pairs_named(refused), 0u) << refused;
+    EXPECT_NE(refused.find("memory_limit 1000"), std::string::npos) << refused;
+    detector.set_self_collision(ia, false);
+    EXPECT_TRUE(detector.detect().pairs.empty());
+    const TetMesh near = small_neighbour();
+    detector.set_positions(ib, near.positions.data(), near.num_vertices());
+    EXPECT_NE(error_message([&] { detector.detect(); }).find("memory_limit 1000"), std::string::npos);
+}
+
 std::string case_name(const ::testing::TestParamInfo<std::tuple<Backend, Method>>& info) {
     return std::string(to_string(std::get<0>(info.param))) + "_" + to_string(std::get<1>(info.param));
 }
@@ -134,6 +155,29 @@ TEST(MemoryLimit, AFirstFrameThatOverflowsItsGuessCountsAndGrowsOnceToTheExactNe
     const FrameResult& r = detector.detect();
     EXPECT_EQ(r.pairs.size(), pile_pairs);
     EXPECT_EQ(r.counts.buffer_regrows, 1u);
+}
+
+TEST(MemoryLimit, AFirstFrameWhoseGuessItsPairsFillToTheLastSlotFinishes) {
+    // A first buffer of exactly the frame's candidates (or about that many): the items that start
+    // once it is full have none to store, which no growth changes; they must finish all the same.
+    const TetMesh pile_mesh = test::identical_tets(40);
+    const TetMesh apart = test::moved(test::random_soup(3000, 1.0, 0.3, 11), 0.0, 50.0, 0.0, 0.0);
+    const auto run = [&](std::size_t capacity, int threads) {
+        DetectorOptions options;
+        options.initial_candidate_capacity = capacity;
+        options.threads = threads;
+        Detector detector(options);
+        const ObjectId ia = detector.add_object(pile_mesh);
+        detector.add_object(apart);
+        detector.set_self_collision(ia, true);
+        const FrameResult& r = detector.detect();
+        return std::make_pair(r.pairs, r.counts.candidates);
+    };
+    const auto [expected, candidates] = run(0, 1);
+    ASSERT_EQ(expected.size(), 40u * 39u / 2u);
+    for (const int threads : {1, 2})
+        for (std::size_t capacity = candidates - 2; capacity <= candidates + 2; ++capacity)
+            EXPECT_EQ(run(capacity, threads).first, expected) << capacity << " slots, " << threads << " threads";
 }
 
 } // namespace

@@ -174,11 +174,12 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
     };
     std::size_t items = all_items;
     const ResumePoint* resume_from = nullptr;
+    bool stop_when_full = !pairs_sized_;
     for (int run = 0;; ++run) {
         FrameCounters* c = counters_.data();
         ResumePoint* stopped = resume_points_[run % 2].data();
         search(items, resume_from, KeyAppender{candidates_.data(), candidates_.size(), &c->candidates, &c->candidate_padding},
-               c, stopped, resume_room, !pairs_sized_);
+               c, stopped, resume_room, stop_when_full);
         if (pairs_sized_) return std::nullopt;
         FrameCounters after = read_counters_now();
         if (!after.stopped_items) return after;
@@ -196,19 +197,28 @@ std::optional<FrameCounters> Pipeline<Exec>::find_candidates(const GridView& gri
         const std::size_t kept = candidates_.size();
         const std::uint64_t keys = (resume ? kept - after.candidate_padding : 0) + counted.candidates;
         reserve_pairs_window(keys);
-        // Room for the next frames too where the memory allows (their overflow would rerun the whole
-        // frame); where it does not hold the kept keys and the grown buffer at once, every item
-        // searches again into a buffer of the keys alone.
-        const std::size_t slots = (resume ? kept : 0) + counted.candidates;
-        const bool copied = resume && resize_within_memory(candidates_grown_, rerun_capacity(kept, slots), slots,
-                                                           room(candidates_grown_.capacity_bytes(), sizeof(std::uint64_t)));
-        if (copied) exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
-        candidates_.swap(candidates_grown_);
-        buffer<std::uint64_t>().swap(candidates_grown_); // frees the old buffer
-        if (!copied && !resize_within_memory(candidates_, keys + keys / 4, keys, room(candidates_.capacity_bytes(), sizeof(std::uint64_t))))
-            refuse_first_frame(keys);
-        ++regrows_;
-        if (copied) {
+        // Items that stopped at a buffer filled to its last slot (or of no room at all) may have nothing
+        // left to store: growing would leave it as it is and stop them again, so they run once more
+        // without stopping, into the buffer as it is.
+        const bool nothing_left = counted.candidates == 0;
+        stop_when_full = !nothing_left;
+        bool copied = false;
+        if (!nothing_left) {
+            // Room for the next frames too where the memory allows (their overflow would rerun the
+            // whole frame); where it does not hold the kept keys and the grown buffer at once, every
+            // item searches again into a buffer of the keys alone.
+            const std::size_t slots = (resume ? kept : 0) + counted.candidates;
+            copied = resume && resize_within_memory(candidates_grown_, rerun_capacity(kept, slots), slots,
+                                                    room(candidates_grown_.capacity_bytes(), sizeof(std::uint64_t)));
+            if (copied) exec_.copy(candidates_grown_.data(), candidates_.data(), kept);
+            candidates_.swap(candidates_grown_);
+            buffer<std::uint64_t>().swap(candidates_grown_); // frees the old buffer
+            if (!copied && !resize_within_memory(candidates_, keys + keys / 4, keys,
+                                                 room(candidates_.capacity_bytes(), sizeof(std::uint64_t))))
+                refuse_first_frame(keys);
+            ++regrows_;
+        }
+        if (copied || (nothing_left && resume)) {
             after.candidates = kept;
         } else {
             after.candidates = after.candidate_padding = after.rejected = 0;
