@@ -181,6 +181,16 @@ TEST(SceneRegistry, KnowsTheThesisScenes) {
     }
 }
 
+TEST(SceneRegistry, RefusesAResolutionOutsideOneToFourForEveryScene) {
+    for (const std::string& name : scene_names())
+        for (const int resolution : {0, 5, -1000000}) {
+            SceneRequest request;
+            request.resolution = resolution;
+            EXPECT_EQ(error_message([&] { open_scene(name, request); }),
+                      name + ": resolution " + std::to_string(resolution) + " out of range [1, 4]");
+        }
+}
+
 TEST(RecordedScene, BinaryRecordingPlaysBackExactly) {
     const fs::path dir = fresh_dir("recording");
     const auto scene = read_scene_file(write_box_scene(dir).string());

@@ -223,11 +223,12 @@ private:
 using IndexPair = std::pair<std::uint32_t, std::uint32_t>;
 
 /// @brief All colliding pairs (i in a, j in b), sorted ascending. Throws kdet::Error for
-/// Method::kdet_no_pairs, which builds no pairs (Detector::detect() gives its flags).
+/// Method::kdet_no_pairs, which builds no pairs (Detector::detect() gives its flags), and for options
+/// whose results this cannot return: results_to_host = false, contacts, distances.
 std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const DetectorOptions& options = {});
 
 /// @brief All colliding pairs i < j inside one mesh (self-collision), sorted ascending. Throws
-/// kdet::Error for Method::kdet_no_pairs, as collide() does.
+/// kdet::Error for the options collide() refuses.
 std::vector<IndexPair> collide_self(const TetMesh& mesh, const DetectorOptions& options = {});
 
 /// @brief True when the CUDA backend can run here; otherwise `reason` (if given) says why not.

@@ -60,7 +60,8 @@ struct DeviceLocateResults {
 
 /// @brief One-off point location in one mesh: `points` are x y z per point (float or double; any
 /// layout through PositionsView), located as float32. Objects are all 0. Throws kdet::Error on a
-/// non-finite point, a negative or non-finite `within`, or a bad mesh (as Detector::add_object).
+/// non-finite point, a negative or non-finite `within`, a bad mesh (as Detector::add_object), or
+/// `results_to_host = false` (whose device arrays would end with the one-off's detector).
 LocateResult locate(const TetMesh& mesh, const PositionsView& points, const LocateOptions& options = {},
                     const DetectorOptions& detector_options = {});
 LocateResult locate(const TetMesh& mesh, const std::vector<double>& xyz, const LocateOptions& options = {},

@@ -115,6 +115,17 @@ void copy_rows(const Coordinates& c, double* out) {
 
 } // namespace
 
+void check_reads_cuda_arrays(const Detector& detector, const char* name) {
+#ifdef KDET_HAS_CUDA
+    if (detector.options().backend != Backend::cuda)
+        throw Error(std::string(name) + ": a CUDA array needs a detector with backend='cuda'; this one runs on the " +
+                    to_string(detector.options().backend));
+#else
+    (void)detector;
+    throw Error(std::string(name) + ": a CUDA array needs kdet built with its CUDA backend (this build has none)");
+#endif
+}
+
 void copy_xyz(const Coordinates& c, double* out) {
     if (c.is_double)
         copy_rows<double>(c, out);
@@ -199,7 +210,7 @@ TetIndices tet_indices(nb::handle object, const char* name) {
         throw nb::type_error((std::string(name) + ": vertex indices must be in host memory").c_str());
     t.rows = shape[0];
     const std::int64_t rs = t.array.stride(0), cs = t.array.stride(1);
-    if (dtype == nb::dtype<std::uint32_t>() && (t.rows <= 1 || (rs == 4 && cs == 1))) {
+    if (dtype == nb::dtype<std::uint32_t>() && cs == 1 && (t.rows <= 1 || rs == 4)) {
         t.data = static_cast<const std::uint32_t*>(t.array.data());
         return t;
     }

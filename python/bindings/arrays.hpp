@@ -42,6 +42,10 @@ struct Coordinates {
 /// @brief Reads @p object (the argument @p name) as coordinates, without copying.
 Coordinates coordinates(nb::handle object, const char* name);
 
+/// @brief Throws unless @p detector can read the CUDA array given as the argument @p name: kdet built
+/// with CUDA and the detector on that backend (a CPU detector would read GPU memory as host memory).
+void check_reads_cuda_arrays(const Detector& detector, const char* name);
+
 /// @brief Copies host coordinates into x y z per vertex, float64 (a TetMesh's vertices).
 void copy_xyz(const Coordinates& c, double* out);
 

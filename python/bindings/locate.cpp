@@ -113,6 +113,7 @@ nb::object detector_locate(nb::handle owner, Detector& detector, std::mutex& mut
         id = static_cast<ObjectId>(value);
     }
     const Coordinates c = coordinates(points, "points");
+    if (c.on_device) check_reads_cuda_arrays(detector, "points");
     LocateResult copy;
     DeviceLocateResults buffers;
     {

@@ -273,10 +273,8 @@ void check_cuda(cudaError_t status, const char* what) {
 /// GPU positions, read where they lie: the library gathers any layout on the detector's stream and
 /// checks the array's device.
 void set_device_positions(PyDetector& self, ObjectId id, const Coordinates& c) {
+    check_reads_cuda_arrays(self.detector, "positions");
 #ifdef KDET_HAS_CUDA
-    if (self.detector.options().backend != Backend::cuda)
-        throw Error("positions: a CUDA array needs a detector with backend='cuda'; this one runs on the " +
-                    std::string(to_string(self.detector.options().backend)));
     nb::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(self.mutex);
     // __cuda_array_interface__'s producer stream (1 and 2 are CUDA's legacy and per-thread default
@@ -284,10 +282,8 @@ void set_device_positions(PyDetector& self, ObjectId id, const Coordinates& c) {
     if (c.stream) check_cuda(cudaStreamSynchronize(reinterpret_cast<cudaStream_t>(c.stream)), "cudaStreamSynchronize");
     self.detector.set_positions_on_device(id, c.view());
 #else
-    (void)self;
     (void)id;
     (void)c;
-    throw Error("positions: a CUDA array needs kdet built with its CUDA backend (this build has none)");
 #endif
 }
 

@@ -106,10 +106,11 @@ void bind_scenes(nb::module_& m) {
 
     m.def(
         "open_scene",
-        [](const std::string& name, int resolution, std::size_t tets, int frames) {
+        [](const std::string& name, int resolution, std::int64_t tets, int frames) {
+            if (tets < 0) throw Error("tets: " + std::to_string(tets) + " is negative");
             SceneRequest request;
             request.resolution = resolution;
-            request.procedural = ProceduralSceneOptions{tets, frames};
+            request.procedural = ProceduralSceneOptions{static_cast<std::size_t>(tets), frames};
             nb::gil_scoped_release release;
             return PyScene{open_scene(name, request)};
         },

@@ -161,6 +161,13 @@ def test_bad_meshes_for_collide(octopus):
         kdet.collide(octopus, 3)
     with pytest.raises(kdet.Error, match="'kdet_no_pairs' only flags colliding tets"):
         kdet.collide(octopus, octopus, method="kdet_no_pairs")
+    # What a one-off query would compute and not return is refused, not dropped.
+    with pytest.raises(kdet.Error, match="collide: results_to_host=false keeps the pairs on the device"):
+        kdet.collide(octopus, octopus, results_to_host=False)
+    with pytest.raises(kdet.Error, match="collide_self: contacts would be computed and dropped"):
+        kdet.collide_self(octopus, contacts=True)
+    with pytest.raises(kdet.Error, match="collide: distances would be computed and dropped"):
+        kdet.collide(octopus, octopus, margin=0.1, distances=True)
 
 
 def test_results_kept_on_the_device_need_device_results(octopus):
@@ -187,6 +194,8 @@ def test_gpu_arrays_need_the_cuda_backend(octopus):
         detector.set_positions(ia, FakeCudaArray(octopus.num_vertices, "<i4"))
     with pytest.raises(TypeError, match="vertices: add_object reads the rest shape on the host"):
         detector.add_object(FakeCudaArray(4), [[0, 1, 2, 3]])
+    with pytest.raises(kdet.Error, match="points: a CUDA array needs"):
+        detector.locate(FakeCudaArray(3))
 
 
 def pairs_with(a: kdet.TetMesh, b_vertices, b_tets) -> np.ndarray:
@@ -223,6 +232,15 @@ def test_every_layout_and_dtype_gives_the_same_pairs(octopus, other):
         np.testing.assert_array_equal(pairs[:, [1, 3]], expected, err_msg=name)
         # The mesh class reads the same layouts.
         np.testing.assert_array_equal(kdet.collide(octopus, (vertices, tets)), expected, err_msg=name)
+
+
+def test_a_single_uint32_tet_is_read_through_its_column_stride():
+    # One row is read in place only where its columns are adjacent; any other stride is gathered.
+    vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]
+    every_other_column = np.array([[0, 9, 1, 9, 2, 9, 3, 9]], dtype=np.uint32)[:, ::2]
+    reversed_columns = np.array([[3, 2, 1, 0]], dtype=np.uint32)[:, ::-1]
+    for name, tets in {"every other column": every_other_column, "reversed columns": reversed_columns}.items():
+        assert kdet.TetMesh(vertices, tets).tets.tolist() == [[0, 1, 2, 3]], name
 
 
 def test_mesh_arrays_are_views_of_the_mesh(octopus):

@@ -103,5 +103,10 @@ def test_scene_bad_input():
         scene.tets(0, 120)
     with pytest.raises(kdet.Error, match="unknown scene 'nope'"):
         kdet.open_scene("nope")
+    for name in ("tearing", "procedural", "pass_through_armadillos"):
+        with pytest.raises(kdet.Error, match=rf"^{name}: resolution -1000000 out of range \[1, 4\]$"):
+            kdet.open_scene(name, resolution=-1000000)
+    with pytest.raises(kdet.Error, match="^tets: -5 is negative$"):
+        kdet.open_scene("procedural", tets=-5)
     with pytest.raises(ValueError, match="frames 5 to 200 out of range"):
         next(kdet.run_scene(scene, first_frame=5, last_frame=200))

@@ -596,6 +596,9 @@ DeviceLocateResults Detector::device_locate_results() const { return impl_->pipe
 
 LocateResult locate(const TetMesh& mesh, const PositionsView& points, const LocateOptions& options,
                     const DetectorOptions& detector_options) {
+    if (!options.results_to_host)
+        throw Error("locate: results_to_host=false would leave a one-off point location only its counts (its device arrays "
+                    "end with its detector); use Detector::locate() and device_locate_results()");
     Detector detector(detector_options);
     const ObjectId object = detector.add_object(mesh);
     detector.locate(points, object, options);
@@ -618,11 +621,17 @@ const DetectorOptions& Detector::options() const { return impl_->options; }
 
 namespace {
 
-/// @brief Throws when `options` ask for a method that builds no pairs, which a one-off query returns.
-void check_builds_pairs(const char* function, const DetectorOptions& options) {
+/// @brief Throws when `options` ask for what a one-off query, which returns host pairs alone, cannot give.
+void check_one_off_options(const char* function, const DetectorOptions& options) {
+    const std::string name(function);
     if (options.method == Method::kdet_no_pairs)
-        throw Error(std::string(function) +
-                    ": method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector::detect().colliding");
+        throw Error(name + ": method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector::detect().colliding");
+    if (!options.results_to_host)
+        throw Error(name + ": results_to_host=false keeps the pairs on the device, and " + name +
+                    " returns them on the host; use Detector::device_results()");
+    if (options.contacts || options.distances)
+        throw Error(name + ": " + (options.contacts ? "contacts" : "distances") + " would be computed and dropped, as " +
+                    name + " returns the pairs alone; use Detector::detect(), whose FrameResult holds them");
 }
 
 std::vector<IndexPair> to_index_pairs(const FrameResult& result) {
@@ -635,7 +644,7 @@ std::vector<IndexPair> to_index_pairs(const FrameResult& result) {
 } // namespace
 
 std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const DetectorOptions& options) {
-    check_builds_pairs("collide", options);
+    check_one_off_options("collide", options);
     Detector detector(options);
     detector.add_object(a);
     detector.add_object(b);
@@ -643,7 +652,7 @@ std::vector<IndexPair> collide(const TetMesh& a, const TetMesh& b, const Detecto
 }
 
 std::vector<IndexPair> collide_self(const TetMesh& mesh, const DetectorOptions& options) {
-    check_builds_pairs("collide_self", options);
+    check_one_off_options("collide_self", options);
     Detector detector(options);
     const ObjectId id = detector.add_object(mesh);
     detector.set_self_collision(id, true);

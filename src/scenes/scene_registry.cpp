@@ -55,6 +55,8 @@ std::unique_ptr<Scene> read_scene_file(const std::string& path, const SceneReque
 }
 
 std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& request) {
+    if (request.resolution < 1 || request.resolution > 4)
+        throw Error(name + ": resolution " + std::to_string(request.resolution) + " out of range [1, 4]");
     if (name == "procedural") return std::make_unique<ProceduralScene>(request.procedural);
     if (name == "tearing") return std::make_unique<scenes::TearingScene>(120);
     if (name == "heap") return make_heap_scene(request.resolution);

@@ -163,8 +163,8 @@ struct SceneRequest {
 /// "pass_through_armadillos" (always resolution 2); these read the meshes `kdet prepare` made (see
 /// prepared_mesh). A path opens a scene file (read_scene_file; a name ending in ".scene"), a recording
 /// (read_recording; ".kdetrec") or a folder of per-frame meshes (read_frame_folder).
-/// Throws kdet::Error naming the known scenes for an unknown name, and saying what is missing and
-/// where it was looked for when data is missing.
+/// Throws kdet::Error for a resolution outside 1-4 (whatever the scene), naming the known scenes for
+/// an unknown name, and saying what is missing and where it was looked for when data is missing.
 std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& request = {});
 
 /// @brief Names open_scene accepts, for help texts and error messages.
