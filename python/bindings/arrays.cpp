@@ -67,7 +67,15 @@ Coordinates from_cuda_array_interface(nb::handle object, const char* name);
 } // namespace
 
 std::string type_label(nb::handle object) {
-    return nb::cast<std::string>(nb::handle(reinterpret_cast<PyObject*>(Py_TYPE(object.ptr()))).attr("__name__"));
+    // Python's own types by name, others with their module: np.bool_ reads "numpy.bool", not "bool", and
+    // kdet's own as the package exports them.
+    const nb::handle type(reinterpret_cast<PyObject*>(Py_TYPE(object.ptr())));
+    const std::string name = nb::cast<std::string>(type.attr("__qualname__"));
+    const nb::object module_name = nb::getattr(type, "__module__", nb::none());
+    if (!nb::isinstance<nb::str>(module_name)) return name;
+    const std::string module = nb::cast<std::string>(module_name);
+    if (module == "builtins") return name;
+    return (module == "kdet._kdet" ? std::string("kdet") : module) + "." + name;
 }
 
 Coordinates coordinates(nb::handle object, const char* name) {

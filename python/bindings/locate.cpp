@@ -3,6 +3,7 @@
 #include "locate.hpp"
 
 #include "arrays.hpp"
+#include "scalars.hpp"
 
 #include <kdet/error.hpp>
 #include <kdet/locate.hpp>
@@ -73,10 +74,10 @@ nb::object buffer_view(const T* data, std::size_t rows, std::size_t columns, nb:
 }
 
 double within_of(nb::handle within) {
-    if (within.is_none()) return 0.0;
-    if (!PyFloat_Check(within.ptr()) && !(PyLong_Check(within.ptr()) && !PyBool_Check(within.ptr())))
-        throw nb::type_error(("within: expected a float or None, got " + type_label(within)).c_str());
-    return nb::cast<double>(within);
+    double distance = 0.0;
+    if (within.is_none()) return distance;
+    if (!read_real(within, distance)) throw nb::type_error(("within: expected a float or None, got " + type_label(within)).c_str());
+    return distance;
 }
 
 /// Refuses the keywords of a detection frame (margin, method, ...), which one-off point location
@@ -104,12 +105,13 @@ nb::object detector_locate(nb::handle owner, Detector& detector, std::mutex& mut
     options.results_to_host = !device_results;
     ObjectId id = all_objects;
     if (!object.is_none()) {
-        if (!PyLong_Check(object.ptr()) || PyBool_Check(object.ptr()))
+        long long value = 0;
+        bool overflow = false;
+        if (!read_integer(object, value, overflow))
             throw nb::type_error(("object: expected an int or None, got " + type_label(object)).c_str());
-        const long long value = nb::cast<long long>(object);
-        if (value < 0 || static_cast<std::uint64_t>(value) >= detector.object_count())
-            throw Error("object id " + std::to_string(value) + " out of range (" + std::to_string(detector.object_count()) +
-                        " objects)");
+        if (overflow || value < 0 || static_cast<std::uint64_t>(value) >= detector.object_count())
+            throw Error("object id " + nb::cast<std::string>(nb::str(object)) + " out of range (" +
+                        std::to_string(detector.object_count()) + " objects)");
         id = static_cast<ObjectId>(value);
     }
     const Coordinates c = coordinates(points, "points");

@@ -5,6 +5,7 @@
 #include "detector.hpp"
 #include "fields.hpp"
 #include "locate.hpp"
+#include "scalars.hpp"
 #include "scenes.hpp"
 #ifdef KDET_HAS_CUDA
 #include <cuda_runtime.h>
@@ -69,23 +70,25 @@ void set_option(const OptionInfo& o, nb::handle value, DetectorOptions& options)
     case OptionType::choice:
         if (!nb::isinstance<nb::str>(value)) throw wrong_type("a str");
         return o.parse(nb::cast<std::string>(value), options, o.name);
-    case OptionType::boolean:
-        if (!PyBool_Check(value.ptr())) throw wrong_type("a bool");
-        return o.set_number(options, value.ptr() == Py_True);
+    case OptionType::boolean: {
+        bool flag = false;
+        if (!read_bool(value, flag)) throw wrong_type("a bool");
+        return o.set_number(options, flag);
+    }
     case OptionType::integer: {
         if (value.is_none() && o.unset_by_default()) return o.put(options, o.get(DetectorOptions{}));
-        if (!PyLong_Check(value.ptr()) || PyBool_Check(value.ptr()))
-            throw wrong_type(o.unset_by_default() ? "an int or None" : "an int");
-        int overflow = 0;
-        const long long number = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
+        long long number = 0;
+        bool overflow = false;
+        if (!read_integer(value, number, overflow)) throw wrong_type(o.unset_by_default() ? "an int or None" : "an int");
         if (overflow)
             throw Error(std::string(o.label) + " " + nb::cast<std::string>(nb::str(value)) + " out of range");
         return o.set_number(options, number);
     }
-    case OptionType::real:
-        if (!(PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr())) || PyBool_Check(value.ptr()))
-            throw wrong_type("a float");
-        return o.set_real(options, nb::cast<double>(value));
+    case OptionType::real: {
+        double number = 0.0;
+        if (!read_real(value, number)) throw wrong_type("a float");
+        return o.set_real(options, number);
+    }
     }
 }
 
@@ -179,7 +182,7 @@ nb::object import_meshio(const char* what) {
     }
 }
 
-TetMesh from_meshio(nb::handle mesh, bool allow_degenerate) {
+TetMesh from_meshio(nb::handle mesh, Flag allow_degenerate) {
     if (!nb::hasattr(mesh, "points") || !nb::hasattr(mesh, "cells"))
         throw nb::type_error(("mesh: expected a meshio.Mesh, got " + type_label(mesh)).c_str());
     nb::list tets;
@@ -345,11 +348,11 @@ nb::object completed_frame(nb::handle handle, bool device_results, const FrameRe
     return nb::cast(device_frame.release(), nb::rv_policy::take_ownership);
 }
 
-nb::object detect(nb::handle handle, bool device_results) {
+nb::object detect(nb::handle handle, Flag device_results) {
     return completed_frame(handle, device_results, &Detector::detect, "detect");
 }
 
-nb::object finish(nb::handle handle, bool device_results) {
+nb::object finish(nb::handle handle, Flag device_results) {
     return completed_frame(handle, device_results, &Detector::finish, "finish");
 }
 
@@ -440,7 +443,7 @@ void bind_mesh(nb::module_& m) {
                         "of the mesh's own memory (no copies).")
         .def(
             "__init__",
-            [](TetMesh* self, nb::handle vertices, nb::handle tets, bool allow_degenerate) {
+            [](TetMesh* self, nb::handle vertices, nb::handle tets, Flag allow_degenerate) {
                 new (self) TetMesh(mesh_from_arrays(vertices, tets, allow_degenerate, "vertices", "tets", "TetMesh"));
             },
             "vertices"_a, "tets"_a, nb::kw_only(), "allow_degenerate"_a = false,
@@ -470,7 +473,7 @@ void bind_mesh(nb::module_& m) {
 
     m.def(
         "read_tet_mesh",
-        [](const std::filesystem::path& path, bool allow_degenerate) {
+        [](const std::filesystem::path& path, Flag allow_degenerate) {
             nb::gil_scoped_release release;
             return kdet::read_tet_mesh(path.string(), ReadOptions{allow_degenerate});
         },
@@ -479,7 +482,7 @@ void bind_mesh(nb::module_& m) {
         ".node/.ele or no extension (TetGen). Bad input raises kdet.Error naming the file and line.");
     m.def(
         "write_tet_mesh",
-        [](const TetMesh& mesh, const std::filesystem::path& path, bool binary) {
+        [](const TetMesh& mesh, const std::filesystem::path& path, Flag binary) {
             nb::gil_scoped_release release;
             kdet::write_tet_mesh(mesh, path.string(), WriteOptions{binary});
         },
@@ -608,21 +611,21 @@ void bind_detector(nb::module_& m) {
              "the next detect(), which raises kdet.Error on a non-finite value and keeps the previous positions.")
         .def(
             "set_self_collision",
-            [](PyDetector& self, std::int64_t object, bool enabled) {
+            [](PyDetector& self, std::int64_t object, Flag enabled) {
                 const ObjectId id = object_id(self, object);
                 locked(self, [&] { self.detector.set_self_collision(id, enabled); });
             },
             "object"_a, "enabled"_a = true, "Switches self-collision of one object (off by default).")
         .def(
             "set_pair_collision",
-            [](PyDetector& self, std::int64_t a, std::int64_t b, bool enabled) {
+            [](PyDetector& self, std::int64_t a, std::int64_t b, Flag enabled) {
                 const ObjectId ia = object_id(self, a), ib = object_id(self, b);
                 locked(self, [&] { self.detector.set_pair_collision(ia, ib, enabled); });
             },
             "a"_a, "b"_a, "enabled"_a, "Switches collision between two different objects (on by default).")
         .def(
             "set_static",
-            [](PyDetector& self, std::int64_t object, bool is_static) {
+            [](PyDetector& self, std::int64_t object, Flag is_static) {
                 const ObjectId id = object_id(self, object);
                 locked(self, [&] { self.detector.set_static(id, is_static); });
             },
@@ -650,7 +653,7 @@ void bind_detector(nb::module_& m) {
              "the frame runs again) and returns what detect() returns.")
         .def(
             "locate",
-            [](nb::handle handle, nb::handle points, nb::handle object, nb::handle within, bool device_results) {
+            [](nb::handle handle, nb::handle points, nb::handle object, nb::handle within, Flag device_results) {
                 PyDetector& self = nb::cast<PyDetector&>(handle);
                 return detector_locate(handle, self.detector, self.mutex, points, object, within, device_results);
             },

@@ -2,6 +2,7 @@
 // C++ scene API (kdet/scenes.hpp, the kdet_scenes target) gives them to `kdet bench`; the frame loop
 // that plays a scene into a Detector is kdet.run_scene() in the pure-Python part.
 #include "detector.hpp"
+#include "scalars.hpp"
 #include "scenes.hpp"
 
 #include <kdet/scenes.hpp>
@@ -122,7 +123,7 @@ void bind_scenes(nb::module_& m) {
     m.def("scene_names", &scene_names, "The scene names open_scene() knows.");
     m.def(
         "add_scene_objects",
-        [](PyDetector& detector, const PyScene& s, bool self) {
+        [](PyDetector& detector, const PyScene& s, Flag self) {
             locked(detector, [&] { add_scene_objects(detector.detector, *s.scene, self); });
         },
         "detector"_a, "scene"_a, "self_collision"_a = false,

@@ -198,6 +198,23 @@ def test_gpu_arrays_need_the_cuda_backend(octopus):
         detector.locate(FakeCudaArray(3))
 
 
+def test_numpys_scalars_are_read_as_pythons(octopus):
+    # What indexing a NumPy array gives: np.bool_ for every bool argument, NumPy numbers for ids and within.
+    is_static = np.array([True, False])
+    detector = kdet.Detector()
+    ia, ib = detector.add_object(octopus), detector.add_object(octopus)
+    detector.set_static(ia, is_static[0])
+    assert detector.is_static(ia) and not detector.is_static(ib)
+    detector.set_self_collision(np.int64(ib), np.True_)
+    detector.set_pair_collision(ia, ib, np.bool_(True))
+    assert len(detector.detect(device_results=np.False_).pairs) > 0
+    hits = detector.locate(octopus.vertices[:3], object=np.uint8(ia), within=np.float32(0.5))
+    assert len(hits.offsets) == 4
+    assert kdet.TetMesh(octopus.vertices, octopus.tets, allow_degenerate=np.False_).num_tets == octopus.num_tets
+    with pytest.raises(TypeError, match=r"within: expected a float or None, got numpy\.bool_?$"):
+        detector.locate(octopus.vertices[:3], within=np.True_)
+
+
 def pairs_with(a: kdet.TetMesh, b_vertices, b_tets) -> np.ndarray:
     detector = kdet.Detector()
     detector.add_object(a)

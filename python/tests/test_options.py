@@ -7,6 +7,7 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import kdet
@@ -64,6 +65,24 @@ def test_every_keyword_takes_a_valid_value_and_refuses_an_invalid_one(name):
                 kdet.Detector(**{name: bad})
     with pytest.raises(TypeError, match=f"^{name}: expected"):
         kdet.Detector(**{name: object()})
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if kdet.OPTIONS[n]["type"] != "choice"])
+def test_every_keyword_takes_numpys_scalars_of_its_kind(name):
+    # What indexing or reducing a NumPy array gives (np.float32, np.int64, np.bool_) reads as Python's own
+    # scalar of that kind; a bool is still no number, nor a number a bool.
+    entry = kdet.OPTIONS[name]
+    value = valid(entry)
+    if entry["type"] == "boolean":
+        scalars, other_kind = [np.bool_(value)], np.int64(1)
+    elif entry["type"] == "integer":
+        scalars, other_kind = [np.int64(value), np.uint32(value)], np.True_
+    else:
+        scalars, other_kind = [np.float32(value), np.float64(value), np.int16(1)], np.True_
+    for scalar in scalars:
+        assert kdet.Detector(**{name: scalar}).options[name] == scalar, type(scalar).__name__
+    with pytest.raises(TypeError, match=f"^{name}: expected "):
+        kdet.Detector(**{name: other_kind})
 
 
 @pytest.mark.parametrize("name", [n for n in NAMES if kdet.OPTIONS[n]["type"] == "choice"])
