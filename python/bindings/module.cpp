@@ -17,14 +17,18 @@
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <algorithm>
+#include <array>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace kdet::python {
@@ -437,6 +441,29 @@ void bind_module(nb::module_& m) {
         "Why the CUDA backend cannot run here, or None when it can.");
 }
 
+/// write_gmsh and write_vtk: a writer whose format has a version, named as the file's header has it (the
+/// first of @p versions is the default), and a binary form.
+template <class Format>
+void bind_versioned_writer(nb::module_& m, const char* name, void (*write)(const TetMesh&, const std::string&, const Format&),
+                           const char* format_name, std::array<std::pair<const char*, decltype(Format::version)>, 2> versions,
+                           const char* doc) {
+    m.def(
+        name,
+        [write, format_name, versions](const TetMesh& mesh, const std::filesystem::path& path, const std::string& version,
+                                       Flag binary) {
+            Format format;
+            format.binary = binary;
+            const auto known = std::find_if(versions.begin(), versions.end(), [&](const auto& v) { return version == v.first; });
+            if (known == versions.end())
+                throw Error(std::string("version: ") + format_name + " '" + version + "' is not written (" + versions[1].first +
+                            " or " + versions[0].first + ")");
+            format.version = known->second;
+            nb::gil_scoped_release release;
+            write(mesh, path.string(), format);
+        },
+        "mesh"_a, "path"_a, nb::kw_only(), "version"_a = versions[0].first, "binary"_a = false, doc);
+}
+
 void bind_mesh(nb::module_& m) {
     nb::class_<TetMesh>(m, "TetMesh",
                         "A tetrahedral mesh: vertices (n, 3) float64 and tets (m, 4) uint32, 0-based. Both are views "
@@ -489,6 +516,57 @@ void bind_mesh(nb::module_& m) {
         "mesh"_a, "path"_a, nb::kw_only(), "binary"_a = false,
         "Writes a tet mesh in the format its extension names (as read_tet_mesh reads it); binary applies to .msh "
         "and .vtk.");
+    bind_versioned_writer<GmshFormat>(m, "write_gmsh", &kdet::write_gmsh, "Gmsh MSH", {{{"4.1", GmshVersion::v4_1}, {"2.2", GmshVersion::v2_2}}},
+                                      "Writes a Gmsh MSH file, version '4.1' or '2.2', ASCII or binary, whatever the "
+                                      "extension of path.");
+    bind_versioned_writer<VtkFormat>(m, "write_vtk", &kdet::write_vtk, "legacy VTK", {{{"5.1", VtkVersion::v5_1}, {"4.2", VtkVersion::v4_2}}},
+                                     "Writes a legacy VTK UNSTRUCTURED_GRID, version '5.1' (VTK 9's OFFSETS/CONNECTIVITY) "
+                                     "or '4.2' (classic CELLS), ASCII or binary, whatever the extension of path.");
+    m.def(
+        "read_surface",
+        [](const std::filesystem::path& path) {
+            auto* surface = new TriangleMesh();
+            try {
+                nb::gil_scoped_release release;
+                *surface = kdet::read_surface(path.string());
+            } catch (...) {
+                delete surface;
+                throw;
+            }
+            nb::capsule owner(surface, [](void* held) noexcept { delete static_cast<TriangleMesh*>(held); });
+            return std::make_pair(rows_view<double, 3>(surface->positions.data(), surface->num_vertices(), owner),
+                                  rows_view<std::uint32_t, 3>(surface->triangles.data(), surface->num_triangles(), owner));
+        },
+        "path"_a,
+        "Reads a triangle surface (.obj, .off, .stl, .ply): (vertices (n, 3) float64, triangles (m, 3) uint32, "
+        "0-based). Bad input raises kdet.Error naming the file and line.");
+    m.def(
+        "read_points",
+        [](const std::filesystem::path& path) {
+            auto* xyz = new std::vector<double>();
+            try {
+                nb::gil_scoped_release release;
+                *xyz = kdet::read_points(path.string());
+            } catch (...) {
+                delete xyz;
+                throw;
+            }
+            nb::capsule owner(xyz, [](void* held) noexcept { delete static_cast<std::vector<double>*>(held); });
+            return rows_view<double, 3>(xyz->data(), xyz->size() / 3, owner);
+        },
+        "path"_a,
+        "Reads query points as `kdet locate` does: a text file of `x y z` lines (# starts a comment), or any tet "
+        "mesh file, whose vertices are the points. Returns (n, 3) float64; bad input raises kdet.Error naming the "
+        "file and line.");
+    m.def(
+        "validate_tet_mesh",
+        [](const TetMesh& mesh, const std::string& source, Flag allow_degenerate) {
+            kdet::validate_tet_mesh(mesh, source, ReadOptions{allow_degenerate});
+        },
+        "mesh"_a, "source"_a = "TetMesh", nb::kw_only(), "allow_degenerate"_a = false,
+        "Checks a mesh as the readers check files (finite coordinates, indices in range, no zero-volume tets "
+        "unless allow_degenerate), for one whose arrays were changed in place; raises kdet.Error naming source "
+        "and the first bad vertex or tet.");
     m.def("from_meshio", &from_meshio, "mesh"_a, nb::kw_only(), "allow_degenerate"_a = false,
           "A TetMesh from a meshio.Mesh: its points and its 'tetra' (and 'tetra10' corner) cells.");
 }

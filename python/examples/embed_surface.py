@@ -3,7 +3,7 @@
 coordinates there), deforms the tet mesh, and carries the surface along: each vertex moves to the same
 barycentric combination of its tet's moved vertices, as a simulation's visual mesh follows its cage.
 
-usage: python3 embed_surface.py [TETS] [SURFACE] [--within D]
+usage: python3 embed_surface.py [TETS] [SURFACE] [--within D]   (SURFACE: .obj, .off, .stl or .ply)
        (default: bunny.mesh and bunny.off from $KDET_DATA_DIR, else ../shared/models)
 
 A vertex that no tet holds (outside the tet mesh) takes the nearest tet within D, with the barycentric
@@ -26,15 +26,6 @@ def default_model(name: str) -> Path:
     return Path(os.environ.get("KDET_DATA_DIR", "../shared/models")) / name
 
 
-def read_off_vertices(path: Path) -> np.ndarray:
-    """The vertices of an OFF surface (the header, then the counts, then one vertex per line)."""
-    words = path.read_text().split()
-    if words[0] != "OFF":
-        raise SystemExit(f"{path}: not an OFF file")
-    count = int(words[1])
-    return np.array(words[4:4 + 3 * count], dtype=np.float64).reshape(count, 3)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("tets", nargs="?", type=Path, default=default_model("bunny.mesh"))
@@ -43,7 +34,7 @@ def main() -> None:
     args = parser.parse_args()
 
     mesh = kdet.read_tet_mesh(args.tets)
-    points = read_off_vertices(args.surface)
+    points, _ = kdet.read_surface(args.surface)  # any of .obj, .off, .stl, .ply
     located = kdet.locate(mesh, points, within=args.within)
 
     # One tet per point: the first of its hits (a point on a shared face, edge or vertex has several,

@@ -59,10 +59,15 @@ from ._kdet import (
     cuda_unavailable_reason,
     from_meshio,
     open_scene,
+    read_points,
+    read_surface,
     read_tet_mesh,
     scene_names,
+    validate_tet_mesh,
     version,
+    write_gmsh,
     write_tet_mesh,
+    write_vtk,
 )
 from ._scenes import run_scene
 
@@ -90,11 +95,16 @@ __all__ = [
     "from_meshio",
     "locate",
     "open_scene",
+    "read_points",
+    "read_surface",
     "read_tet_mesh",
     "run_scene",
     "scene_names",
+    "validate_tet_mesh",
     "version",
+    "write_gmsh",
     "write_tet_mesh",
+    "write_vtk",
 ]
 
 # What collide() and collide_self() take as a mesh: a TetMesh, a meshio.Mesh, or (vertices, tets).
