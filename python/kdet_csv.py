@@ -32,14 +32,17 @@ class BenchFile:
 
     @property
     def scene(self) -> str:
-        """The scene's name, with `kdet bench`'s file-name suffix for --rings and --filters off, so that
-        such runs are told apart from the plain ones in tables and plots."""
+        """The scene's name, with `kdet bench`'s file-name suffix for --rings, --filters off and --margin,
+        so that such runs are told apart from the plain ones in tables and plots."""
         name = self.header.get("scene name", "?")
         rings = self.header.get("exclusion rings", "0")
         if rings != "0":
             name += f"_rings{rings}"
         if self.header.get("collision filters", "on") == "off":
             name += "_filters-off"
+        margin = self.header.get("margin", "0")
+        if margin != "0":
+            name += f"_margin{margin}"
         return name
 
     @property

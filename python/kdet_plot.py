@@ -29,6 +29,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # files only, no display
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 import numpy as np  # noqa: E402
 
 from kdet_csv import BenchFile, read_folder  # noqa: E402
@@ -41,7 +42,7 @@ STAGES = [
     ("narrow phase time", "narrow phase"),
 ]
 # Parameters that tell apart two files of the same method in one figure.
-DISTINGUISHING_KEYS = ["overlap test", "hashing algorithm", "block size", "threads", "backend", "first frame"]
+DISTINGUISHING_KEYS = ["overlap test", "hashing algorithm", "block size", "threads", "backend", "first frame", "#frames"]
 
 
 def series_label(bench: BenchFile, others: list[BenchFile]) -> str:
@@ -65,12 +66,32 @@ def suffix(self_collisions: bool) -> str:
     return "_self" if self_collisions else ""
 
 
-def by_setting(files: list[BenchFile]) -> dict[tuple[str, bool], list[BenchFile]]:
-    """Files grouped by (method, self-collisions)."""
-    groups: dict[tuple[str, bool], list[BenchFile]] = defaultdict(list)
+def setting(bench: BenchFile, files: list[BenchFile]) -> tuple[tuple[str, str], ...]:
+    """What tells a file apart from the others of its method and self-collision setting in one case (scene
+    and resolution): (name, value) of the parameters of DISTINGUISHING_KEYS, and the tet count, that vary
+    within a case."""
+    same = [f for f in files if (f.algorithm, f.self_collisions) == (bench.algorithm, bench.self_collisions)]
+    cases: dict[tuple[str, int], list[BenchFile]] = defaultdict(list)
+    for f in same:
+        cases[(f.scene, f.resolution)].append(f)
+    values = [(key, lambda f, key=key: f.header.get(key)) for key in DISTINGUISHING_KEYS]
+    values.append(("tets", lambda f: str(f.total_tets)))
+    return tuple((name, value(bench)) for name, value in values
+                 if any(len({value(f) for f in case}) > 1 for case in cases.values()))
+
+
+def by_setting(files: list[BenchFile]) -> dict[tuple[str, bool], tuple[str, list[BenchFile]]]:
+    """Files grouped by method, self-collisions and the parameters that set them apart within a case, so
+    that each group has one file per panel: (name for file names, self-collisions) -> (label, files)."""
+    groups: dict[tuple, list[BenchFile]] = defaultdict(list)
     for bench in files:
-        groups[(bench.algorithm, bench.self_collisions)].append(bench)
-    return groups
+        groups[(bench.algorithm, bench.self_collisions, setting(bench, files))].append(bench)
+    named: dict[tuple[str, bool], tuple[str, list[BenchFile]]] = {}
+    for (method, self_collisions, values), members in groups.items():
+        label = ", ".join([method] + [f"{name} {value}" for name, value in values])
+        name = label.replace(", ", "_").replace(" ", "-").replace("#", "")
+        named[(name, self_collisions)] = (label, members)
+    return named
 
 
 def save(fig, path: str, written: list[str]) -> None:
@@ -81,7 +102,7 @@ def save(fig, path: str, written: list[str]) -> None:
 
 
 def grid_figure(files: list[BenchFile], draw: Callable, title: str, path: str, written: list[str]) -> None:
-    """One panel per scene (rows) and resolution (columns); `draw(ax, files_of_panel)` fills a panel."""
+    """One panel per scene (rows) and resolution (columns); `draw(ax, files_of_panel, files)` fills a panel."""
     scenes = sorted({f.scene for f in files})
     resolutions = sorted({f.resolution for f in files})
     fig, axes = plt.subplots(len(scenes), len(resolutions), squeeze=False,
@@ -93,47 +114,63 @@ def grid_figure(files: list[BenchFile], draw: Callable, title: str, path: str, w
             if not panel:
                 ax.axis("off")
                 continue
-            draw(ax, panel)
+            draw(ax, panel, files)
             ax.set_title(f"{scene} - {resolution}", fontsize=10)
             ax.set_xlabel("frame")
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.grid(alpha=0.3)
     fig.suptitle(title)
     save(fig, path, written)
 
 
-# One colour per method in every panel and figure (where a panel holds one file of that method).
+# One colour per method in every panel and figure where the files hold one setting of it; the settings
+# of a method run several ways take the other colours, none of them a method's.
 METHOD_COLORS = {"kdet": "tab:red", "kdet_no_pairs": "tab:green", "gpu": "tab:orange", "gpu_no_loop": "tab:blue"}
+SETTING_COLORS = ["tab:purple", "tab:brown", "tab:pink", "tab:gray", "tab:olive", "tab:cyan", "black", "gold"]
 
 
-def method_color(bench: BenchFile, panel: list[BenchFile]) -> str | None:
-    alone = sum(1 for other in panel if other.algorithm == bench.algorithm) == 1
-    return METHOD_COLORS.get(bench.algorithm) if alone else None
+def method_color(bench: BenchFile, files: list[BenchFile]) -> str:
+    """The colour of a file's series, the same in every panel that draws it among `files`."""
+    labels = sorted({series_label(f, files) for f in files})
+    same_method = sorted({series_label(f, files) for f in files if f.algorithm == bench.algorithm})
+    if len(same_method) == 1 and bench.algorithm in METHOD_COLORS:
+        return METHOD_COLORS[bench.algorithm]
+    return SETTING_COLORS[labels.index(series_label(bench, files)) % len(SETTING_COLORS)]
 
 
-def draw_frame_times(ax, panel: list[BenchFile]) -> None:
+def single_frame_marker(bench: BenchFile) -> str | None:
+    """A marker where a series has one frame, which a line alone would not show."""
+    return "o" if len(bench.rows) == 1 else None
+
+
+def draw_frame_times(ax, panel: list[BenchFile], files: list[BenchFile]) -> None:
     for bench in panel:
         ax.plot(bench.column("frame"), bench.column("device time"), label=series_label(bench, panel), linewidth=1.2,
-                color=method_color(bench, panel))
+                color=method_color(bench, files), marker=single_frame_marker(bench))
     ax.set_ylabel("frame time (ms)")
     ax.legend(fontsize=7)
 
 
-def draw_stages(ax, panel: list[BenchFile]) -> None:
-    bench = panel[0]  # one method per figure; several files only when other parameters vary
-    ax.stackplot(bench.column("frame"), *[bench.column(c) for c, _ in STAGES], labels=[n for _, n in STAGES])
+def draw_stages(ax, panel: list[BenchFile], files: list[BenchFile]) -> None:
+    bench = panel[0]  # one setting per figure (by_setting), so one file per panel
+    stages = [bench.column(c) for c, _ in STAGES]
+    ax.stackplot(bench.column("frame"), *stages, labels=[n for _, n in STAGES])
     ax.set_ylabel("time (ms)")
-    ax.legend(fontsize=7, loc="upper left")
+    # Room above the stack for the legend, which a filled area leaves nowhere else.
+    ax.set_ylim(0, 1.45 * max(max(map(sum, zip(*stages))), 1e-9))
+    ax.legend(fontsize=7, loc="upper left", ncol=2)
 
 
-def draw_host_vs_device(ax, panel: list[BenchFile]) -> None:
+def draw_host_vs_device(ax, panel: list[BenchFile], files: list[BenchFile]) -> None:
     bench = panel[0]
-    ax.plot(bench.column("frame"), bench.column("host time"), label="host", linewidth=1.2)
-    ax.plot(bench.column("frame"), bench.column("device time"), label="device", linewidth=1.0, linestyle="--")
+    marker = single_frame_marker(bench)
+    ax.plot(bench.column("frame"), bench.column("host time"), label="host", linewidth=1.2, marker=marker)
+    ax.plot(bench.column("frame"), bench.column("device time"), label="device", linewidth=1.0, linestyle="--", marker=marker)
     ax.set_ylabel("time (ms)")
     ax.legend(fontsize=7)
 
 
-def draw_run_spread(ax, panel: list[BenchFile]) -> None:
+def draw_run_spread(ax, panel: list[BenchFile], files: list[BenchFile]) -> None:
     bench = panel[0]
     per_frame: dict[float, list[float]] = defaultdict(list)
     for frame, time in zip(bench.column("frame"), bench.column("device time")):
@@ -175,9 +212,10 @@ def penetration_figure(scene: str, files: list[BenchFile], path: str, written: l
         drawn = True
         depth, time, candidates = (np.array(v) for v in zip(*points))
         label = f"{series_label(bench, files)} - r{bench.resolution}"
-        time_ax.scatter(depth, time, s=10, label=label)
+        color = method_color(bench, files) if len({f.resolution for f in files}) == 1 else None
+        dots = time_ax.scatter(depth, time, s=10, label=label, color=color)
         if bench.header.get("hashing algorithm") != "none":  # the grid methods, as in the thesis
-            dots = pairs_ax.scatter(depth, candidates, s=10, label=label)
+            pairs_ax.scatter(depth, candidates, s=10, label=label, color=dots.get_facecolor()[0])
             if len(depth) >= 4 and np.ptp(depth) > 0:
                 fit = np.polyfit(depth, candidates, 3)
                 line = np.linspace(depth.min(), depth.max(), 100)
@@ -198,19 +236,20 @@ def penetration_figure(scene: str, files: list[BenchFile], path: str, written: l
 def memory_figure(files: list[BenchFile], title: str, path: str, written: list[str]) -> None:
     case_of = {(f.resolution, f.scene, f.total_tets): f for f in files}
     cases = sorted(case_of)
-    methods = sorted({f.algorithm for f in files})
-    height = 0.8 / len(methods)
-    fig, ax = plt.subplots(figsize=(8, 1.0 + 0.45 * len(cases) * len(methods)))
-    for m, method in enumerate(methods):
+    series = sorted({series_label(f, files) for f in files})
+    height = 0.8 / len(series)
+    fig, ax = plt.subplots(figsize=(8, 1.0 + 0.45 * len(cases) * len(series)))
+    for m, label in enumerate(series):
+        of_series = [f for f in files if series_label(f, files) == label]
         mib = []
         for case in cases:
-            match = [f for f in files if (f.resolution, f.scene, f.total_tets, f.algorithm) == case + (method,)]
-            mib.append(int(match[0].header.get("peak memory bytes", "0")) / 2**20 if match else 0.0)
-        ax.barh(np.arange(len(cases)) + m * height, mib, height=height, label=method, color=METHOD_COLORS.get(method))
+            match = [f for f in of_series if (f.resolution, f.scene, f.total_tets) == case]
+            mib.append(max(int(f.header.get("peak memory bytes", "0")) for f in match) / 2**20 if match else 0.0)
+        ax.barh(np.arange(len(cases)) + m * height, mib, height=height, label=label, color=method_color(of_series[0], files))
     ax.set_yticks(np.arange(len(cases)) + 0.4 - height / 2, [case_label(case_of[c], files) for c in cases],
                   fontsize=8)
     ax.set_xlabel("peak detector memory (MiB)")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.grid(axis="x", alpha=0.3)
     ax.set_title(title)
     save(fig, path, written)
@@ -248,19 +287,20 @@ def plot_folder(folder: str, out: str) -> list[str]:
                     os.path.join(out, f"frame_times{suffix(self_collisions)}.png"), written)
         memory_figure(files, "Detector memory" + with_self,
                       os.path.join(out, f"memory{suffix(self_collisions)}.png"), written)
-    for (method, self_collisions), files in sorted(by_setting(averages).items()):
-        name = f"{method}{suffix(self_collisions)}"
+    for (setting_name, self_collisions), (label, files) in sorted(by_setting(averages).items()):
+        name = f"{setting_name}{suffix(self_collisions)}"
         with_self = ", with self-collisions" if self_collisions else ""
-        grid_figure(files, draw_stages, f"Time per stage: {method}{with_self}",
+        grid_figure(files, draw_stages, f"Time per stage: {label}{with_self}",
                     os.path.join(out, f"stages_{name}.png"), written)
-        grid_figure(files, draw_host_vs_device, f"Host vs device time: {method}{with_self}",
+        grid_figure(files, draw_host_vs_device, f"Host vs device time: {label}{with_self}",
                     os.path.join(out, f"host_vs_device_{name}.png"), written)
-        boxplot_figure(files, f"Frame times: {method}{with_self}", os.path.join(out, f"boxplot_{name}.png"), written)
-    for (method, self_collisions), files in sorted(by_setting(raw).items()):
+        boxplot_figure(files, f"Frame times: {label}{with_self}", os.path.join(out, f"boxplot_{name}.png"), written)
+    for (setting_name, self_collisions), (label, files) in sorted(by_setting(raw).items()):
         with_self = ", with self-collisions" if self_collisions else ""
-        grid_figure(files, draw_run_spread, f"Spread over the runs: {method}{with_self}",
-                    os.path.join(out, f"run_spread_{method}{suffix(self_collisions)}.png"), written)
-    for scene in sorted({f.scene for f in averages}):
+        grid_figure(files, draw_run_spread, f"Spread over the runs: {label}{with_self}",
+                    os.path.join(out, f"run_spread_{setting_name}{suffix(self_collisions)}.png"), written)
+    # The box overlap along x is that of a scene's first two objects: a depth only where there are two.
+    for scene in sorted({f.scene for f in averages if int(f.header.get("#objects", "2")) == 2}):
         files = [f for f in averages if f.scene == scene and not f.self_collisions]
         penetration_figure(scene, files, os.path.join(out, f"penetration_{scene}.png"), written)
     total_time_figure(averages, os.path.join(out, "total_time.png"), written)

@@ -7,11 +7,13 @@
 #include <kdet/detector.hpp>
 #include <kdet/io.hpp>
 #include <kdet/locate.hpp>
+#include <kdet/option_table.hpp>
 
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -186,6 +188,15 @@ TEST(Cli, LocateWritesTheLibrarysHitsAndNamesBadLines) {
     }
     EXPECT_EQ(lines, expected.hit_count);
     EXPECT_GT(lines, 0u);
+    std::size_t held = 0, near = 0;
+    for (std::size_t p = 0; p < expected.point_count; ++p)
+        if (expected.offsets[p + 1] > expected.offsets[p]) ++(expected.distances[expected.offsets[p]] > 0 ? near : held);
+    ASSERT_GT(held, 0u);
+    ASSERT_GT(near, 0u);
+    EXPECT_NE(r.out.find("located " + std::to_string(held + near) + " (" + std::to_string(held) + " in a tet, " +
+                         std::to_string(near) + " near one)"),
+              std::string::npos)
+        << r.out;
 
     const Outcome bad = kdet_cli("locate " + data_path("octopus-low.mesh") + " " + (dir / "bad.txt").string() + " --out " + out.string());
     EXPECT_EQ(bad.exit_code, 1);
@@ -198,6 +209,48 @@ TEST(Cli, LocateWritesTheLibrarysHitsAndNamesBadLines) {
         EXPECT_NE(refused.out.find("for --within"), std::string::npos) << refused.out;
         EXPECT_EQ(line_count(refused.out), 1u) << refused.out;
     }
+}
+
+TEST(Cli, WithAMarginTheSummaryCountsThePairsWithinItAndThoseThatOverlap) {
+    const TetMesh bunny = test::load_model("bunny.mesh");
+    const auto dir = temp_dir();
+    write_tetgen(test::moved(bunny, 0.0, 0.9 * test::extent_of(bunny), 0.0, 0.0), (dir / "beside").string()); // touching
+    DetectorOptions options;
+    options.margin = 0.05f * static_cast<float>(test::extent_of(bunny));
+    options.distances = true;
+    Detector detector(options);
+    detector.add_object(bunny);
+    detector.add_object(read_tet_mesh((dir / "beside").string()));
+    const FrameResult& expected = detector.detect();
+    const auto overlapping = static_cast<std::size_t>(std::count(expected.distances.begin(), expected.distances.end(), 0.0f));
+    ASSERT_GT(overlapping, 0u);
+    ASSERT_LT(overlapping, expected.pairs.size());
+    const std::string margin = find_option("margin")->text(options);
+    const std::string arguments = "collide " + data_path("bunny.mesh") + " " + (dir / "beside").string() + " --margin " + margin;
+    const Outcome with_distances = kdet_cli(arguments + " --distances " + (dir / "distances.txt").string());
+    ASSERT_EQ(with_distances.exit_code, 0) << with_distances.out;
+    EXPECT_NE(with_distances.out.find("pairs in margin   " + std::to_string(expected.pairs.size()) + " (" +
+                                      std::to_string(overlapping) + " overlapping, the rest apart)\n"),
+              std::string::npos)
+        << with_distances.out;
+    const Outcome without = kdet_cli(arguments);
+    EXPECT_NE(without.out.find("pairs in margin   " + std::to_string(expected.pairs.size()) + "\n"), std::string::npos) << without.out;
+    EXPECT_EQ(without.out.find("colliding pairs"), std::string::npos) << without.out;
+    const Outcome json = kdet_cli(arguments + " --json --distances " + (dir / "distances.txt").string());
+    EXPECT_NE(json.out.find("\"margin\": " + margin + ","), std::string::npos) << json.out;
+    EXPECT_NE(json.out.find("\"overlapping_pairs\": " + std::to_string(overlapping) + ","), std::string::npos) << json.out;
+}
+
+TEST(Cli, BenchWithoutPairsCountsItsTetsAndHelpListsTheTablesOptions) {
+    const Outcome r = kdet_cli("bench --tets 3000 --scene-frames 3 -n 1 -c kdet_no_pairs -d " + (temp_dir() / "bench").string());
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    EXPECT_NE(r.out.find("most colliding tets in a frame"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("most colliding pairs"), std::string::npos) << r.out;
+    const Outcome help = kdet_cli("bench --help");
+    for (const OptionInfo& o : option_table())
+        if (o.shown_on(front_end_bench)) {
+            EXPECT_NE(help.out.find(std::string(o.bench_flag) + " "), std::string::npos) << o.name;
+        }
 }
 
 TEST(Cli, BenchRunsTheBuiltInSceneWithoutData) {

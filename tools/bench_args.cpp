@@ -11,6 +11,16 @@ namespace kdet::cli {
 
 namespace {
 
+/// The table's options that bench takes under their --flag (the thesis's single-letter flags and the
+/// backend are worded above).
+std::string table_options_help(const DetectorOptions& defaults) {
+    std::string lines;
+    for (const OptionInfo& o : option_table())
+        if (o.shown_on(front_end_bench) && std::string(o.bench_flag).rfind("--", 0) == 0 && std::string(o.name) != "backend")
+            lines += option_help_line(o, front_end_bench, defaults);
+    return lines;
+}
+
 std::string help_text() {
     const DetectorOptions defaults = bench_default_options();
     std::string thesis_names;
@@ -43,8 +53,7 @@ thesis options (any order):
 
 more options:
   --backend B          where detection runs: )" + find_option("backend")->values_help(defaults) + R"(; cuda needs a GPU
-)" + option_help_line(*find_option("threads"), front_end_bench, defaults) +
-           option_help_line(*find_option("bucket_capacity"), front_end_bench, defaults) + R"(  --frames A:B         run frames A to B only (0-based, inclusive)
+)" + table_options_help(defaults) + R"(  --frames A:B         run frames A to B only (0-based, inclusive)
   --rings K            with -s yes: also leave out tets within K mesh edges of each other in every
                        object (self-exclusion rings, 0-)" + std::to_string(max_exclusion_rings) + R"(; default 0: only tets sharing a vertex)
   --filters on|off     the scene's collision filters between objects (heap's groups; default on)

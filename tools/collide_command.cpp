@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -21,7 +22,8 @@ namespace {
 const char* collide_help = R"(usage: kdet collide A [B] [options]
 
 Reports the colliding tetrahedron pairs between meshes A and B, or inside A with --self
-(with --margin D, every pair at most D apart).
+(with --margin D, every pair at most D apart: the summary counts them, and with --distances
+how many of them overlap).
 A and B are tet meshes: TetGen (name, name.node or name.ele), MEDIT .mesh, Gmsh .msh (2.2 or 4.1)
 or legacy VTK .vtk (4.x or 5.1); these two ASCII or binary.
 Tetrahedra of one mesh that share a vertex are adjacent and never reported.
@@ -31,8 +33,9 @@ options:
   --exclusion-rings K  with --self, also leave out tets with vertices within K mesh edges of
                        each other (0-4; 0, the default, leaves out only tets sharing a vertex)
   --pairs FILE         write 'i j' per line: 0-based tet indices in file order, sorted
-  --contacts FILE      write 'i j depth nx ny nz' per colliding pair: moving B's tet j by depth
-                       along (nx, ny, nz) separates it from A's tet i (from the 44-axis SAT)
+  --contacts FILE      write 'i j depth nx ny nz' per pair: moving B's tet j by depth along
+                       (nx, ny, nz) separates it from A's tet i (from the 44-axis SAT); with
+                       --margin, a pair that does not overlap reads 'i j 0 0 0 0'
   --distances FILE     write 'i j distance ax ay az bx by bz' per pair: the distance and a closest
                        point on A's tet i, then on B's tet j (a common point when they intersect)
   --check-exact        judge the chosen test against CGAL's exact predicates and print its
@@ -58,6 +61,11 @@ std::string one_line(const nlohmann::ordered_json& value) {
 
 /// @brief Milliseconds to the nanosecond, printed as such rather than with the binary fraction's tail.
 double milliseconds(double value) { return std::round(value * 1e6) / 1e6; }
+
+/// @brief Of a frame's pairs within the margin, those that overlap (distance 0); needs its distances.
+std::uint64_t overlapping_pairs(const FrameResult& result) {
+    return static_cast<std::uint64_t>(std::count(result.distances.begin(), result.distances.end(), 0.0f));
+}
 
 /// @brief What follows a pair's indices in write_pair_lines.
 enum class PairColumns { none, contacts, distances };
@@ -181,10 +189,11 @@ int run_collide(int argc, char** argv) {
         out["self"] = self;
         if (self) out["exclusion_rings"] = rings;
         for (const char* name : {"method", "test", "hash", "backend"}) out[name] = find_option(name)->text(options);
-        out["margin"] = find_option("margin")->real(options);
+        out["margin"] = std::stod(find_option("margin")->text(options)); // as given, not widened from float
         out["candidates"] = c.candidates;
         out["narrow_phase_candidates"] = c.narrow_phase_candidates;
         out["colliding_pairs"] = c.colliding_pairs;
+        if (options.margin > 0.0f && options.distances) out["overlapping_pairs"] = overlapping_pairs(result);
         out["colliding_tets"] = c.colliding_tets;
         out["buffer_regrows"] = c.buffer_regrows;
         out["host_waits"] = c.host_waits;
@@ -214,9 +223,15 @@ int run_collide(int argc, char** argv) {
     if (options.margin > 0.0f) std::printf("margin            %s\n", find_option("margin")->text(options).c_str());
     std::printf("candidates        %llu (%llu to the narrow phase)\n", static_cast<unsigned long long>(c.candidates),
                 static_cast<unsigned long long>(c.narrow_phase_candidates));
-    if (options.method != Method::kdet_no_pairs)
-        std::printf("colliding pairs   %llu\n", static_cast<unsigned long long>(c.colliding_pairs));
-    std::printf("colliding tets    %llu\n", static_cast<unsigned long long>(c.colliding_tets));
+    // With a margin the pairs are those within it, overlapping or not; their distances split them.
+    const bool margin = options.margin > 0.0f;
+    if (options.method != Method::kdet_no_pairs) {
+        std::printf(margin ? "pairs in margin   %llu" : "colliding pairs   %llu", static_cast<unsigned long long>(c.colliding_pairs));
+        if (margin && options.distances)
+            std::printf(" (%llu overlapping, the rest apart)", static_cast<unsigned long long>(overlapping_pairs(result)));
+        std::printf("\n");
+    }
+    std::printf(margin ? "tets in a pair    %llu\n" : "colliding tets    %llu\n", static_cast<unsigned long long>(c.colliding_tets));
     if (options.narrow_phase == NarrowPhase::exact)
         std::printf("exact stage       %llu pairs\n", static_cast<unsigned long long>(c.exact_stage_pairs));
     std::printf("times (ms)        boxes %.3f, populate %.3f, candidates %.3f, sort pairs %.3f, narrow %.3f\n",

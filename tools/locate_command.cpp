@@ -80,9 +80,15 @@ int run_locate(int argc, char** argv) {
     const std::vector<double> points = read_points(inputs[1]);
     const LocateResult result = locate(mesh, points, locate_options, options);
     write_hits(out_path, result, locate_options.within > 0);
-    std::size_t held = 0;
-    for (std::size_t p = 0; p < result.point_count; ++p) held += result.offsets[p + 1] > result.offsets[p];
-    std::printf("points %zu, located %zu, (point, tet) lines %zu\n", result.point_count, held, result.hit_count);
+    // A point's hits either hold it (distance 0) or, with --within, are its one nearest tet.
+    std::size_t held = 0, near = 0;
+    for (std::size_t p = 0; p < result.point_count; ++p) {
+        if (result.offsets[p + 1] == result.offsets[p]) continue;
+        ++(result.distances[result.offsets[p]] > 0.0 ? near : held);
+    }
+    std::printf("points %zu, located %zu", result.point_count, held + near);
+    if (locate_options.within > 0) std::printf(" (%zu in a tet, %zu near one)", held, near);
+    std::printf(", (point, tet) lines %zu\n", result.hit_count);
     return exit_ok;
 }
 

@@ -1,5 +1,6 @@
-"""`kdet plot` on the CSV files of `kdet bench`: the figures it promises are written, and a case whose
-box overlap along x never changes gets no penetration figure (one column of dots says nothing)."""
+"""`kdet plot` on the CSV files of `kdet bench`: the figures it promises are written, runs that differ in
+a setting are drawn apart, and a case whose box overlap along x never changes gets no penetration
+figure (one column of dots says nothing)."""
 
 from __future__ import annotations
 
@@ -50,6 +51,21 @@ def test_no_penetration_figure_when_the_overlap_never_changes(cli: Path, bench_f
     assert done.returncode == 0, done.stderr
     assert (bench_folder / "again" / "penetration_pass_through_armadillos.png").exists()
     assert not (bench_folder / "again" / "penetration_tearing.png").exists()
+
+
+def test_runs_that_differ_in_a_setting_get_figures_of_their_own(cli: Path, models: Path, tmp_path: Path) -> None:
+    # Two tests of one method, and a margin (its own case, as in the file names): no figure draws one of
+    # them in place of the others.
+    for extra in (["-o", "sat"], ["-o", "exact"], ["-o", "sat", "--margin", "0.01"]):
+        done = run([str(cli), "bench", "tearing", "-n", "1", "--frames", "0:1", "-d", str(tmp_path), "--quiet"] + extra,
+                   models=models)
+        assert done.returncode == 0, done.stderr
+    done = run([str(cli), "plot", str(tmp_path)])
+    assert done.returncode == 0, done.stderr
+    written = {Path(line.split(" ", 1)[1]).name for line in done.stdout.splitlines() if line.startswith("wrote ")}
+    for figure in ("stages", "host_vs_device", "boxplot", "run_spread"):
+        assert {f"{figure}_kdet_overlap-test-sat.png", f"{figure}_kdet_overlap-test-exact.png"} <= written, figure
+        assert f"{figure}_kdet.png" not in written, figure
 
 
 def test_plot_of_a_folder_without_csv_files_fails_with_one_line(cli: Path, tmp_path: Path) -> None:

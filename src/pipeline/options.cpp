@@ -211,7 +211,8 @@ const std::vector<OptionInfo>& option_table() {
             OptionType::integer, 0, no_limit, "sized from the tets", front_end_python),
         number<std::size_t, &O::memory_limit>(
             "memory_limit", "--memory-limit", "--memory-limit", "memory limit",
-            "bytes the detector may take for a frame's candidates and pairs; a frame that needs more fails at once",
+            "bytes the detector may take for a frame's candidates and pairs; a frame that needs\n"
+            "more fails at once",
             OptionType::integer, 0, no_limit, "as much as the memory holds", text_front_ends | front_end_python),
         number<bool, &O::contacts>("contacts", "", "", "contacts", "depth and direction per colliding pair",
                                    OptionType::boolean, 0, 1, nullptr, front_end_python),

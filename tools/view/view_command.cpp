@@ -35,9 +35,14 @@ int run_view(int argc, char** argv) {
     if (!config.screenshot.empty()) {
         viewer.screenshot(config.screenshot, config.width, config.height, config.panel);
         const FrameResult& r = session.result();
-        std::printf("wrote %s: frame %d of %s, %llu colliding pairs, %llu colliding tets\n", config.screenshot.c_str(),
-                    session.frame(), session.scene().name().c_str(), static_cast<unsigned long long>(r.counts.colliding_pairs),
-                    static_cast<unsigned long long>(r.counts.colliding_tets));
+        std::printf("wrote %s: frame %d of %s, ", config.screenshot.c_str(), session.frame(), session.scene().name().c_str());
+        const auto pairs = static_cast<unsigned long long>(r.counts.colliding_pairs);
+        const auto tets = static_cast<unsigned long long>(r.counts.colliding_tets);
+        if (config.options.margin > 0.0f)
+            std::printf("%llu pairs within the margin (%llu overlapping), %llu tets in a pair\n", pairs,
+                        pairs - static_cast<unsigned long long>(session.margin_pairs()), tets);
+        else
+            std::printf("%llu colliding pairs, %llu colliding tets\n", pairs, tets);
         if (!config.points.empty()) {
             const view::PointCounts points = view::count_points(session.located());
             std::printf("points: %zu in a tet, %zu near one, %zu without\n", points.held, points.near, points.missed);
