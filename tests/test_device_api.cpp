@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -30,9 +32,28 @@ void expect_rejected(const DetectorOptions& options, const std::string& naming) 
 TEST(DetectorOptions, InvalidSettingsAreRejectedByName) {
     DetectorOptions o;
     o.block_size = 0;
-    expect_rejected(o, "block size");
+    expect_rejected(o, "block_size: expected a positive number, got 0");
     o.block_size = 2048;
-    expect_rejected(o, "block size");
+    expect_rejected(o, "block size 2048 out of range [1, 1024]");
+    // Every option of the table is checked, in the table's words: threads (0 leaves it to OpenMP),
+    // an enum cast from an integer, a margin that is not a distance.
+    o = DetectorOptions{};
+    o.threads = -1;
+    expect_rejected(o, "threads: expected a positive number, got -1");
+    o.threads = 100000;
+    expect_rejected(o, "threads 100000 out of range [1, 1024]");
+    o = DetectorOptions{};
+    o.method = static_cast<Method>(99);
+    expect_rejected(o, "method: 99 is not one of its values (kdet, kdet_no_pairs, brute_force_loop or brute_force_pairs)");
+    o = DetectorOptions{};
+    o.hash = static_cast<HashFunction>(-1);
+    expect_rejected(o, "hash: -1 is not one of its values");
+    o = DetectorOptions{};
+    o.margin = -0.5f;
+    expect_rejected(o, "margin: expected a finite number >= 0, got -0.5");
+    o = DetectorOptions{};
+    o.memory_limit = SIZE_MAX; // any count: no limit in effect
+    EXPECT_NO_THROW(Detector{o});
     o = DetectorOptions{};
     o.bucket_capacity = 4097;
     expect_rejected(o, "bucket capacity 4097 out of range [0, 4096]");

@@ -280,7 +280,9 @@ TEST(IoRoundTrip, BunnyThroughBothFormats) {
 
 TEST(IoRoundTrip, WriterChosenByExtensionReadsBack) {
     TempDir dir;
-    for (const char* name : {"small.mesh", "small.msh", "small.vtk", "small", "small2.node", "small3.ele"})
+    // The single-file formats in any case, as read_surface takes its extensions.
+    for (const char* name : {"small.mesh", "small.msh", "small.vtk", "small", "small2.node", "small3.ele", "UPPER.MESH",
+                             "Mixed.Msh", "UPPER.VTK"})
         for (const bool binary : {false, true}) {
             const std::string path = dir.file_path(name);
             kdet::write_tet_mesh(two_tets(), path, kdet::WriteOptions{binary});

@@ -925,6 +925,20 @@ TEST(Detector, RejectsBadInputWithClearErrors) {
     EXPECT_THROW(detector.set_positions(id, xyz.data(), 3), Error);
     EXPECT_THROW(detector.set_positions(id + 1, xyz.data(), 4), Error);
     EXPECT_THROW(detector.set_pair_collision(id, id, true), Error);
+    EXPECT_EQ(error_message([&] { detector.add_object(xyz.data(), 4, nullptr, 1); }),
+              "object 1: the tets' pointer is null, with 1 tets");
+    EXPECT_EQ(error_message([&] { detector.set_tets(id, nullptr, 2); }), "object 0: the tets' pointer is null, with 2 tets");
+    // A TetMesh with a partial vertex or tet, which num_vertices() and num_tets() would drop.
+    TetMesh partial{std::vector<double>(xyz.begin(), xyz.end()), tet};
+    partial.positions.pop_back();
+    EXPECT_EQ(error_message([&] { detector.add_object(partial); }),
+              "add_object: the mesh's positions hold 11 values, not a multiple of 3");
+    partial.positions.push_back(1.0);
+    partial.tets.pop_back();
+    EXPECT_EQ(error_message([&] { detector.set_tets(id, partial); }),
+              "object 0: set_tets: the mesh's tets hold 3 indices, not a multiple of 4");
+    EXPECT_EQ(error_message([&] { collide_self(partial); }), "add_object: the mesh's tets hold 3 indices, not a multiple of 4");
+    EXPECT_EQ(detector.object_count(), 1u);
 }
 
 TEST(Detector, ReportsMemoryAndStageTimes) {

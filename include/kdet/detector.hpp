@@ -56,6 +56,7 @@ struct PositionsView {
 /// test. Non-finite coordinates, and doubles beyond float range, are refused with a kdet::Error naming
 /// the object and vertex.
 /// By default every pair of different objects is checked and self-collision is off.
+/// A moved-from detector may only be destroyed or assigned to.
 class Detector {
 public:
     explicit Detector(const DetectorOptions& options = {});
@@ -173,6 +174,9 @@ public:
     /// simulation's next step meanwhile. A detector's first frame (and the first after objects were
     /// added) still reads a few sizes back to size its buffers. On Backend::cpu the work is done before
     /// it returns. Call finish() before reading any result, device_results() included.
+    /// While the frame is pending every other call is allowed: set_positions, the switches and filters
+    /// and add_object take effect from the next frame (finish() returns the frame as it was started);
+    /// detect_async, detect, set_tets, remove_object, exclude_rest_contacts and locate finish it first.
     void detect_async();
 
     /// @brief Completes the detection detect_async() started: waits for it once, checks that every

@@ -20,8 +20,8 @@ struct ReadOptions {
 };
 
 /// @brief Reads a mesh, choosing the format by the extension of @p path:
-/// ".mesh" is MEDIT; ".msh" is Gmsh; ".vtk" is legacy VTK; ".node", ".ele" or no extension is TetGen
-/// (see read_tetgen).
+/// ".mesh" is MEDIT; ".msh" is Gmsh; ".vtk" is legacy VTK (these three in any case); ".node", ".ele"
+/// or no extension is TetGen (see read_tetgen).
 /// @throws Error for any other extension (naming the file and the supported formats) and for bad input.
 TetMesh read_tet_mesh(const std::string& path, const ReadOptions& options = {});
 
@@ -60,7 +60,8 @@ TriangleMesh read_surface(const std::string& path);
 
 /// @brief Reads query points: a text file of `x y z` lines (`#` starts a comment), or any tet mesh file
 /// read_tet_mesh() reads (by its extension, or a TetGen stem with its .node beside it), whose vertices
-/// are the points (its tets may be degenerate). Returns x y z per point.
+/// are the points (its tets may be degenerate). Returns x y z per point (none for a file of comments
+/// and blank lines only).
 /// Throws kdet::Error naming the file and line for a malformed line or a coordinate that is not
 /// finite or beyond float range.
 std::vector<double> read_points(const std::string& path);
@@ -113,6 +114,7 @@ struct WriteOptions {
 /// @brief Writes a mesh in the format that read_tet_mesh chooses for the extension of @p path:
 /// ".mesh" MEDIT, ".msh" Gmsh 4.1, ".vtk" VTK 5.1 (binary when @p options say so), and ".node",
 /// ".ele" or no extension TetGen (`name.node` + `name.ele`). Coordinates read back exactly.
+/// Degenerate tetrahedra are written; reading them back needs ReadOptions::allow_degenerate.
 /// @throws Error for any other extension, an invalid mesh or a file that cannot be written.
 void write_tet_mesh(const TetMesh& mesh, const std::string& path, const WriteOptions& options = {});
 

@@ -92,6 +92,11 @@ const OptionInfo* find_option(const std::string& name);
 /// @brief "a, b or c": names for messages and help.
 std::string join_names(const std::vector<std::string>& names);
 
+/// @brief Throws kdet::Error for a value of @p options that the table does not take, in the words of
+/// its parse and set_* functions: a choice that is none of its names (an enum cast from an integer), an
+/// integer outside its range (an unset default excepted), a real that is not finite and >= 0.
+void check_options(const DetectorOptions& options);
+
 /// @brief Reads a whole decimal integer in [lo, hi], or throws kdet::Error "invalid value 'TEXT' for
 /// SHOWN: expected an integer in [lo, hi]".
 long long parse_integer(const std::string& shown, const std::string& text, long long lo, long long hi);

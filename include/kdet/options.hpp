@@ -92,7 +92,8 @@ struct DetectorOptions {
     /// grows) throws kdet::Error at once, naming its pairs and their bytes, and leaves the detector usable.
     std::size_t memory_limit = 0;
     /// Return depth and direction per colliding pair, whatever the narrow-phase test: a stage after
-    /// the test computes them with the 44-axis SAT's minimum translation vector.
+    /// the test computes them with the 44-axis SAT's minimum translation vector. Per pair, so
+    /// Method::kdet_no_pairs, which builds none, returns none (as for distances).
     bool contacts = false;
     /// Report every pair whose closed sets lie at most this distance apart (finite, >= 0), decided
     /// exactly for the float coordinates and this float; 0: the pairs that touch or intersect.

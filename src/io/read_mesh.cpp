@@ -300,23 +300,24 @@ TetMesh read_medit(const std::string& path, const ReadOptions& options) {
 }
 
 TetMesh read_tet_mesh(const std::string& path, const ReadOptions& options) {
-    const std::string extension = std::filesystem::path(path).extension().string();
+    // Any case for the formats of one file; TetGen's pair is found by the spelling given.
+    const std::string given = std::filesystem::path(path).extension().string(), extension = lowercase_extension(path);
     if (extension == ".mesh") return read_medit(path, options);
     if (extension == ".msh") return read_gmsh(path, options);
     if (extension == ".vtk") return read_vtk(path, options);
-    if (extension.empty() || extension == ".node" || extension == ".ele") return read_tetgen(path, options);
-    throw Error(path + ": unsupported mesh format " + excerpt(extension) +
+    if (given.empty() || given == ".node" || given == ".ele") return read_tetgen(path, options);
+    throw Error(path + ": unsupported mesh format " + excerpt(given) +
                 "; supported: .mesh (MEDIT ASCII), .msh (Gmsh 2.2/4.1), .vtk (legacy VTK), .node/.ele or a name "
                 "without extension (TetGen)");
 }
 
 void write_tet_mesh(const TetMesh& mesh, const std::string& path, const WriteOptions& options) {
-    const std::string extension = std::filesystem::path(path).extension().string();
+    const std::string given = std::filesystem::path(path).extension().string(), extension = lowercase_extension(path);
     if (extension == ".mesh") return write_medit(mesh, path);
     if (extension == ".msh") return write_gmsh(mesh, path, GmshFormat{GmshVersion::v4_1, options.binary});
     if (extension == ".vtk") return write_vtk(mesh, path, VtkFormat{VtkVersion::v5_1, options.binary});
-    if (extension.empty() || extension == ".node" || extension == ".ele") return write_tetgen(mesh, tetgen_stem(path));
-    throw Error(path + ": cannot write mesh format " + excerpt(extension) +
+    if (given.empty() || given == ".node" || given == ".ele") return write_tetgen(mesh, tetgen_stem(path));
+    throw Error(path + ": cannot write mesh format " + excerpt(given) +
                 "; supported: .mesh (MEDIT), .msh (Gmsh 4.1), .vtk (legacy VTK 5.1), .node/.ele or a name without "
                 "extension (TetGen)");
 }

@@ -17,8 +17,10 @@ bool ends_with(const std::string& text, const std::string& suffix) {
 
 /// A mesh file by its extension (as read_tet_mesh reads them), or a TetGen stem with its .node beside it.
 bool is_mesh_file(const std::string& path) {
-    for (const char* extension : {".mesh", ".msh", ".vtk", ".node", ".ele"})
-        if (ends_with(path, extension)) return true;
+    const std::string extension = io::lowercase_extension(path);
+    for (const char* known : {".mesh", ".msh", ".vtk"})
+        if (extension == known) return true;
+    if (ends_with(path, ".node") || ends_with(path, ".ele")) return true;
     std::error_code ignored;
     return !std::filesystem::exists(path, ignored) && std::filesystem::is_regular_file(path + ".node", ignored);
 }

@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -397,16 +396,10 @@ TriangleMesh read_ply(const std::string& path) {
     return mesh;
 }
 
-std::string lowercase(std::string text) {
-    std::transform(text.begin(), text.end(), text.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return text;
-}
-
 } // namespace
 
 TriangleMesh read_surface(const std::string& path) {
-    const std::string extension = lowercase(std::filesystem::path(path).extension().string());
+    const std::string extension = lowercase_extension(path);
     if (extension == ".obj") return read_obj(path);
     if (extension == ".off") return read_off(path);
     if (extension == ".stl") return read_stl(path);

@@ -6,6 +6,7 @@
 #include <kdet/error.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +17,13 @@
 #include <system_error>
 
 namespace kdet::io {
+
+std::string lowercase_extension(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return extension;
+}
 
 std::string excerpt(std::string_view text) {
     constexpr std::size_t max_shown = 40;

@@ -30,6 +30,9 @@ struct Token {
 /// the message stays one readable line whatever the file holds.
 std::string excerpt(std::string_view text);
 
+/// @brief The extension of @p path in lower case (".MSH" reads as ".msh"), with its dot; empty when none.
+std::string lowercase_extension(const std::string& path);
+
 /// @brief A double for a message, with 3 significant digits.
 std::string short_number(double value);
 

@@ -76,7 +76,9 @@ inline std::string bytes_text(std::uint64_t bytes) {
                                                std::uint64_t limit) {
     const std::string over = limit ? "more than memory_limit " + std::to_string(limit) + " leaves"
                                    : "more than the memory holds";
-    throw Error(need + " " + bytes_text(bytes) + ", " + over + " beside the detector's " + bytes_text(held) +
+    // A limit below what the detector holds for its scene leaves no room for any pair: say so first.
+    const std::string below = limit && held >= limit ? " (the limit is below what the detector holds for the scene alone)" : "";
+    throw Error(need + " " + bytes_text(bytes) + ", " + over + " beside the detector's " + bytes_text(held) + below +
                 "; nothing was detected");
 }
 

@@ -5,6 +5,7 @@
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
 #include <kdet/locate.hpp>
+#include <kdet/option_table.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -239,6 +240,8 @@ struct Detector::Impl {
     }
 
     void check_indices(ObjectId id, const std::uint32_t* tets, std::size_t tet_count, std::size_t vertex_count) const {
+        if (!tets && tet_count > 0)
+            throw Error("object " + std::to_string(id) + ": the tets' pointer is null, with " + std::to_string(tet_count) + " tets");
         const std::size_t bad_index = first_where(4 * tet_count, [&](std::ptrdiff_t i) { return tets[i] >= vertex_count; });
         if (bad_index < 4 * tet_count)
             throw Error("object " + std::to_string(id) + ": tet " + std::to_string(bad_index / 4) + " has vertex index " +
@@ -366,13 +369,7 @@ struct Detector::Impl {
 
 Detector::Detector(const DetectorOptions& options) : impl_(std::make_unique<Impl>()) {
     impl_->options = options;
-    if (options.block_size < 1 || options.block_size > 1024)
-        throw Error("block size " + std::to_string(options.block_size) + " out of range [1, 1024]");
-    if (options.bucket_capacity > max_bucket_capacity)
-        throw Error("bucket capacity " + std::to_string(options.bucket_capacity) + " out of range [0, " +
-                    std::to_string(max_bucket_capacity) + "] (0 chooses it from the scene)");
-    if (!(options.margin >= 0.0f) || !std::isfinite(options.margin))
-        throw Error("margin " + distance_text(options.margin) + ": expected a finite distance >= 0");
+    check_options(options);
     if (options.cuda_stream && options.backend != Backend::cuda)
         throw Error("option cuda_stream is set, but the backend is '" + std::string(to_string(options.backend)) +
                     "': a CUDA stream needs backend 'cuda'");
@@ -391,7 +388,21 @@ ObjectId Detector::add_object(const double* positions, std::size_t vertex_count,
                               std::size_t tet_count) {
     return impl_->add(xyz_view(positions, vertex_count), tets, tet_count);
 }
+namespace {
+
+/// @brief Throws where a TetMesh's arrays hold a partial vertex or tet, which num_vertices() and
+/// num_tets() would drop.
+void check_whole(const TetMesh& mesh, const std::string& what) {
+    if (mesh.positions.size() % 3 != 0)
+        throw Error(what + ": the mesh's positions hold " + std::to_string(mesh.positions.size()) + " values, not a multiple of 3");
+    if (mesh.tets.size() % 4 != 0)
+        throw Error(what + ": the mesh's tets hold " + std::to_string(mesh.tets.size()) + " indices, not a multiple of 4");
+}
+
+} // namespace
+
 ObjectId Detector::add_object(const TetMesh& mesh) {
+    check_whole(mesh, "add_object");
     return impl_->add(xyz_view(mesh.positions.data(), mesh.num_vertices()), mesh.tets.data(), mesh.num_tets());
 }
 ObjectId Detector::add_object(const PositionsView& positions, const std::uint32_t* tets, std::size_t tet_count) {
@@ -526,6 +537,7 @@ void Detector::set_tets(ObjectId object, const std::uint32_t* tets, std::size_t 
 }
 
 void Detector::set_tets(ObjectId object, const TetMesh& mesh) {
+    check_whole(mesh, "object " + std::to_string(object) + ": set_tets");
     set_tets(object, mesh.tets.data(), mesh.num_tets(), xyz_view(mesh.positions.data(), mesh.num_vertices()));
 }
 

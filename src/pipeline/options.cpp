@@ -386,6 +386,26 @@ void OptionInfo::set_real(DetectorOptions& options, double value) const {
     put(options, bits);
 }
 
+void check_options(const DetectorOptions& options) {
+    DetectorOptions scratch = options; // the setters check into it
+    for (const OptionInfo& o : option_table()) {
+        const long long value = o.get(options);
+        switch (o.type) {
+        case OptionType::choice:
+            if (value < 0 || value >= static_cast<long long>(o.names().size()))
+                throw Error(std::string(o.name) + ": " + std::to_string(value) + " is not one of its values (" +
+                            join_names(o.names()) + ")");
+            break;
+        case OptionType::integer:
+            // Counts without a bound (std::size_t: bytes, pairs) take any value, SIZE_MAX as well.
+            if (o.max != no_limit && !(o.unset_by_default() && value == o.get(DetectorOptions{}))) o.set_number(scratch, value);
+            break;
+        case OptionType::boolean: break;
+        case OptionType::real: o.set_real(scratch, o.real(options)); break;
+        }
+    }
+}
+
 void OptionInfo::set_number(DetectorOptions& options, long long value) const {
     if (value < min) {
         const std::string zero = zero_means ? "0 (" + std::string(zero_means) + ") or " : "";
