@@ -218,8 +218,10 @@ int run_collide(int argc, char** argv) {
     std::printf("%s", self ? ", self-collision" : "");
     if (rings > 0) std::printf(", exclusion rings %d", rings);
     std::printf("\n");
+    // Brute force builds no grid, so no hash (as kdet bench's files say).
+    const bool grid = options.method == Method::kdet || options.method == Method::kdet_no_pairs;
     std::printf("method            %s, test %s, hash %s, backend %s\n", to_string(options.method),
-                to_string(options.narrow_phase), to_string(options.hash), to_string(options.backend));
+                to_string(options.narrow_phase), grid ? to_string(options.hash) : "none", to_string(options.backend));
     if (options.margin > 0.0f) std::printf("margin            %s\n", find_option("margin")->text(options).c_str());
     std::printf("candidates        %llu (%llu to the narrow phase)\n", static_cast<unsigned long long>(c.candidates),
                 static_cast<unsigned long long>(c.narrow_phase_candidates));

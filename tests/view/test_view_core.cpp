@@ -270,13 +270,16 @@ TEST(ViewArgs, ScenesMeshesAndEveryFlag) {
     EXPECT_EQ(parse({std::filesystem::temp_directory_path().string()}).source.scene,
               std::filesystem::temp_directory_path().string());
     EXPECT_EQ(parse({"--tets", "5000", "--scene-frames", "9"}).source.request.procedural.total_tets, 5000u);
+    EXPECT_EQ(parse({"--self", "--exclusion-rings", "2"}).exclusion_rings, 2);
 }
 
 TEST(ViewArgs, MistakesAreOneLineErrors) {
     EXPECT_NE(usage_error({"--size", "10x10"}).find("--size"), std::string::npos);
     EXPECT_NE(usage_error({"--size", "big"}).find("WxH"), std::string::npos);
     EXPECT_NE(usage_error({"--clip", "w"}).find("x, y, z"), std::string::npos);
-    EXPECT_NE(usage_error({"--opacity", "2"}).find("--opacity"), std::string::npos);
+    EXPECT_NE(usage_error({"--opacity", "2"}).find("--opacity: expected a number in [0, 1]"), std::string::npos);
+    EXPECT_NE(usage_error({"--exclusion-rings", "1"}).find("needs --self"), std::string::npos);
+    EXPECT_NE(usage_error({"--self", "--exclusion-rings", "5"}).find("--exclusion-rings"), std::string::npos);
     EXPECT_NE(usage_error({"--camera", "10"}).find("YAW,PITCH"), std::string::npos);
     EXPECT_NE(usage_error({"--panel"}).find("--screenshot"), std::string::npos);
     EXPECT_NE(usage_error({"armadillos", "--tets", "5000"}).find("procedural scene only"), std::string::npos);

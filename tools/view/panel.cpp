@@ -317,7 +317,7 @@ void Viewer::panel_results() {
         }
         row_ms("boxes", t.bounding_boxes);
         row_ms("populate grid", t.populate_grid);
-        row_ms("candidates", t.find_candidates);
+        row_ms("find candidates", t.find_candidates);
         row_ms("sort pairs", t.sort_pairs);
         row_ms("narrow phase", t.narrow_phase);
         row_ms("detect() total", t.total);

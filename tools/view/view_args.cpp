@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cstdio>
 #include <filesystem>
 
 namespace kdet::view {
@@ -25,6 +26,8 @@ SCENE is anything `kdet bench` opens: procedural (default), a thesis scene, a .s
 
 scene options:
   --self               self-collision of every object (as `kdet bench -s yes`)
+  --exclusion-rings K  with --self, also leave out tets within K mesh edges of each other (0-4,
+                       as `kdet collide --exclusion-rings`; the panel's slider changes it)
   --res N, -r N        resolution 1-4 of the thesis scenes (default 1)
   --tets N             tetrahedra of the procedural scene (default 100000)
   --scene-frames N     frames of the procedural scene (default 120)
@@ -73,7 +76,8 @@ display options (the panel changes them too):
   --normals            contact normals as short lines (turns the detector's contacts on)
   --camera YAW,PITCH   view direction in degrees (default 35,25)
   --zoom F             camera distance as a multiple of the framing distance (default 1)
-  --focus colliding    start framed on the colliding tetrahedra (as the F key)
+  --focus WHAT         start framed on the colliding tetrahedra (colliding, as the F key) or on
+                       the whole scene (all, the default)
 
 headless (no window; needs an X display: run under xvfb-run on a machine without one):
   --screenshot FILE    draw frame --frame into a PNG and exit
@@ -86,8 +90,9 @@ headless (no window; needs an X display: run under xvfb-run on a machine without
 )";
 
 float parse_float(const std::string& flag, const std::string& text, float lo, float hi) {
-    return static_cast<float>(
-        parse_number(flag, text, lo, hi, "a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]"));
+    char range[64];
+    std::snprintf(range, sizeof range, "a number in [%g, %g]", static_cast<double>(lo), static_cast<double>(hi));
+    return static_cast<float>(parse_number(flag, text, lo, hi, range));
 }
 
 void parse_size(const std::string& text, ViewConfig& config) {
@@ -141,6 +146,9 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     parser.positionals(2, positionals);
     parser.flag("--help", config.help);
     parser.flag("--self", config.self);
+    parser.option("--exclusion-rings", "K", [&](const std::string& v) {
+        config.exclusion_rings = static_cast<int>(parse_integer("--exclusion-rings", v, 0, max_exclusion_rings));
+    });
     parser.flag("--allow-degenerate", config.source.read_options.allow_degenerate);
     parser.detector_options(config.options, front_end_view);
     const auto resolution = [&](const std::string& flag, const std::string& v) {
@@ -211,6 +219,8 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     if (!config.screenshot.empty() && config.profile)
         throw cli::UsageError("view: --screenshot and --profile are two different runs; give one");
     if (within_given && config.points.empty()) throw cli::UsageError("view: --within applies to --points only");
+    if (config.exclusion_rings > 0 && !config.self)
+        throw cli::UsageError("view: --exclusion-rings acts within an object: it needs --self");
     if (config.panel && config.screenshot.empty()) throw cli::UsageError("view: --panel applies to --screenshot only");
     return config;
 }

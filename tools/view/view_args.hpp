@@ -41,6 +41,7 @@ struct ViewConfig {
     ViewSource source;
     DetectorOptions options;
     bool self = false;
+    int exclusion_rings = 0;       ///< with self: Detector::set_self_exclusion_rings of every object
     int frame = 0;                 ///< 0-based frame to show first (checked when the scene is open)
     std::string screenshot;        ///< headless: draw frame `frame` into this PNG and exit
     bool profile = false;          ///< headless: draw every frame once and print the times

@@ -26,6 +26,7 @@ int run_view(int argc, char** argv) {
         throw Error("view: --backend cuda is not available here: " + reason);
     config.options.contacts = view::wants_contacts(config.display, false);
     view::ViewSession session(config.source, config.options, config.self);
+    session.set_exclusion_rings(config.exclusion_rings);
     if (!config.points.empty()) session.set_points(read_points(config.points), config.within);
     if (config.frame >= session.num_frames())
         throw UsageError("view: invalid value '" + std::to_string(config.frame) + "' for --frame: scene '" +
