@@ -28,7 +28,7 @@ struct Detector::Impl {
     std::unique_ptr<PipelineBase> pipeline;
     SceneTopology topology;
     std::vector<std::uint32_t> object_vertex_begin{0};
-    std::vector<std::uint8_t> pair_enabled; // [objects * objects]
+    PairSwitches pair_enabled;
     bool topology_changed = false;
     std::vector<vec3> positions;            // host copy, float32 and in the order the pipeline stores them
     std::vector<std::uint8_t> positions_dirty; // per object: changed since the last upload
@@ -282,12 +282,7 @@ struct Detector::Impl {
         positions_on_device.push_back(0);
         positions_staged.push_back(0);
 
-        const std::size_t n = objects();
-        std::vector<std::uint8_t> enabled(n * n, 0);
-        for (std::size_t a = 0; a < n; ++a)
-            for (std::size_t b = 0; b < n; ++b)
-                enabled[a * n + b] = (a < n - 1 && b < n - 1) ? pair_enabled[a * (n - 1) + b] : (a != b ? 1 : 0);
-        pair_enabled.swap(enabled);
+        pair_enabled.add_object();
         filters.add_object(pair_enabled);
         removed.push_back(0);
         topology_changed = true;
@@ -436,7 +431,7 @@ void Detector::set_positions_on_device(ObjectId object, const PositionsView& pos
 
 void Detector::set_self_collision(ObjectId object, bool enabled) {
     impl_->check_object(object);
-    impl_->pair_enabled[object * impl_->objects() + object] = enabled ? 1 : 0;
+    impl_->pair_enabled(object, object) = enabled ? 1 : 0;
 }
 
 void Detector::set_static(ObjectId object, bool is_static) {
@@ -456,7 +451,7 @@ void Detector::set_pair_collision(ObjectId a, ObjectId b, bool enabled) {
     impl_->check_object(a);
     impl_->check_object(b);
     if (a == b) throw Error("set_pair_collision needs two different objects; use set_self_collision");
-    impl_->pair_enabled[a * impl_->objects() + b] = impl_->pair_enabled[b * impl_->objects() + a] = enabled ? 1 : 0;
+    impl_->pair_enabled(a, b) = impl_->pair_enabled(b, a) = enabled ? 1 : 0;
     impl_->filters.set_explicit(a, b);
 }
 
@@ -509,7 +504,7 @@ void Detector::remove_object(ObjectId object) {
     d.prepare_edit(*this);
     d.replace(object, nullptr, 0, nullptr, 0);
     d.filters.set_rings(object, 0, ExclusionLists{});
-    d.pair_enabled[object * d.objects() + object] = 0;
+    d.pair_enabled(object, object) = 0;
     d.removed[object] = 1;
 }
 
@@ -565,7 +560,7 @@ void Detector::detect_async() {
         if (d.positions_staged[o]) staged.push_back({first, count});
         if (d.topology.object_static[o] && (d.positions_dirty[o] || d.positions_staged[o])) d.pipeline->static_moved();
     }
-    d.pipeline->start(uploads, staged, d.pair_enabled);
+    d.pipeline->start(uploads, staged, d.pair_enabled.table());
     std::fill(d.positions_dirty.begin(), d.positions_dirty.end(), 0);
     std::fill(d.positions_staged.begin(), d.positions_staged.end(), 0);
     d.frame_pending = true;

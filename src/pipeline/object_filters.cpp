@@ -17,7 +17,7 @@ std::string too_many_ids(std::uint64_t ids) {
 
 } // namespace
 
-void ObjectFilters::add_object(std::vector<std::uint8_t>& pair_enabled) {
+void ObjectFilters::add_object(PairSwitches& pair_enabled) {
     group_.push_back(1);
     mask_.push_back(~0u);
     rings_.push_back(0);
@@ -27,7 +27,7 @@ void ObjectFilters::add_object(std::vector<std::uint8_t>& pair_enabled) {
 }
 
 void ObjectFilters::set_filter(std::uint32_t object, std::uint32_t group, std::uint32_t mask,
-                               std::vector<std::uint8_t>& pair_enabled) {
+                               PairSwitches& pair_enabled) {
     group_[object] = group;
     mask_[object] = mask;
     const std::size_t n = group_.size();
@@ -36,7 +36,7 @@ void ObjectFilters::set_filter(std::uint32_t object, std::uint32_t group, std::u
         const std::uint64_t key = object < other ? (std::uint64_t{object} << 32 | other) : (std::uint64_t{other} << 32 | object);
         if (explicit_pairs_.count(key)) continue;
         const std::uint8_t on = (group_[object] & mask_[other]) != 0 && (group_[other] & mask_[object]) != 0;
-        pair_enabled[object * n + other] = pair_enabled[other * n + object] = on;
+        pair_enabled(object, other) = pair_enabled(other, object) = on;
     }
 }
 

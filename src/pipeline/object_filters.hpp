@@ -5,6 +5,7 @@
 /// it checks, and the pairs of tets excluded beyond shared vertices (self-exclusion rings, rest
 /// contacts), which it hands the pipeline as ExclusionLists (pair_exclusions.hpp).
 
+#include "pipeline/pair_switches.hpp"
 #include "pipeline/pipeline_base.hpp"
 
 #include <cstdint>
@@ -19,10 +20,10 @@ class ObjectFilters {
 public:
     /// @brief The filters of a new object (group 1, every mask bit): its row and column of the
     /// detector's switches (`pair_enabled`, already grown to the new count) follow them.
-    void add_object(std::vector<std::uint8_t>& pair_enabled);
+    void add_object(PairSwitches& pair_enabled);
     /// @brief Sets an object's group and mask, and with them its switches against every object whose
     /// pair with it no explicit set_pair_collision() decided.
-    void set_filter(std::uint32_t object, std::uint32_t group, std::uint32_t mask, std::vector<std::uint8_t>& pair_enabled);
+    void set_filter(std::uint32_t object, std::uint32_t group, std::uint32_t mask, PairSwitches& pair_enabled);
     /// @brief Notes that the pair's switch was set explicitly: the filters no longer change it.
     void set_explicit(std::uint32_t a, std::uint32_t b);
     std::uint32_t group(std::uint32_t object) const { return group_[object]; }

@@ -266,7 +266,7 @@ void Pipeline<Exec>::refuse_first_frame(std::uint64_t candidates, bool at_least)
 
 template <class Exec>
 void Pipeline<Exec>::start(const std::vector<PositionUpload>& uploads, const std::vector<VertexRange>& staged,
-                           const std::vector<std::uint8_t>& pair_enabled) {
+                           std::vector<std::uint8_t> pair_enabled) {
     staged_ = staged;
     waits_before_ = exec_.host_waits();
     regrows_ = 0;
@@ -274,7 +274,7 @@ void Pipeline<Exec>::start(const std::vector<PositionUpload>& uploads, const std
     clock_.mark(frame_start);
     for (const PositionUpload& u : uploads) exec_.upload(positions_.data() + u.first, u.positions, u.count);
     // Two static objects (or one with itself) are never checked: their pairs cannot change.
-    std::vector<std::uint8_t> enabled = pair_enabled;
+    std::vector<std::uint8_t>& enabled = pair_enabled;
     const std::size_t objects = object_boxes_.size();
     for (std::size_t a = 0; a < objects; ++a)
         for (std::size_t b = 0; b < objects; ++b)

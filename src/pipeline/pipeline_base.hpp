@@ -137,7 +137,7 @@ public:
     /// [objects * objects], symmetric, diagonal = self-collision. Waits for nothing, except on a first
     /// frame (it sizes the buffers from what it reads).
     virtual void start(const std::vector<PositionUpload>& uploads, const std::vector<VertexRange>& staged,
-                       const std::vector<std::uint8_t>& pair_enabled) = 0;
+                       std::vector<std::uint8_t> pair_enabled) = 0;
     /// @brief Completes the detection start() enqueued: reads its counters (and results when they go
     /// to the host) with one wait, and grows a buffer and reruns the frame if one was too small.
     /// Returns no_vertex, or the lowest global vertex of the staged positions with a non-finite

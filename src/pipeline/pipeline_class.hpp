@@ -188,7 +188,7 @@ public:
     std::string device_name() const override { return exec_.device_name(); }
 
     void start(const std::vector<PositionUpload>& uploads, const std::vector<VertexRange>& staged,
-               const std::vector<std::uint8_t>& pair_enabled) override;
+               std::vector<std::uint8_t> pair_enabled) override;
     std::uint32_t finish(FrameResult& result) override;
 
 protected:
