@@ -146,7 +146,7 @@ TEST(BenchArgs, EveryMistakeIsOneLineNamingTheFlagAndWhatItAccepts) {
         {{"--rings", "5", "-s", "yes"}, "invalid value '5' for --rings: expected an integer in [0, 4]"},
         {{"--rings", "1"}, "bench: --rings needs -s yes"},
         {{"--filters", "no"}, "invalid value 'no' for --filters: expected on or off"},
-        {{"--mpi", "--filters", "off"}, "bench: --rings and --filters off are not available with --mpi"},
+        {{"--mpi", "--rings", "1", "-s", "yes"}, "bench: --rings is not available with --mpi"},
         {{"--frobnicate"}, "bench: unknown option '--frobnicate'"},
         {{"-r"}, "bench: option '-r' needs a value <resolution>"},
         {{"-h"}, "bench: option '-h' needs a value <hash>"},

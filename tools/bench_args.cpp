@@ -145,8 +145,7 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     if (!scene.empty()) config.scene = scene[0];
     if (!config.partition.empty() && !config.mpi) throw UsageError("bench: --partition needs --mpi");
     if (config.rings > 0 && !config.self) throw UsageError("bench: --rings needs -s yes (rings act within an object)");
-    if (config.mpi && (config.rings > 0 || !config.filters))
-        throw UsageError("bench: --rings and --filters off are not available with --mpi");
+    if (config.mpi && config.rings > 0) throw UsageError("bench: --rings is not available with --mpi");
     return config;
 }
 

@@ -48,21 +48,6 @@ std::size_t all_tets(const Scene& scene) {
 
 std::string margin_text(const DetectorOptions& options) { return find_option("margin")->text(options); }
 
-std::string stem_of(const BenchConfig& config, const Scene& scene, int last_frame) {
-    const std::size_t tets = all_tets(scene);
-    std::string stem = scene.name() + "_r" + std::to_string(config.request.resolution) + "_" +
-                       bench_method_name(config.options.method) + "_" + to_string(config.options.narrow_phase) + "_" +
-                       hash_label(config.options) + "_g" + std::to_string(config.options.block_size) + "_self-" +
-                       (config.self ? "yes" : "no") + "_" + to_string(config.options.backend) + "_" +
-                       std::to_string(tets) + "tets";
-    if (config.first_frame != 0 || last_frame != scene.num_frames() - 1)
-        stem += "_f" + std::to_string(config.first_frame) + "-" + std::to_string(last_frame);
-    if (config.rings > 0) stem += "_rings" + std::to_string(config.rings);
-    if (!config.filters) stem += "_filters-off";
-    if (config.options.margin > 0) stem += "_margin" + margin_text(config.options);
-    return stem;
-}
-
 std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene, const Detector& detector,
                                    int last_frame, std::size_t peak_memory) {
     const DetectorOptions& o = config.options;
@@ -99,6 +84,21 @@ std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene
 }
 
 } // namespace
+
+std::string stem_of(const BenchConfig& config, const Scene& scene, int last_frame) {
+    const std::size_t tets = all_tets(scene);
+    std::string stem = scene.name() + "_r" + std::to_string(config.request.resolution) + "_" +
+                       bench_method_name(config.options.method) + "_" + to_string(config.options.narrow_phase) + "_" +
+                       hash_label(config.options) + "_g" + std::to_string(config.options.block_size) + "_self-" +
+                       (config.self ? "yes" : "no") + "_" + to_string(config.options.backend) + "_" +
+                       std::to_string(tets) + "tets";
+    if (config.first_frame != 0 || last_frame != scene.num_frames() - 1)
+        stem += "_f" + std::to_string(config.first_frame) + "-" + std::to_string(last_frame);
+    if (config.rings > 0) stem += "_rings" + std::to_string(config.rings);
+    if (!config.filters) stem += "_filters-off";
+    if (config.options.margin > 0) stem += "_margin" + margin_text(config.options);
+    return stem;
+}
 
 int last_frame_of(const BenchConfig& config, const Scene& scene) {
     return config.last_frame < 0 ? scene.num_frames() - 1 : config.last_frame;

@@ -31,6 +31,10 @@ using BenchProgress = std::function<bool(int run, int frame_index)>;
 /// @brief The last frame `config` selects in `scene` (its --frames B, else the scene's last frame).
 int last_frame_of(const BenchConfig& config, const Scene& scene);
 
+/// @brief The files' name without extension: the scene, resolution, method, test, hash, block size,
+/// self-collision, backend and tets, then what differs from a plain run (frames, rings, filters, margin).
+std::string stem_of(const BenchConfig& config, const Scene& scene, int last_frame);
+
 /// @brief Runs frames first_frame..last_frame_of() of `scene` config.runs times with one Detector
 /// (its buffers persist between runs, as in an application). Only detect() is timed; the scene's
 /// positions are computed and uploaded outside the measured time.

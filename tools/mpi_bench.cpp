@@ -49,6 +49,8 @@ int run_bench_mpi(const BenchConfig& config) {
         } catch (const std::exception& e) {
             bad = std::string(e.what());
         }
+        if (bad.empty() && scene->changes_tets())
+            bad = "bench: scene '" + scene->name() + "' changes its tets from frame to frame, which --mpi does not follow";
         mpi::agree_on_error(comm, bad);
         const int first = config.first_frame, last = last_frame_of(config, *scene);
         // Split as a simulation would split its mesh: at the first frame's positions.
@@ -66,10 +68,18 @@ int run_bench_mpi(const BenchConfig& config) {
             parts.push_back(mpi::local_part(at_first[o], owners[o], rank));
             detector.add_object(parts[o]);
         }
+        // kdet::mpi has switches alone: the scene's filters and static objects become switches with the
+        // answers a Detector gives (no pair of two static objects, no static object's self-collision).
         for (std::size_t a = 0; a < scene->num_objects(); ++a) {
-            detector.set_self_collision(static_cast<ObjectId>(a), config.self);
-            for (std::size_t b = a + 1; b < scene->num_objects(); ++b)
-                detector.set_pair_collision(static_cast<ObjectId>(a), static_cast<ObjectId>(b), scene->checks_pair(a, b));
+            detector.set_self_collision(static_cast<ObjectId>(a), config.self && !scene->is_static(a));
+            const CollisionFilter fa = scene->collision_filter(a);
+            for (std::size_t b = a + 1; b < scene->num_objects(); ++b) {
+                const CollisionFilter fb = scene->collision_filter(b);
+                const bool filtered = config.filters && !((fa.group & fb.mask) && (fb.group & fa.mask));
+                const bool both_static = scene->is_static(a) && scene->is_static(b);
+                detector.set_pair_collision(static_cast<ObjectId>(a), static_cast<ObjectId>(b),
+                                            scene->checks_pair(a, b) && !filtered && !both_static);
+            }
         }
 
         std::vector<MpiFrameRow> rows;
@@ -112,9 +122,8 @@ int run_bench_mpi(const BenchConfig& config) {
             row.total_ms /= config.runs;
         }
         std::filesystem::create_directories(config.output_dir);
-        std::string stem = scene->name() + "_r" + std::to_string(config.request.resolution) + "_self-" +
-                           (config.self ? "yes" : "no") + "_" + to_string(config.options.backend) + "_mpi-np" +
-                           std::to_string(size) + "-" + (kind == mpi::Partition::slabs ? "slabs" : "random");
+        const std::string stem = stem_of(config, *scene, last) + "_mpi-np" + std::to_string(size) + "-" +
+                                 (kind == mpi::Partition::slabs ? "slabs" : "random");
         const std::string path = config.output_dir + "/" + stem + ".csv";
         std::ofstream csv(path);
         if (!csv) throw Error(path + ": cannot open file for writing");

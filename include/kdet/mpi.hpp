@@ -88,7 +88,9 @@ struct FrameResult {
 /// (prefixed "rank R: " with the lowest rank at fault), and leaves every rank's detector as it was.
 class Detector {
 public:
-    /// @brief Works on a duplicate of @p comm. DetectorOptions::results_to_host must stay on.
+    /// @brief Works on a duplicate of @p comm; collective. Throws on every rank where a rank turns
+    /// DetectorOptions::results_to_host off or distances on (mpi::FrameResult has none), or where the
+    /// ranks' method, test, margin or contacts differ.
     explicit Detector(MPI_Comm comm, const DetectorOptions& options = {});
     ~Detector();
     Detector(Detector&&) noexcept;
@@ -118,6 +120,7 @@ public:
     const FrameResult& detect();
 
     /// @brief Collective: the last detection's pairs of all ranks on @p root, sorted (empty elsewhere).
+    /// Throws kdet::Error for a root that is not a rank of the communicator.
     std::vector<TetPair> gather_pairs(int root = 0) const;
 
     std::size_t object_count() const;

@@ -8,6 +8,7 @@
 
 #include <kdet/error.hpp>
 #include <kdet/mpi.hpp>
+#include <kdet/option_table.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -593,11 +594,26 @@ const FrameResult& Detector::Impl::detect() {
 }
 
 Detector::Detector(MPI_Comm comm, const DetectorOptions& options) : impl_(std::make_unique<Impl>(options)) {
-    if (!options.results_to_host)
-        throw Error("kdet::mpi::Detector needs results_to_host: it filters the local pairs on the host");
     MPI_Comm_dup(comm, &impl_->comm);
     MPI_Comm_rank(impl_->comm, &impl_->rank);
     MPI_Comm_size(impl_->comm, &impl_->size);
+    // Construction is collective: an option one rank refuses fails on every rank, not in a later call.
+    std::string bad;
+    if (!options.results_to_host) bad = "kdet::mpi::Detector needs results_to_host: it filters the local pairs on the host";
+    else if (options.distances) bad = "kdet::mpi::Detector returns no distances: its FrameResult has pairs, flags and contacts";
+    std::string error = detail::agree(impl_->comm, bad);
+    // The options that decide the answer must agree (threads, backend and buffer sizes may differ).
+    std::uint64_t h = 1469598103934665603ull;
+    for (const char* name : {"method", "test", "margin", "contacts"})
+        for (const char c : find_option(name)->text(options)) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+    std::uint64_t range[2] = {h, ~h}, agreed[2] = {0, 0};
+    MPI_Allreduce(range, agreed, 2, MPI_UINT64_T, MPI_MAX, impl_->comm);
+    if (error.empty() && (agreed[0] != h || agreed[1] != ~h))
+        error = "the method, test, margin or contacts of kdet::mpi::Detector differ between ranks (give every rank the same)";
+    if (!error.empty()) {
+        MPI_Comm_free(&impl_->comm); // no destructor runs for a constructor that throws
+        throw Error(error);
+    }
 }
 
 Detector::~Detector() {
@@ -653,6 +669,9 @@ const FrameResult& Detector::detect() { return impl_->detect(); }
 
 std::vector<TetPair> Detector::gather_pairs(int root) const {
     const Impl& d = *impl_;
+    if (root < 0 || root >= d.size)
+        throw Error("gather_pairs: root " + std::to_string(root) + " is not a rank of the communicator (0 to " +
+                    std::to_string(d.size - 1) + ")");
     const int count = static_cast<int>(d.result.pairs.size());
     std::vector<int> counts(d.rank == root ? static_cast<std::size_t>(d.size) : 0), at(counts.size());
     MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, root, d.comm);

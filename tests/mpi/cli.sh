@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `kdet collide --mpi` under mpirun writes exactly the pairs `kdet collide` writes, with both partitions,
-# kdet bench --mpi finds the same pairs per frame on 1 and 2 ranks,
+# kdet bench --mpi finds the same pairs per frame on 1 and 2 ranks and as without --mpi on a scene of
+# filters and a static object, refuses a scene whose tets change,
 # a file missing on rank 0 fails on every rank with one message, --partition alone is a usage error.
 #   cli.sh KDET MPIEXEC DATA_DIR WORK
 set -euo pipefail
@@ -28,6 +29,19 @@ done
 rows() { cut -d, -f1,3 "$1"/*.csv; }
 [[ "$(rows "$work/bench1" | wc -l)" == 5 && "$(rows "$work/bench1")" == "$(rows "$work/bench2")" ]] ||
   { echo "kdet bench --mpi: other rows on 2 ranks" >&2; rows "$work/bench1" >&2; rows "$work/bench2" >&2; exit 1; }
+# A scene of collision groups and a static floor (heap), and a scene whose tets change (refused).
+"$kdet" bench heap --frames 100:101 -n 1 --threads 1 -d "$work/heap" --quiet >/dev/null
+OMP_NUM_THREADS=1 "$mpiexec" -np 2 --oversubscribe --allow-run-as-root "$kdet" bench heap --frames 100:101 -n 1 --mpi \
+  -d "$work/heap_mpi" --quiet >/dev/null
+plain=$(sed -n '/^frame,/,$p' "$work"/heap/heap_*[0-9].csv | tail -n +2 | cut -d, -f1,8 | tr -d ' ')
+split=$(tail -n +2 "$work"/heap_mpi/*.csv | cut -d, -f1,3)
+[[ -n "$plain" && "$plain" == "$split" ]] || { echo "kdet bench heap --mpi: other pairs" >&2; echo "$plain" "$split" >&2; exit 1; }
+if OMP_NUM_THREADS=1 "$mpiexec" -np 2 --oversubscribe --allow-run-as-root "$kdet" bench tearing --frames 0:1 -n 1 --mpi \
+  -d "$work/tearing" --quiet >"$work/tearing.out" 2>&1; then
+  echo "kdet bench tearing --mpi did not refuse the changing tets" >&2
+  exit 1
+fi
+grep -q "changes its tets from frame to frame, which --mpi does not follow" "$work/tearing.out"
 set +e
 "$kdet" collide "$data/bunny.mesh" --self --partition random 2>"$work/usage.out"
 status=$?

@@ -454,6 +454,31 @@ TEST(Mpi, BadInputOnOneRankFailsOnEveryRank) {
         EXPECT_EQ(same_error_everywhere([&] { detector.detect(); }),
                   "self-collision or pair switches differ between ranks (set them alike on every rank)");
     }
+    if (rank == last) detector.set_self_collision(id, true);
+    EXPECT_EQ(same_error_everywhere([&] { (void)detector.gather_pairs(size); }),
+              "gather_pairs: root " + std::to_string(size) + " is not a rank of the communicator (0 to " +
+                  std::to_string(last) + ")");
+}
+
+TEST(Mpi, OptionsOneRankRefusesOrThatDecideTheAnswerDifferFailOnEveryRank) {
+    const int rank = world_rank(), size = world_size(), last = size - 1;
+    DetectorOptions options = one_thread();
+    if (rank == last) options.results_to_host = false;
+    EXPECT_EQ(same_error_everywhere([&] { mpi::Detector refused(MPI_COMM_WORLD, options); }),
+              "rank " + std::to_string(last) + ": kdet::mpi::Detector needs results_to_host: it filters the local pairs on the host");
+    options = one_thread();
+    options.distances = true;
+    EXPECT_EQ(same_error_everywhere([&] { mpi::Detector refused(MPI_COMM_WORLD, options); }),
+              "rank 0: kdet::mpi::Detector returns no distances: its FrameResult has pairs, flags and contacts");
+    if (size > 1) {
+        options = one_thread();
+        if (rank == last) options.margin = 0.02f;
+        EXPECT_EQ(same_error_everywhere([&] { mpi::Detector refused(MPI_COMM_WORLD, options); }),
+                  "the method, test, margin or contacts of kdet::mpi::Detector differ between ranks (give every rank the same)");
+    }
+    options = one_thread();
+    if (rank == last) options.threads = 2; // threads may differ: no error
+    EXPECT_NO_THROW(mpi::Detector(MPI_COMM_WORLD, options));
 }
 
 } // namespace
