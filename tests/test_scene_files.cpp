@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <ostream>
 #include <string>
 #include <unistd.h>
@@ -45,12 +46,13 @@ TEST(SceneFile, ErrorsNameFileAndLine) {
     EXPECT_EQ(parse_error("kdet-scene 2\n"), "s.scene:1: unknown scene format version '2'");
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n  mesh bunny\n  colour red\n"),
               "s.scene:5: unknown statement 'colour'");
-    EXPECT_EQ(parse_error("kdet-scene 1\nframes x\n"), "s.scene:2: 'x' is not a finite number");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes x\n"), "s.scene:2: 'x' is not a finite decimal number");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 0x10\n"), "s.scene:2: '0x10' is not a finite decimal number");
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nmesh bunny\n"), "s.scene:3: 'mesh' stands before any 'object'");
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n mesh bunny\n key 5 move 1 2\n"),
               "s.scene:5: 'move' needs 3 value(s)");
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n mesh bunny\n key 5 bend 1\n key 2 bend 0\n"),
-              "s.scene:6: keys of 'bend' must have increasing frames (2 after 5.000000)");
+              "s.scene:6: keys of 'bend' must have increasing frames (2 after 5)");
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n mesh bunny\ncollide a b\n"),
               "s.scene:5: no object named 'b'");
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n"), "s.scene:3: object 'a' has no 'mesh' or 'file'");
@@ -60,6 +62,20 @@ TEST(SceneFile, ErrorsNameFileAndLine) {
               "s.scene:5: squash 0.95 is outside (-1, 0.9)");
     EXPECT_EQ(parse_error("kdet-scene 1\nframes 2\nobject a\n squash y\n key 1 move 0 0 0 squash -1\n"),
               "s.scene:5: squash -1 is outside (-1, 0.9)");
+    // Between its keys too: a curve through 0, 0.8 and 0.8 rises past 0.9 before it levels off.
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 40\nobject a\n mesh bunny\n squash y\n key 0 squash 0\n key 2 squash 0.8\n"
+                          " key 39 squash 0.8\n"),
+              "s.scene:8: object 'a': the squash between the keys of frames 2 and 39 reaches 0.901 at frame 10, outside "
+              "(-1, 0.9): the curve through the keys overshoots them (add a key or move one)");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 10\nobject a\n mesh bunny\n key 0 bend 0\n key 9 bend 0.5\n"),
+              "s.scene:5: object 'a': its bend keys need a 'bend ALONG_AXIS TOWARD_AXIS' statement");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nname a\nframes 4\n"), "s.scene:4: 'frames' is given twice (first at line 2)");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n mesh bunny\n scale 2\n scale 3\n"),
+              "s.scene:6: object 'a' has 'scale' twice (first at line 5)");
+    EXPECT_EQ(parse_error("kdet-scene 1\nframes 3\nobject a\n file box.node\n resolution 3\n"),
+              "s.scene:3: object 'a' reads a 'file': 'resolution' applies to the prepared models of 'mesh' only");
+    // A byte-order mark before the header is skipped; an underflow reads as the tiny number it is.
+    EXPECT_EQ(parse_error("\xEF\xBB\xBFkdet-scene 1\nframes 3\nobject a\n mesh bunny\n wobble 0.01 1e-308\n"), "no error");
 }
 
 TEST(SceneFile, MistakesFoundWhilePlayingNameFileAndLine) {
@@ -211,6 +227,17 @@ TEST(RecordedScene, BinaryRecordingPlaysBackExactly) {
             EXPECT_EQ(a, b) << "object " << o << " frame " << f;
         }
     }
+    // A non-finite coordinate in a later frame names the file and the frame.
+    {
+        std::fstream edit(path, std::ios::in | std::ios::out | std::ios::binary);
+        edit.seekp(-4, std::ios::end); // the last coordinate of the last frame
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        edit.write(reinterpret_cast<const char*>(&nan), sizeof nan);
+    }
+    const auto broken = open_scene(path);
+    EXPECT_EQ(error_message([&] { broken->positions(1, 29, b); }),
+              path + ": frame 29, object 1: vertex " + std::to_string(scene->rest_mesh(1).num_vertices() - 1) +
+                  " has a non-finite coordinate");
     // A cut-off file is refused when opened.
     fs::resize_file(path, fs::file_size(path) - 5);
     EXPECT_THROW(read_recording(path), Error);
@@ -276,6 +303,32 @@ TEST(RecordedScene, FolderOfVtkFrames) {
     scene->positions(0, 10, a);
     played->positions(0, 10, b);
     EXPECT_EQ(a, b);
+    // Given with a trailing '/', as shells complete it: the folder's own name all the same.
+    EXPECT_EQ(open_scene((dir / "recorded").string() + "/")->name(), "recorded");
+
+    // Frames lost or doubled, another mesh kind among them, a frame of other vertices: each named.
+    const fs::path a_folder = dir / "recorded" / "a";
+    fs::copy_file(a_folder / "frame_3.vtk", a_folder / "frame_03.vtk");
+    EXPECT_EQ(error_message([&] { open_scene((dir / "recorded").string()); }),
+              a_folder.string() + ": frame_03.vtk and frame_3.vtk are both frame 3");
+    fs::remove(a_folder / "frame_03.vtk");
+    fs::rename(a_folder / "frame_5.vtk", dir / "frame_5.vtk");
+    EXPECT_EQ(error_message([&] { open_scene((dir / "recorded").string()); }),
+              a_folder.string() + ": the frames jump from frame_4.vtk to frame_6.vtk (a frame missing?)");
+    fs::rename(dir / "frame_5.vtk", a_folder / "frame_5.VTK"); // any case
+    EXPECT_EQ(open_scene((dir / "recorded").string())->num_frames(), 12);
+    write_tet_mesh(scene->rest_mesh(0), (a_folder / "extra.msh").string());
+    EXPECT_EQ(error_message([&] { open_scene((dir / "recorded").string()); }),
+              (a_folder / "extra.msh").string() + ": a frame folder holds .vtk or .node frames, not .msh");
+    fs::remove(a_folder / "extra.msh");
+    TetMesh grown = scene->rest_mesh(0);
+    grown.positions.insert(grown.positions.end(), {9.0, 9.0, 9.0});
+    write_vtk(grown, (a_folder / "frame_7.vtk").string());
+    const auto uneven = open_scene((dir / "recorded").string());
+    EXPECT_EQ(error_message([&] { uneven->positions(0, 7, b); }),
+              (a_folder / "frame_7.vtk").string() + ": " + std::to_string(grown.num_vertices()) +
+                  " vertices, but the first frame " + (a_folder / "frame_0.vtk").string() + " has " +
+                  std::to_string(grown.num_vertices() - 1));
     fs::remove_all(dir);
 }
 

@@ -8,10 +8,12 @@
 #include <kdet/scenes.hpp>
 
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/filesystem.h>
 #include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <utility>
@@ -107,13 +109,13 @@ void bind_scenes(nb::module_& m) {
 
     m.def(
         "open_scene",
-        [](const std::string& name, int resolution, std::int64_t tets, int frames) {
+        [](const std::filesystem::path& name, int resolution, std::int64_t tets, int frames) {
             if (tets < 0) throw Error("tets: " + std::to_string(tets) + " is negative");
             SceneRequest request;
             request.resolution = resolution;
             request.procedural = ProceduralSceneOptions{static_cast<std::size_t>(tets), frames};
             nb::gil_scoped_release release;
-            return PyScene{open_scene(name, request)};
+            return PyScene{open_scene(name.string(), request)};
         },
         "name"_a, "resolution"_a = 1, "tets"_a = ProceduralSceneOptions{}.total_tets,
         "frames"_a = ProceduralSceneOptions{}.frames,

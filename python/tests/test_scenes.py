@@ -108,5 +108,7 @@ def test_scene_bad_input():
             kdet.open_scene(name, resolution=-1000000)
     with pytest.raises(kdet.Error, match="^tets: -5 is negative$"):
         kdet.open_scene("procedural", tets=-5)
+    with pytest.raises(kdet.Error, match="missing.scene: cannot open scene file"):
+        kdet.open_scene(Path("missing.scene"))  # paths as os.PathLike, as the mesh functions take them
     with pytest.raises(ValueError, match="frames 5 to 200 out of range"):
         next(kdet.run_scene(scene, first_frame=5, last_frame=200))

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fcntl.h>
@@ -59,26 +60,61 @@ bool natural_less(const std::string& a, const std::string& b) {
     return a.size() - i < b.size() - j;
 }
 
-/// @brief The frame files of one object folder: .vtk, or .node (each with its .ele).
+/// @brief The last number in a file's stem ("frame_012.vtk": 12), or -1 without one.
+long long frame_number(const std::string& file) {
+    const std::string stem = fs::path(file).stem().string();
+    const std::size_t end = stem.find_last_of("0123456789");
+    if (end == std::string::npos) return -1;
+    std::size_t begin = end;
+    while (begin > 0 && std::isdigit(static_cast<unsigned char>(stem[begin - 1]))) --begin;
+    return end - begin < 18 ? std::stoll(stem.substr(begin, end - begin + 1)) : -1;
+}
+
+/// @brief The frame files of one object folder: .vtk, or .node (each with its .ele), in any case, in
+/// the order of their numbers, which must run without gaps or repeats where the names carry them.
 std::vector<std::string> frame_files(const fs::path& folder) {
     std::vector<std::string> vtk, node;
     for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
         if (!entry.is_regular_file()) continue;
-        const std::string ext = entry.path().extension().string();
+        std::string ext = entry.path().extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
         if (ext == ".vtk") vtk.push_back(entry.path().string());
         if (ext == ".node") node.push_back(entry.path().string());
+        if (ext == ".msh" || ext == ".mesh")
+            throw Error(entry.path().string() + ": a frame folder holds .vtk or .node frames, not " + ext);
     }
     if (!vtk.empty() && !node.empty())
         throw Error(folder.string() + ": holds both .vtk and .node frames; keep one kind per folder");
     std::vector<std::string>& files = vtk.empty() ? node : vtk;
-    std::sort(files.begin(), files.end(), natural_less);
+    // By number, then by name where numbers tie (frame_03 and frame_3), so that the order never
+    // depends on the directory's.
+    std::sort(files.begin(), files.end(), [](const std::string& a, const std::string& b) {
+        return natural_less(a, b) || (!natural_less(b, a) && a < b);
+    });
+    for (std::size_t f = 1; f < files.size(); ++f) {
+        const long long before = frame_number(files[f - 1]), number = frame_number(files[f]);
+        if (before < 0 || number < 0) continue;
+        if (number == before)
+            throw Error(folder.string() + ": " + fs::path(files[f - 1]).filename().string() + " and " +
+                        fs::path(files[f]).filename().string() + " are both frame " + std::to_string(number));
+        if (number != before + 1)
+            throw Error(folder.string() + ": the frames jump from " + fs::path(files[f - 1]).filename().string() + " to " +
+                        fs::path(files[f]).filename().string() + " (a frame missing?)");
+    }
     return files;
+}
+
+/// @brief A folder's own name, also when given with a trailing '/'.
+std::string folder_name(const std::string& path) {
+    fs::path folder(path);
+    if (folder.filename().empty()) folder = folder.parent_path();
+    return folder.filename().string();
 }
 
 /// @brief One object per folder; each frame is read from its file when asked for.
 class FrameFolderScene final : public Scene {
 public:
-    explicit FrameFolderScene(const std::string& path) : name_(fs::path(path).filename().string()) {
+    explicit FrameFolderScene(const std::string& path) : name_(folder_name(path)) {
         if (!fs::is_directory(path)) throw Error(path + ": not a folder of frames");
         std::vector<fs::path> folders;
         if (!frame_files(path).empty()) {
@@ -120,6 +156,9 @@ private:
         check_frame(name_, frame, num_frames());
         const std::string& file = files_[object][static_cast<std::size_t>(frame)];
         TetMesh mesh = read_tet_mesh(file);
+        if (mesh.num_vertices() != rest.num_vertices())
+            throw Error(file + ": " + std::to_string(mesh.num_vertices()) + " vertices, but the first frame " +
+                        files_[object].front() + " has " + std::to_string(rest.num_vertices()));
         if (mesh.tets != rest.tets)
             throw Error(file + ": its tets differ from those of the first frame " + files_[object].front());
         return std::move(mesh.positions);
@@ -271,6 +310,9 @@ private:
         for (std::size_t i = 0; i < count; ++i) {
             const std::uint32_t bits = get_u32(&bytes[4 * i]);
             std::memcpy(&out[i], &bits, 4);
+            if (!std::isfinite(out[i]))
+                throw Error(path_ + ": frame " + std::to_string(frame) + ", object " + std::to_string(object) + ": vertex " +
+                            std::to_string(i / 3) + " has a non-finite coordinate");
         }
     }
 

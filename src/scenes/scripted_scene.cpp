@@ -52,30 +52,6 @@ double channel(const ObjectSpec& object, Channel c, double frame) {
 
 } // namespace
 
-std::array<double, 3> evaluate(const std::vector<Key>& keys, double frame) {
-    if (keys.empty()) return {};
-    if (frame <= keys.front().frame) return keys.front().value;
-    if (frame >= keys.back().frame) return keys.back().value;
-    std::size_t k = 0;
-    while (keys[k + 1].frame <= frame) ++k;
-    // Catmull-Rom tangents; the first and last key take the slope towards their neighbour, so that two
-    // keys give a constant speed.
-    const auto tangent = [&](std::size_t i, std::size_t axis) {
-        const std::size_t before = i == 0 ? 0 : i - 1, after = i + 1 == keys.size() ? i : i + 1;
-        return (keys[after].value[axis] - keys[before].value[axis]) / (keys[after].frame - keys[before].frame);
-    };
-    const double h = keys[k + 1].frame - keys[k].frame;
-    const double s = (frame - keys[k].frame) / h;
-    // Cubic Hermite basis.
-    const double h00 = (1 + 2 * s) * (1 - s) * (1 - s), h10 = s * (1 - s) * (1 - s);
-    const double h01 = s * s * (3 - 2 * s), h11 = s * s * (s - 1);
-    std::array<double, 3> value{};
-    for (std::size_t axis = 0; axis < 3; ++axis)
-        value[axis] = h00 * keys[k].value[axis] + h10 * h * tangent(k, axis) + h01 * keys[k + 1].value[axis] +
-                      h11 * h * tangent(k + 1, axis);
-    return value;
-}
-
 ScriptedScene::ScriptedScene(SceneSpec spec, int resolution, const std::string& base_dir) : spec_(std::move(spec)) {
     for (const ObjectSpec& object : spec_.objects) {
         if (!object.model.empty()) {

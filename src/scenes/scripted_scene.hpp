@@ -21,6 +21,7 @@ constexpr std::size_t kNumChannels = 5;
 struct Key {
     double frame = 0.0;
     std::array<double, 3> value{};
+    std::size_t line = 0; ///< of the scene file, for messages
 };
 
 /// @brief An object of a scene file as written.
