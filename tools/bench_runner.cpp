@@ -26,12 +26,6 @@ std::string compiler() {
 #endif
 }
 
-// Brute force builds no grid, so the thesis wrote "none" for its hash.
-std::string hash_label(const DetectorOptions& options) {
-    const bool grid = options.method == Method::kdet || options.method == Method::kdet_no_pairs;
-    return grid ? to_string(options.hash) : "none";
-}
-
 std::size_t tets_of(const Scene& scene, std::size_t object) {
     return object < scene.num_objects() ? scene.rest_mesh(object).num_tets() : 0;
 }

@@ -1,5 +1,6 @@
 #include "cli_args.hpp"
 
+#include <cstdio>
 #include <kdet/error.hpp>
 
 #include <CLI/CLI.hpp>
@@ -46,6 +47,22 @@ void CommandLine::positionals(std::size_t max_count, std::vector<std::string>& o
 
 std::string flag_of(const OptionInfo& option, FrontEnd front_end) {
     return front_end == front_end_bench ? option.bench_flag : option.flag;
+}
+
+std::string hash_label(const DetectorOptions& options) {
+    const bool grid = options.method == Method::kdet || options.method == Method::kdet_no_pairs;
+    return grid ? to_string(options.hash) : "none";
+}
+
+void print_pair_counts(const DetectorOptions& options, std::uint64_t pairs, std::uint64_t tets, const std::uint64_t* overlapping) {
+    const bool margin = options.margin > 0.0f;
+    if (options.method != Method::kdet_no_pairs) {
+        std::printf(margin ? "pairs in margin   %llu" : "colliding pairs   %llu", static_cast<unsigned long long>(pairs));
+        if (margin && overlapping)
+            std::printf(" (%llu overlapping, the rest apart)", static_cast<unsigned long long>(*overlapping));
+        std::printf("\n");
+    }
+    std::printf(margin ? "tets in a pair    %llu\n" : "colliding tets    %llu\n", static_cast<unsigned long long>(tets));
 }
 
 void CommandLine::detector_options(DetectorOptions& options, FrontEnd front_end) {

@@ -7,6 +7,7 @@
 #include <kdet/options.hpp>
 
 #include <functional>
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -52,5 +53,15 @@ private:
 
 /// @brief The flag under which @p option appears on @p front_end (bench: its thesis flag).
 std::string flag_of(const OptionInfo& option, FrontEnd front_end);
+
+/// @brief The grid hash @p options use, or "none" for the brute-force methods, which build no grid
+/// (as the thesis's files wrote it).
+std::string hash_label(const DetectorOptions& options);
+
+/// @brief The summary's pair and tet lines: "colliding pairs" and "colliding tets", or with a margin
+/// "pairs in margin" (with @p overlapping, when known, how many of them overlap) and "tets in a pair".
+/// kdet_no_pairs builds no pairs: its line is left out.
+void print_pair_counts(const DetectorOptions& options, std::uint64_t pairs, std::uint64_t tets,
+                       const std::uint64_t* overlapping = nullptr);
 
 } // namespace kdet::cli

@@ -218,22 +218,14 @@ int run_collide(int argc, char** argv) {
     std::printf("%s", self ? ", self-collision" : "");
     if (rings > 0) std::printf(", exclusion rings %d", rings);
     std::printf("\n");
-    // Brute force builds no grid, so no hash (as kdet bench's files say).
-    const bool grid = options.method == Method::kdet || options.method == Method::kdet_no_pairs;
     std::printf("method            %s, test %s, hash %s, backend %s\n", to_string(options.method),
-                to_string(options.narrow_phase), grid ? to_string(options.hash) : "none", to_string(options.backend));
+                to_string(options.narrow_phase), hash_label(options).c_str(), to_string(options.backend));
     if (options.margin > 0.0f) std::printf("margin            %s\n", find_option("margin")->text(options).c_str());
     std::printf("candidates        %llu (%llu to the narrow phase)\n", static_cast<unsigned long long>(c.candidates),
                 static_cast<unsigned long long>(c.narrow_phase_candidates));
     // With a margin the pairs are those within it, overlapping or not; their distances split them.
-    const bool margin = options.margin > 0.0f;
-    if (options.method != Method::kdet_no_pairs) {
-        std::printf(margin ? "pairs in margin   %llu" : "colliding pairs   %llu", static_cast<unsigned long long>(c.colliding_pairs));
-        if (margin && options.distances)
-            std::printf(" (%llu overlapping, the rest apart)", static_cast<unsigned long long>(overlapping_pairs(result)));
-        std::printf("\n");
-    }
-    std::printf(margin ? "tets in a pair    %llu\n" : "colliding tets    %llu\n", static_cast<unsigned long long>(c.colliding_tets));
+    const std::uint64_t overlapping = options.distances ? overlapping_pairs(result) : 0;
+    print_pair_counts(options, c.colliding_pairs, c.colliding_tets, options.distances ? &overlapping : nullptr);
     if (options.narrow_phase == NarrowPhase::exact)
         std::printf("exact stage       %llu pairs\n", static_cast<unsigned long long>(c.exact_stage_pairs));
     std::printf("times (ms)        boxes %.3f, populate %.3f, candidates %.3f, sort pairs %.3f, narrow %.3f\n",

@@ -97,15 +97,11 @@ int run(const MpiCollide& request, int rank, int size) {
     if (!request.self) std::printf(" x %s (%zu tets)", request.meshes[1].c_str(), meshes[1].num_tets());
     std::printf("%s\n", request.self ? ", self-collision" : "");
     const DetectorOptions& options = request.options;
-    const bool grid = options.method == Method::kdet || options.method == Method::kdet_no_pairs;
     std::printf("method            %s, test %s, hash %s, backend %s\n", to_string(options.method),
-                to_string(options.narrow_phase), grid ? to_string(options.hash) : "none", to_string(options.backend));
+                to_string(options.narrow_phase), hash_label(options).c_str(), to_string(options.backend));
     std::printf("ranks             %d, partition %s\n", size, kind == mpi::Partition::slabs ? "slabs" : "random");
-    // As kdet collide words it: with a margin, the pairs within it.
-    const bool margin = options.margin > 0.0f;
-    if (margin) std::printf("margin            %s\n", find_option("margin")->text(options).c_str());
-    if (options.method != Method::kdet_no_pairs) std::printf(margin ? "pairs in margin   %zu\n" : "colliding pairs   %zu\n", pairs.size());
-    std::printf(margin ? "tets in a pair    %llu\n" : "colliding tets    %llu\n", total[0]);
+    if (options.margin > 0.0f) std::printf("margin            %s\n", find_option("margin")->text(options).c_str());
+    print_pair_counts(options, pairs.size(), total[0]);
     const double mean = static_cast<double>(total[3]) / size;
     std::printf("exchange          %llu tets sent (%.3f per tet), %llu bytes; tets per rank with those received: "
                 "%.0f to %.0f (%.2f of the mean owned)\n",
