@@ -207,6 +207,15 @@ TEST(SceneRegistry, RefusesAResolutionOutsideOneToFourForEveryScene) {
         }
 }
 
+std::string recording_error(const std::string& path) {
+    try {
+        read_recording(path);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
 TEST(RecordedScene, BinaryRecordingPlaysBackExactly) {
     const fs::path dir = fresh_dir("recording");
     const auto scene = read_scene_file(write_box_scene(dir).string());
@@ -238,20 +247,16 @@ TEST(RecordedScene, BinaryRecordingPlaysBackExactly) {
     EXPECT_EQ(error_message([&] { broken->positions(1, 29, b); }),
               path + ": frame 29, object 1: vertex " + std::to_string(scene->rest_mesh(1).num_vertices() - 1) +
                   " has a non-finite coordinate");
-    // A cut-off file is refused when opened.
-    fs::resize_file(path, fs::file_size(path) - 5);
+    // Bytes past the frames the header announces are refused, as a cut-off file is, when opened.
+    const auto size = fs::file_size(path);
+    fs::resize_file(path, size + 3);
+    EXPECT_EQ(recording_error(path),
+              path + ": byte " + std::to_string(size) + ": 3 bytes past the last of the 30 frames the header announces");
+    fs::resize_file(path, fs::file_size(path) - 8);
     EXPECT_THROW(read_recording(path), Error);
     fs::remove_all(dir);
 }
 
-std::string recording_error(const std::string& path) {
-    try {
-        read_recording(path);
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "no error";
-}
 
 TEST(RecordedScene, CountsTheFileCannotHoldAreRefusedBeforeAnythingIsReserved) {
     // Without the check against the file's size, these counts reserve 64 GB for the tets, 103 GB for

@@ -291,6 +291,11 @@ private:
         const std::uint64_t data_bytes = file_size_ - std::min(file_size_, data_offset_);
         if (frame_bytes_ > 0 && static_cast<std::uint64_t>(frames_) > data_bytes / frame_bytes_)
             check_extent(data_offset_, data_bytes + 1, "the last frame");
+        // Bytes past the last frame: a header whose frame count was edited down, or two files joined.
+        const std::uint64_t frames_end = data_offset_ + frame_bytes_ * static_cast<std::uint64_t>(frames_);
+        if (file_size_ > frames_end)
+            throw Error(path_ + ": byte " + std::to_string(frames_end) + ": " + std::to_string(file_size_ - frames_end) +
+                        " bytes past the last of the " + std::to_string(frames_) + " frames the header announces");
         for (std::size_t o = 0; o < meshes_.size(); ++o) {
             std::vector<double> rest;
             positions(o, 0, rest);
