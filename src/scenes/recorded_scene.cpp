@@ -1,6 +1,8 @@
 /// @file recorded_scene.cpp
 /// @brief Scenes played back from per-frame mesh files or from kdet's binary recordings (.kdetrec).
 
+#include "io/text_reader.hpp"
+
 #include <kdet/error.hpp>
 #include <kdet/io.hpp>
 #include <kdet/scenes.hpp>
@@ -76,8 +78,7 @@ std::vector<std::string> frame_files(const fs::path& folder) {
     std::vector<std::string> vtk, node;
     for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
         if (!entry.is_regular_file()) continue;
-        std::string ext = entry.path().extension().string();
-        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        const std::string ext = io::lowercase_extension(entry.path().string());
         if (ext == ".vtk") vtk.push_back(entry.path().string());
         if (ext == ".node") node.push_back(entry.path().string());
         if (ext == ".msh" || ext == ".mesh")
