@@ -6,6 +6,7 @@
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
 
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <new>
@@ -13,6 +14,19 @@
 void kdet::cli::print_error(const char* message) { std::cerr << "kdet: error: " << message << std::endl; }
 
 namespace {
+
+/// True for a command given --mpi in a process that an MPI launcher started as a rank other than 0:
+/// errors found before MPI starts (a bad flag) are the same on every rank, so only rank 0 prints them.
+bool quiet_rank(int argc, char** argv) {
+    bool mpi = false;
+    for (int k = 2; k < argc; ++k) mpi = mpi || std::strcmp(argv[k], "--mpi") == 0;
+    if (!mpi) return false;
+    for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"}) {
+        const char* value = std::getenv(name);
+        if (value && *value) return std::strcmp(value, "0") != 0;
+    }
+    return false;
+}
 
 const char* usage = R"(usage: kdet <command> [arguments]
 
@@ -68,16 +82,16 @@ int main(int argc, char** argv) {
         std::cerr << "kdet: unknown command '" << command << "' (commands: collide, locate, bench, view, plot, prepare; see 'kdet --help')\n";
         return exit_usage;
     } catch (const UsageError& e) {
-        std::cerr << "kdet " << e.what() << "\n";
+        if (!quiet_rank(argc, argv)) std::cerr << "kdet " << e.what() << "\n";
         return exit_usage;
     } catch (const kdet::Error& e) {
-        print_error(e.what());
+        if (!quiet_rank(argc, argv)) print_error(e.what());
         return exit_failure;
     } catch (const std::bad_alloc&) {
-        print_error("out of memory");
+        if (!quiet_rank(argc, argv)) print_error("out of memory");
         return exit_failure;
     } catch (const std::exception& e) {
-        print_error(e.what());
+        if (!quiet_rank(argc, argv)) print_error(e.what());
         return exit_failure;
     }
 }

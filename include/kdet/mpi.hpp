@@ -98,10 +98,10 @@ public:
     Detector(const Detector&) = delete;
     Detector& operator=(const Detector&) = delete;
 
-    /// @brief Collective: adds one object, each rank giving its part (possibly empty). Checks ids
-    /// against the global counts (which every rank must give alike), that each tet's vertices are held
-    /// by the rank, that no tet is owned twice, that a vertex held by several ranks has one position
-    /// and that positions are finite.
+    /// @brief Collective: adds one object, each rank giving its part (possibly empty), its tets in any
+    /// order. Checks ids against the global counts (which every rank must give alike), that each tet's
+    /// vertices are held by the rank, that every tet is owned by exactly one rank, that a vertex held
+    /// by several ranks has one position and that positions are finite.
     ObjectId add_object(const ObjectPart& part);
     ObjectId add_object(const MeshPart& part) { return add_object(part.view()); }
 

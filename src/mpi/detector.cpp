@@ -90,8 +90,11 @@ struct Detector::Impl {
         std::vector<float> positions;           ///< x y z per held vertex
         std::vector<std::uint32_t> sorted_ids;  ///< vertex_ids sorted, for lookups
         std::vector<std::uint32_t> sorted_slot; ///< index into vertex_ids of each sorted id
-        std::vector<std::uint32_t> tet_ids;     ///< owned tets' global ids
-        std::vector<std::uint32_t> tets;        ///< 4 indices into vertex_ids per owned tet
+        /// Owned tets' global ids, ascending: the local detector then meets a pair of owned tets in
+        /// the single detector's order and computes its contact alike.
+        std::vector<std::uint32_t> tet_ids;
+        std::vector<std::uint32_t> tets;        ///< 4 indices into vertex_ids per owned tet, tet_ids' order
+        std::vector<std::uint32_t> caller_slot; ///< for each owned tet, its index in the caller's part
         bool self = false;
 
         /// The held index of global vertex @p id, or -1.
@@ -190,31 +193,35 @@ std::string Detector::Impl::validate(const ObjectPart& part, Object& out) const 
         if (k > 0 && out.sorted_ids[k] == out.sorted_ids[k - 1])
             return name + "vertex id " + std::to_string(out.sorted_ids[k]) + " given twice";
     }
-    out.tet_ids.assign(part.tet_ids, part.tet_ids + part.tet_count);
-    out.tets.resize(4 * part.tet_count);
     for (std::size_t t = 0; t < part.tet_count; ++t) {
-        if (out.tet_ids[t] >= part.global_tet_count)
-            return name + "tet id " + std::to_string(out.tet_ids[t]) + " out of range (" +
+        if (part.tet_ids[t] >= part.global_tet_count)
+            return name + "tet id " + std::to_string(part.tet_ids[t]) + " out of range (" +
                    std::to_string(part.global_tet_count) + " tets)";
         for (int c = 0; c < 4; ++c) {
             const std::uint32_t g = part.tets[4 * t + c];
-            const std::ptrdiff_t h = out.held(g);
-            if (h < 0)
-                return name + "tet " + std::to_string(out.tet_ids[t]) + " uses vertex " + std::to_string(g) +
+            if (out.held(g) < 0)
+                return name + "tet " + std::to_string(part.tet_ids[t]) + " uses vertex " + std::to_string(g) +
                        (g >= part.global_vertex_count ? ", out of range (" + std::to_string(part.global_vertex_count) + " vertices)"
                                                       : ", which this rank does not hold");
-            out.tets[4 * t + c] = static_cast<std::uint32_t>(h);
         }
     }
-    std::vector<std::uint32_t> ids = out.tet_ids;
-    std::sort(ids.begin(), ids.end());
-    const auto twice = std::adjacent_find(ids.begin(), ids.end());
-    if (twice != ids.end()) return name + "tet id " + std::to_string(*twice) + " given twice";
+    out.caller_slot.resize(part.tet_count);
+    for (std::size_t t = 0; t < part.tet_count; ++t) out.caller_slot[t] = static_cast<std::uint32_t>(t);
+    std::sort(out.caller_slot.begin(), out.caller_slot.end(),
+              [&](std::uint32_t x, std::uint32_t y) { return part.tet_ids[x] < part.tet_ids[y]; });
+    out.tet_ids.resize(part.tet_count);
+    out.tets.resize(4 * part.tet_count);
+    for (std::size_t k = 0; k < part.tet_count; ++k) {
+        const std::size_t t = out.caller_slot[k];
+        out.tet_ids[k] = part.tet_ids[t];
+        if (k > 0 && out.tet_ids[k] == out.tet_ids[k - 1]) return name + "tet id " + std::to_string(out.tet_ids[k]) + " given twice";
+        for (int c = 0; c < 4; ++c) out.tets[4 * k + static_cast<std::size_t>(c)] = static_cast<std::uint32_t>(out.held(part.tets[4 * t + c]));
+    }
     return {};
 }
 
 /// Collective: each vertex id and tet id goes to a directory rank (blocks of ids), which finds a tet
-/// owned by two ranks or a vertex held with two positions. Returns this rank's finding, or "".
+/// owned by two ranks or by none, or a vertex held with two positions. Returns this rank's finding, or "".
 std::string Detector::Impl::check_directory(const Object& object) const {
     struct Entry {
         std::uint32_t id, kind; // kind 0: vertex, 1: tet
@@ -246,6 +253,15 @@ std::string Detector::Impl::check_directory(const Object& object) const {
             return name + "vertex " + std::to_string(a.id) + " has different positions on ranks " +
                    std::to_string(a.from) + " and " + std::to_string(b.from);
     }
+    // This rank's block of tet ids is [first, end): each must have come from some rank.
+    const std::uint64_t tets = object.global_tets, ranks = static_cast<std::uint64_t>(size), r = static_cast<std::uint64_t>(rank);
+    const std::uint64_t first = (r * tets + ranks - 1) / ranks, end = ((r + 1) * tets + ranks - 1) / ranks;
+    std::uint64_t next = first;
+    for (const Entry& e : got)
+        if (e.kind == 1 && e.id == next) ++next;
+    if (next < end)
+        return name + "tet " + std::to_string(next) + " is owned by no rank (each of the " + std::to_string(tets) +
+               " tets must be owned by one)";
     return {};
 }
 
@@ -528,8 +544,9 @@ void Detector::Impl::collect_pairs(const kdet::FrameResult& frame) {
     }
     result.colliding.resize(objects.size());
     for (std::size_t o = 0; o < objects.size(); ++o) {
-        const std::size_t owned = objects[o].tet_ids.size();
-        result.colliding[o].assign(frame.colliding[o].begin(), frame.colliding[o].begin() + static_cast<std::ptrdiff_t>(owned));
+        const Object& object = objects[o];
+        result.colliding[o].resize(object.tet_ids.size());
+        for (std::size_t k = 0; k < object.tet_ids.size(); ++k) result.colliding[o][object.caller_slot[k]] = frame.colliding[o][k];
     }
     result.counts = frame.counts;
     result.times = frame.times;

@@ -2,7 +2,8 @@
 # `kdet collide --mpi` under mpirun writes exactly the pairs `kdet collide` writes, with both partitions,
 # kdet bench --mpi finds the same pairs per frame on 1 and 2 ranks and as without --mpi on a scene of
 # filters and a static object, refuses a scene whose tets change,
-# a file missing on rank 0 fails on every rank with one message, --partition alone is a usage error.
+# a file missing on rank 0 fails on every rank with one message, so does a bad flag, and --partition
+# alone is a usage error.
 #   cli.sh KDET MPIEXEC DATA_DIR WORK
 set -euo pipefail
 kdet="$1" mpiexec="$2" data="${KDET_DATA_DIR:-$3}" work="$4"
@@ -47,4 +48,10 @@ set +e
 status=$?
 set -e
 [[ $status == 2 && "$(cat "$work/usage.out")" == "kdet collide: --partition needs --mpi" ]] || { echo "exit $status" >&2; exit 1; }
+# A bad flag, found before MPI starts, is printed once, not once per rank.
+if run collide "$data/bunny.mesh" --self --mpi --margin -1 >"$work/flag.out" 2>&1; then
+  echo "a negative margin did not fail under mpirun" >&2
+  exit 1
+fi
+[[ "$(grep -c "margin" "$work/flag.out")" == 1 ]] || { echo "a usage error not printed once:" >&2; cat "$work/flag.out" >&2; exit 1; }
 echo "kdet collide --mpi on 3 ranks: $(wc -l <"$work/expected.txt") pairs, the same as without --mpi"

@@ -61,10 +61,28 @@ std::vector<double> held_positions(const mpi::MeshPart& part, const std::vector<
     return out;
 }
 
+/// A part's tets and vertices in descending id order, as a simulation's own numbering may give them.
+mpi::MeshPart reversed(const mpi::MeshPart& part) {
+    mpi::MeshPart out = part;
+    const std::size_t nv = part.vertex_ids.size(), nt = part.tet_ids.size();
+    for (std::size_t v = 0; v < nv; ++v) {
+        out.vertex_ids[v] = part.vertex_ids[nv - 1 - v];
+        for (int c = 0; c < 3; ++c) out.positions[3 * v + c] = part.positions[3 * (nv - 1 - v) + c];
+    }
+    for (std::size_t t = 0; t < nt; ++t) {
+        out.tet_ids[t] = part.tet_ids[nt - 1 - t];
+        for (int c = 0; c < 4; ++c) out.tets[4 * t + c] = part.tets[4 * (nt - 1 - t) + c];
+    }
+    return out;
+}
+
+enum class PartOrder { ascending, descending };
+
 /// Runs @p s split as @p owners on every rank and on one CPU Detector, frame by frame, and compares;
 /// @p rebuilt, when given, gets per frame whether any rank's local detector changed its set of tets.
 void expect_same_as_single(const Scenario& s, const std::vector<std::vector<int>>& owners,
-                           const DetectorOptions& options = one_thread(), std::vector<int>* rebuilt = nullptr) {
+                           const DetectorOptions& options = one_thread(), std::vector<int>* rebuilt = nullptr,
+                           PartOrder order = PartOrder::ascending) {
     const int rank = world_rank();
     mpi::Detector distributed(MPI_COMM_WORLD, options);
     DetectorOptions reference = options; // one process on the CPU: the answer every backend must give
@@ -72,7 +90,8 @@ void expect_same_as_single(const Scenario& s, const std::vector<std::vector<int>
     Detector single(reference);
     std::vector<mpi::MeshPart> parts;
     for (std::size_t o = 0; o < s.meshes.size(); ++o) {
-        parts.push_back(mpi::local_part(s.meshes[o], owners[o], rank));
+        const mpi::MeshPart part = mpi::local_part(s.meshes[o], owners[o], rank);
+        parts.push_back(order == PartOrder::ascending ? part : reversed(part));
         distributed.add_object(parts.back());
         single.add_object(s.meshes[o]);
         distributed.set_self_collision(static_cast<ObjectId>(o), s.self[o]);
@@ -247,6 +266,21 @@ TEST(Mpi, ContactsAsTheSingleDetectors) {
     options.narrow_phase = NarrowPhase::sat;
     std::vector<const TetMesh*> meshes{&s.meshes[0], &s.meshes[1]};
     expect_same_as_single(s, mpi::partition_tets(meshes, world_size(), mpi::Partition::random, 3), options);
+}
+
+TEST(Mpi, ContactsAsTheSingleDetectorsWhateverOrderARankGivesItsTets) {
+    // A pair's contact is computed with its lower tet first: a rank's local detector must meet two owned
+    // tets in that order too, or depth and direction differ in their last bits (seen on these soups).
+    Scenario s = scenario({random_soup(1500, 1.0, 1.5, 11), random_soup(1500, 1.0, 1.5, 12)});
+    s.self[0] = true;
+    DetectorOptions options = one_thread();
+    options.contacts = true;
+    std::vector<const TetMesh*> meshes{&s.meshes[0], &s.meshes[1]};
+    const std::vector<std::vector<int>> owners = mpi::partition_tets(meshes, world_size(), mpi::Partition::random, 3);
+    for (PartOrder order : {PartOrder::ascending, PartOrder::descending}) {
+        SCOPED_TRACE(order == PartOrder::ascending ? "ascending ids" : "descending ids");
+        expect_same_as_single(s, owners, options, nullptr, order);
+    }
 }
 
 TEST(Mpi, PairsWithinAMarginAsTheSingleDetectors) {
@@ -428,6 +462,19 @@ TEST(Mpi, BadInputOnOneRankFailsOnEveryRank) {
         EXPECT_EQ(same_error_everywhere([&] { detector.add_object(twice); }),
                   "rank 0: object 0: tet 0 is owned by ranks 0 and 1");
     }
+    // The last rank leaves out the last tet it owns: no rank owns it.
+    mpi::MeshPart short_part = good;
+    std::uint32_t left_out = 0;
+    for (std::size_t t = 0; t < owners.size(); ++t)
+        if (owners[t] == last) left_out = static_cast<std::uint32_t>(t);
+    if (rank == last) {
+        short_part.tet_ids.pop_back();
+        short_part.tets.resize(4 * short_part.tet_ids.size());
+    }
+    const int directory = static_cast<int>(std::uint64_t{left_out} * static_cast<std::uint64_t>(size) / soup.num_tets());
+    EXPECT_EQ(same_error_everywhere([&] { detector.add_object(short_part); }),
+              "rank " + std::to_string(directory) + ": object 0: tet " + std::to_string(left_out) +
+                  " is owned by no rank (each of the 200 tets must be owned by one)");
     EXPECT_EQ(detector.object_count(), 0u);
 
     // A NaN on the last rank: detect() fails everywhere, and the detector keeps the previous positions.
