@@ -655,7 +655,7 @@ TEST(IoValidate, NamesTheTetOrVertex) {
     kdet::TetMesh partial = two_tets();
     partial.tets.pop_back();
     EXPECT_EQ(error_message([&] { kdet::validate_tet_mesh(partial, "scene"); }),
-              "scene: tets hold 7 indices, not a multiple of 4");
+              "scene: the mesh's tets hold 7 indices, not a multiple of 4");
 
     EXPECT_EQ(error_message([] { kdet::validate_tet_mesh(kdet::TetMesh{}, "scene"); }), "scene: no tetrahedra");
 }

@@ -324,11 +324,7 @@ void write_tet_mesh(const TetMesh& mesh, const std::string& path, const WriteOpt
 
 void validate_tet_mesh(const TetMesh& mesh, const std::string& source, const ReadOptions& options) {
     const auto fail = [&source](const std::string& what) { throw Error(source + ": " + what); };
-    if (mesh.positions.size() % 3 != 0) {
-        fail("positions hold " + std::to_string(mesh.positions.size()) + " values, not a multiple of 3");
-    }
-    if (mesh.tets.size() % 4 != 0)
-        fail("tets hold " + std::to_string(mesh.tets.size()) + " indices, not a multiple of 4");
+    io::check_whole_entries(mesh, source);
     if (mesh.num_tets() == 0) fail("no tetrahedra");
     for (std::size_t v = 0; v < mesh.num_vertices(); ++v) {
         for (std::size_t axis = 0; axis < 3; ++axis) {

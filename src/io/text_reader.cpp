@@ -36,6 +36,14 @@ std::string excerpt(std::string_view text) {
     return out + "'";
 }
 
+void check_whole_entries(const TetMesh& mesh, const std::string& source) {
+    if (mesh.positions.size() % 3 != 0)
+        throw Error(source + ": the mesh's positions hold " + std::to_string(mesh.positions.size()) +
+                    " values, not a multiple of 3");
+    if (mesh.tets.size() % 4 != 0)
+        throw Error(source + ": the mesh's tets hold " + std::to_string(mesh.tets.size()) + " indices, not a multiple of 4");
+}
+
 std::string short_number(double value) {
     char text[32];
     std::snprintf(text, sizeof text, "%.3g", value);

@@ -33,6 +33,10 @@ std::string excerpt(std::string_view text);
 /// @brief The extension of @p path in lower case (".MSH" reads as ".msh"), with its dot; empty when none.
 std::string lowercase_extension(const std::string& path);
 
+/// @brief Throws "SOURCE: the mesh's positions hold N values, not a multiple of 3" (or its tets, of 4)
+/// where @p mesh holds a partial vertex or tet, which num_vertices() and num_tets() would drop.
+void check_whole_entries(const TetMesh& mesh, const std::string& source);
+
 /// @brief A double for a message, with 3 significant digits.
 std::string short_number(double value);
 

@@ -1,4 +1,5 @@
 #include "grid/bucket_table.hpp"
+#include "io/text_reader.hpp"
 #include "pipeline/object_filters.hpp"
 #include "pipeline/pipeline_base.hpp"
 
@@ -383,21 +384,9 @@ ObjectId Detector::add_object(const double* positions, std::size_t vertex_count,
                               std::size_t tet_count) {
     return impl_->add(xyz_view(positions, vertex_count), tets, tet_count);
 }
-namespace {
-
-/// @brief Throws where a TetMesh's arrays hold a partial vertex or tet, which num_vertices() and
-/// num_tets() would drop.
-void check_whole(const TetMesh& mesh, const std::string& what) {
-    if (mesh.positions.size() % 3 != 0)
-        throw Error(what + ": the mesh's positions hold " + std::to_string(mesh.positions.size()) + " values, not a multiple of 3");
-    if (mesh.tets.size() % 4 != 0)
-        throw Error(what + ": the mesh's tets hold " + std::to_string(mesh.tets.size()) + " indices, not a multiple of 4");
-}
-
-} // namespace
 
 ObjectId Detector::add_object(const TetMesh& mesh) {
-    check_whole(mesh, "add_object");
+    io::check_whole_entries(mesh, "add_object");
     return impl_->add(xyz_view(mesh.positions.data(), mesh.num_vertices()), mesh.tets.data(), mesh.num_tets());
 }
 ObjectId Detector::add_object(const PositionsView& positions, const std::uint32_t* tets, std::size_t tet_count) {
@@ -532,7 +521,7 @@ void Detector::set_tets(ObjectId object, const std::uint32_t* tets, std::size_t 
 }
 
 void Detector::set_tets(ObjectId object, const TetMesh& mesh) {
-    check_whole(mesh, "object " + std::to_string(object) + ": set_tets");
+    io::check_whole_entries(mesh, "object " + std::to_string(object) + ": set_tets");
     set_tets(object, mesh.tets.data(), mesh.num_tets(), xyz_view(mesh.positions.data(), mesh.num_vertices()));
 }
 
