@@ -24,6 +24,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -91,7 +92,7 @@ bool is_highlight(const std::uint8_t* p) { return p[0] >= 60 && p[0] > 1.7 * p[1
 /// @brief A surface pixel: a cool colour, well away from the grey background.
 bool is_surface(const std::uint8_t* p) { return std::max(p[1], p[2]) > p[0] + 35; }
 
-bool is_normal_line(const std::uint8_t* p) { return p[0] > 180 && p[1] > 150 && p[2] < 110; }
+bool is_normal_line(const std::uint8_t* p) { return p[0] > 235 && p[1] > 235 && p[2] > 235; }
 
 std::size_t count(const Picture& picture, const std::function<bool(const std::uint8_t*)>& kind) {
     std::size_t n = 0;
@@ -344,7 +345,7 @@ TEST(ViewPicture, DisplayModes) {
     const auto dark = [](const std::uint8_t* p) { return p[0] < 40 && p[1] < 45 && p[2] < 55; };
     const Picture wire = screenshot(base + " --wireframe", "wire");
     EXPECT_GT(count(wire, dark), count(plain, dark) + 1000);
-    // Contact normals: yellow lines with --normals only, whatever the test (contacts are an option).
+    // Contact normals: white lines with --normals only, whatever the test (contacts are an option).
     const Picture normals = screenshot(base + " --test sat_mtv --normals", "normals");
     EXPECT_GT(count(normals, is_normal_line), 200u);
     EXPECT_EQ(count(plain, is_normal_line), 0u);
@@ -384,6 +385,32 @@ TEST(ViewCommand, FrameOutOfRangeAndOneLineErrors) {
 }
 
 // ---- OpenGL buffers, in this process ----
+
+TEST(ViewRenderer, EveryKindOfThingHasAColourOfItsOwn) {
+    // Objects, colliding tets, margin tets, the tets holding query points, the points by status and the
+    // contact normals: no two kinds may be near enough in colour to be taken for one another.
+    struct Kind {
+        std::string name;
+        Color color;
+    };
+    std::vector<Kind> kinds{{"colliding", highlight_color()}, {"margin", margin_color()}, {"located", located_color()},
+                            {"normals", normal_color()}};
+    for (int status = 0; status < 3; ++status) kinds.push_back({"point " + std::to_string(status), point_color(status)});
+    const auto distance = [](Color a, Color b) {
+        return std::sqrt((a.r - b.r) * (a.r - b.r) + (a.g - b.g) * (a.g - b.g) + (a.b - b.b) * (a.b - b.b));
+    };
+    for (std::size_t i = 0; i < kinds.size(); ++i)
+        for (std::size_t j = i + 1; j < kinds.size(); ++j) {
+            if (kinds[i].name == "normals" && kinds[j].name == "point 0") continue; // lines and dots: told apart by shape
+            EXPECT_GT(distance(kinds[i].color, kinds[j].color), 0.3f) << kinds[i].name << " and " << kinds[j].name;
+        }
+    for (std::size_t object = 0; object < 6; ++object) {
+        for (const Kind& kind : kinds)
+            EXPECT_GT(distance(object_color(object), kind.color), 0.3f) << "object " << object << " and " << kind.name;
+        for (std::size_t other = 0; other < object; ++other)
+            EXPECT_GT(distance(object_color(object), object_color(other)), 0.15f) << "objects " << object << " and " << other;
+    }
+}
 
 TEST(ViewRenderer, VertexBuffersAreUpdatedInPlace) {
     REQUIRE_GL();

@@ -116,15 +116,16 @@ Color scaled(Color c, float s) { return {c.r * s, c.g * s, c.b * s}; }
 } // namespace
 
 Color object_color(std::size_t object) {
-    // Blues, greens, violets and neutrals only: red belongs to the colliding tets.
-    static constexpr Color palette[] = {{0.30f, 0.56f, 0.92f}, {0.36f, 0.78f, 0.52f}, {0.66f, 0.54f, 0.94f},
-                                        {0.36f, 0.78f, 0.84f}, {0.72f, 0.74f, 0.78f}, {0.86f, 0.80f, 0.38f}};
+    // Blues, violets and muted neutrals only: red belongs to the colliding tets, yellow to the margin's,
+    // green to the tets that hold query points.
+    static constexpr Color palette[] = {{0.30f, 0.56f, 0.92f}, {0.66f, 0.54f, 0.94f}, {0.36f, 0.78f, 0.84f},
+                                        {0.72f, 0.74f, 0.78f}, {0.44f, 0.50f, 0.68f}, {0.74f, 0.66f, 0.56f}};
     return palette[object % (sizeof palette / sizeof palette[0])];
 }
 
 Color highlight_color() { return {0.96f, 0.20f, 0.12f}; }
 
-Color margin_color() { return {0.98f, 0.86f, 0.10f}; }
+Color margin_color() { return {0.98f, 0.92f, 0.30f}; }
 
 Color point_color(int status) {
     // None of them red or of the objects' cool colours.
@@ -133,6 +134,8 @@ Color point_color(int status) {
 }
 
 Color located_color() { return {0.45f, 0.90f, 0.15f}; }
+
+Color normal_color() { return {0.97f, 0.97f, 0.97f}; }
 
 Renderer::Renderer() {
     mesh_program_ = link(mesh_vertex_shader, mesh_fragment_shader);
@@ -524,7 +527,7 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
     if (display.contact_normals && contacts_.vertices > 0) {
         glUniform1i(lit, 0);
         glUniform1f(uniform(mesh_program_, "offset_scale"), 0.05f * scene_radius_ * display.normal_length);
-        set_color(mesh_program_, Color{1.0f, 0.88f, 0.22f}, 1.0f);
+        set_color(mesh_program_, normal_color(), 1.0f);
         if (translucent) glDisable(GL_DEPTH_TEST);
         glBindVertexArray(contacts_.array);
         glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(contacts_.vertices));

@@ -32,6 +32,8 @@ Color margin_color();
 Color point_color(int status);
 /// @brief The tets that hold query points.
 Color located_color();
+/// @brief The contact normals' lines: white, apart from the margin's yellow they often lie over.
+Color normal_color();
 
 /// @brief At most this many contact normals are drawn (an even sample of the colliding pairs).
 constexpr std::size_t max_contact_lines = 1500;
