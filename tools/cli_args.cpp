@@ -54,6 +54,10 @@ std::string hash_label(const DetectorOptions& options) {
     return grid ? to_string(options.hash) : "none";
 }
 
+std::uint64_t overlapping_pairs(const FrameResult& result) {
+    return static_cast<std::uint64_t>(std::count(result.distances.begin(), result.distances.end(), 0.0f));
+}
+
 void print_pair_counts(const DetectorOptions& options, std::uint64_t pairs, std::uint64_t tets, const std::uint64_t* overlapping) {
     const bool margin = options.margin > 0.0f;
     if (options.method != Method::kdet_no_pairs) {

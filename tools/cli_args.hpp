@@ -5,6 +5,7 @@
 
 #include <kdet/option_table.hpp>
 #include <kdet/options.hpp>
+#include <kdet/results.hpp>
 
 #include <functional>
 #include <cstdint>
@@ -57,6 +58,9 @@ std::string flag_of(const OptionInfo& option, FrontEnd front_end);
 /// @brief The grid hash @p options use, or "none" for the brute-force methods, which build no grid
 /// (as the thesis's files wrote it).
 std::string hash_label(const DetectorOptions& options);
+
+/// @brief Of a frame's pairs within the margin, those that overlap (distance 0); needs its distances.
+std::uint64_t overlapping_pairs(const FrameResult& result);
 
 /// @brief The summary's pair and tet lines: "colliding pairs" and "colliding tets", or with a margin
 /// "pairs in margin" (with @p overlapping, when known, how many of them overlap) and "tets in a pair".

@@ -62,11 +62,6 @@ std::string one_line(const nlohmann::ordered_json& value) {
 /// @brief Milliseconds to the nanosecond, printed as such rather than with the binary fraction's tail.
 double milliseconds(double value) { return std::round(value * 1e6) / 1e6; }
 
-/// @brief Of a frame's pairs within the margin, those that overlap (distance 0); needs its distances.
-std::uint64_t overlapping_pairs(const FrameResult& result) {
-    return static_cast<std::uint64_t>(std::count(result.distances.begin(), result.distances.end(), 0.0f));
-}
-
 /// @brief What follows a pair's indices in write_pair_lines.
 enum class PairColumns { none, contacts, distances };
 

@@ -1,5 +1,7 @@
 #include "session.hpp"
 
+#include "cli_args.hpp"
+
 #include <kdet/error.hpp>
 
 #include <time.h>
@@ -243,13 +245,13 @@ void ViewSession::find_margin_tets() {
     margin_tets_.clear();
     margin_pairs_ = 0;
     if (!(options_.margin > 0.0f)) return;
+    margin_pairs_ = result_.pairs.size() - static_cast<std::size_t>(cli::overlapping_pairs(result_));
     // 0: in no pair within the margin only, 1: in one, 2: in an overlapping pair (which wins).
     margin_tets_.resize(scene_->num_objects());
     for (std::size_t o = 0; o < margin_tets_.size(); ++o) margin_tets_[o].assign(mesh(o).num_tets(), 0);
     for (std::size_t p = 0; p < result_.pairs.size(); ++p) {
         const TetPair& pair = result_.pairs[p];
         const bool overlaps = result_.distances[p] == 0.0f;
-        margin_pairs_ += overlaps ? 0 : 1;
         for (std::uint8_t* flag : {&margin_tets_[pair.object_a][pair.tet_a], &margin_tets_[pair.object_b][pair.tet_b]})
             *flag = overlaps ? 2 : std::max<std::uint8_t>(*flag, 1);
     }
