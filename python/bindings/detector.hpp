@@ -5,6 +5,8 @@
 #include <kdet/detector.hpp>
 #include <kdet/error.hpp>
 
+#include "scalars.hpp"
+
 #include <nanobind/nanobind.h>
 
 #include <cstdint>
@@ -29,6 +31,11 @@ inline ObjectId object_id(PyDetector& self, std::int64_t object) {
         throw Error("object id " + std::to_string(object) + " out of range (" +
                     std::to_string(self.detector.object_count()) + " objects)");
     return static_cast<ObjectId>(object);
+}
+
+/// The argument @p name as an object id (a TypeError for a value that is no int).
+inline ObjectId object_id(PyDetector& self, Arg<std::int64_t> object, const char* name = "object") {
+    return object_id(self, read_arg(object, name));
 }
 
 /// Calls @p f with the lock held and the GIL released.

@@ -26,7 +26,7 @@ std::uint32_t bits(std::int64_t value, const char* name) {
     return static_cast<std::uint32_t>(value);
 }
 
-void set_tets(PyDetector& self, std::int64_t object, nb::handle tets, nb::handle vertices) {
+void set_tets(PyDetector& self, Arg<std::int64_t> object, nb::handle tets, nb::handle vertices) {
     const ObjectId id = object_id(self, object);
     const TetIndices t = tet_indices(tets, "tets");
     if (vertices.is_none()) return locked(self, [&] { self.detector.set_tets(id, t.data, t.rows); });
@@ -42,9 +42,9 @@ void bind_filters(nb::class_<PyDetector>& detector) {
     detector
         .def(
             "set_collision_filter",
-            [](PyDetector& self, std::int64_t object, std::int64_t group, std::int64_t mask) {
+            [](PyDetector& self, Arg<std::int64_t> object, Arg<std::int64_t> group, Arg<std::int64_t> mask) {
                 const ObjectId id = object_id(self, object);
-                const std::uint32_t g = bits(group, "group"), k = bits(mask, "mask");
+                const std::uint32_t g = bits(read_arg(group, "group"), "group"), k = bits(read_arg(mask, "mask"), "mask");
                 locked(self, [&] { self.detector.set_collision_filter(id, g, k); });
             },
             "object"_a, "group"_a, "mask"_a,
@@ -53,28 +53,29 @@ void bind_filters(nb::class_<PyDetector>& detector) {
             "set. set_pair_collision() wins over the filters; self-collision is set_self_collision()'s alone.")
         .def(
             "collision_filter",
-            [](PyDetector& self, std::int64_t object) {
+            [](PyDetector& self, Arg<std::int64_t> object) {
                 const CollisionFilter f = self.detector.collision_filter(object_id(self, object));
                 return std::make_pair(f.group, f.mask);
             },
             "object"_a, "The object's (group, mask).")
         .def(
             "set_self_exclusion_rings",
-            [](PyDetector& self, std::int64_t object, int rings) {
+            [](PyDetector& self, Arg<std::int64_t> object, Arg<int> rings) {
                 const ObjectId id = object_id(self, object);
-                locked(self, [&] { self.detector.set_self_exclusion_rings(id, rings); });
+                const int n = read_arg(rings, "rings");
+                locked(self, [&] { self.detector.set_self_exclusion_rings(id, n); });
             },
             "object"_a, "rings"_a,
             "Within the object, also leaves out tets with vertices within `rings` mesh edges of each other (0, the "
             "default: only tets sharing a vertex); at most Detector.MAX_EXCLUSION_RINGS.")
         .def(
             "self_exclusion_rings",
-            [](PyDetector& self, std::int64_t object) { return self.detector.self_exclusion_rings(object_id(self, object)); },
+            [](PyDetector& self, Arg<std::int64_t> object) { return self.detector.self_exclusion_rings(object_id(self, object)); },
             "object"_a)
         .def(
             "exclude_rest_contacts",
-            [](PyDetector& self, std::int64_t object, std::optional<std::int64_t> other) {
-                const ObjectId a = object_id(self, object), b = other ? object_id(self, *other) : a;
+            [](PyDetector& self, Arg<std::int64_t> object, std::optional<Arg<std::int64_t>> other) {
+                const ObjectId a = object_id(self, object), b = other ? object_id(self, *other, "other") : a;
                 return locked(self, [&] { return self.detector.exclude_rest_contacts(a, b); });
             },
             "object"_a, "other"_a = nb::none(),
@@ -82,7 +83,7 @@ void bind_filters(nb::class_<PyDetector>& detector) {
             "reports them again; returns how many it recorded.")
         .def(
             "remove_object",
-            [](PyDetector& self, std::int64_t object) {
+            [](PyDetector& self, Arg<std::int64_t> object) {
                 const ObjectId id = object_id(self, object);
                 locked(self, [&] { self.detector.remove_object(id); });
             },
@@ -91,7 +92,7 @@ void bind_filters(nb::class_<PyDetector>& detector) {
             "FrameResult.colliding stays, empty.")
         .def(
             "set_tets",
-            [](PyDetector& self, std::int64_t object, const TetMesh& mesh) {
+            [](PyDetector& self, Arg<std::int64_t> object, const TetMesh& mesh) {
                 const ObjectId id = object_id(self, object);
                 locked(self, [&] { self.detector.set_tets(id, mesh); });
             },
@@ -101,7 +102,11 @@ void bind_filters(nb::class_<PyDetector>& detector) {
              "count may change). Results use the new numbering from the next detect(); the other objects keep "
              "their state.")
         .def(
-            "contains", [](PyDetector& self, std::int64_t object) { return object >= 0 && self.detector.contains(static_cast<ObjectId>(object)); },
+            "contains",
+            [](PyDetector& self, Arg<std::int64_t> object) {
+                const std::int64_t id = read_arg(object, "object");
+                return id >= 0 && self.detector.contains(static_cast<ObjectId>(id));
+            },
             "object"_a, "Whether the id names an object that was added and not removed.");
 }
 

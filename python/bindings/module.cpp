@@ -186,7 +186,8 @@ nb::object import_meshio(const char* what) {
     }
 }
 
-TetMesh from_meshio(nb::handle mesh, Flag allow_degenerate) {
+TetMesh from_meshio(nb::handle mesh, Arg<bool> allow_degenerate_arg) {
+    const bool allow_degenerate = read_arg(allow_degenerate_arg, "allow_degenerate");
     if (!nb::hasattr(mesh, "points") || !nb::hasattr(mesh, "cells"))
         throw nb::type_error(("mesh: expected a meshio.Mesh, got " + type_label(mesh)).c_str());
     nb::list tets;
@@ -294,7 +295,7 @@ void set_device_positions(PyDetector& self, ObjectId id, const Coordinates& c) {
 #endif
 }
 
-void set_positions(PyDetector& self, std::int64_t object, nb::handle positions) {
+void set_positions(PyDetector& self, Arg<std::int64_t> object, nb::handle positions) {
     const ObjectId id = object_id(self, object);
     const Coordinates c = coordinates(positions, "positions");
     if (c.on_device) return set_device_positions(self, id, c);
@@ -352,12 +353,12 @@ nb::object completed_frame(nb::handle handle, bool device_results, const FrameRe
     return nb::cast(device_frame.release(), nb::rv_policy::take_ownership);
 }
 
-nb::object detect(nb::handle handle, Flag device_results) {
-    return completed_frame(handle, device_results, &Detector::detect, "detect");
+nb::object detect(nb::handle handle, Arg<bool> device_results) {
+    return completed_frame(handle, read_arg(device_results, "device_results"), &Detector::detect, "detect");
 }
 
-nb::object finish(nb::handle handle, Flag device_results) {
-    return completed_frame(handle, device_results, &Detector::finish, "finish");
+nb::object finish(nb::handle handle, Arg<bool> device_results) {
+    return completed_frame(handle, read_arg(device_results, "device_results"), &Detector::finish, "finish");
 }
 
 nb::dict options_dict(const DetectorOptions& options) {
@@ -450,9 +451,9 @@ void bind_versioned_writer(nb::module_& m, const char* name, void (*write)(const
     m.def(
         name,
         [write, format_name, versions](const TetMesh& mesh, const std::filesystem::path& path, const std::string& version,
-                                       Flag binary) {
+                                       Arg<bool> binary) {
             Format format;
-            format.binary = binary;
+            format.binary = read_arg(binary, "binary");
             const auto known = std::find_if(versions.begin(), versions.end(), [&](const auto& v) { return version == v.first; });
             if (known == versions.end())
                 throw Error(std::string("version: ") + format_name + " '" + version + "' is not written (" + versions[1].first +
@@ -470,8 +471,9 @@ void bind_mesh(nb::module_& m) {
                         "of the mesh's own memory (no copies).")
         .def(
             "__init__",
-            [](TetMesh* self, nb::handle vertices, nb::handle tets, Flag allow_degenerate) {
-                new (self) TetMesh(mesh_from_arrays(vertices, tets, allow_degenerate, "vertices", "tets", "TetMesh"));
+            [](TetMesh* self, nb::handle vertices, nb::handle tets, Arg<bool> allow_degenerate) {
+                const bool degenerate = read_arg(allow_degenerate, "allow_degenerate");
+                new (self) TetMesh(mesh_from_arrays(vertices, tets, degenerate, "vertices", "tets", "TetMesh"));
             },
             "vertices"_a, "tets"_a, nb::kw_only(), "allow_degenerate"_a = false,
             "Copies and checks the arrays as the readers check files (finite coordinates, indices in range, "
@@ -500,18 +502,20 @@ void bind_mesh(nb::module_& m) {
 
     m.def(
         "read_tet_mesh",
-        [](const std::filesystem::path& path, Flag allow_degenerate) {
+        [](const std::filesystem::path& path, Arg<bool> allow_degenerate) {
+            const ReadOptions options{read_arg(allow_degenerate, "allow_degenerate")};
             nb::gil_scoped_release release;
-            return kdet::read_tet_mesh(path.string(), ReadOptions{allow_degenerate});
+            return kdet::read_tet_mesh(path.string(), options);
         },
         "path"_a, nb::kw_only(), "allow_degenerate"_a = false,
         "Reads a tet mesh, the format chosen by the extension: .mesh (MEDIT), .msh (Gmsh 2.2/4.1), .vtk (legacy VTK), "
         ".node/.ele or no extension (TetGen). Bad input raises kdet.Error naming the file and line.");
     m.def(
         "write_tet_mesh",
-        [](const TetMesh& mesh, const std::filesystem::path& path, Flag binary) {
+        [](const TetMesh& mesh, const std::filesystem::path& path, Arg<bool> binary) {
+            const WriteOptions options{read_arg(binary, "binary")};
             nb::gil_scoped_release release;
-            kdet::write_tet_mesh(mesh, path.string(), WriteOptions{binary});
+            kdet::write_tet_mesh(mesh, path.string(), options);
         },
         "mesh"_a, "path"_a, nb::kw_only(), "binary"_a = false,
         "Writes a tet mesh in the format its extension names (as read_tet_mesh reads it); binary applies to .msh "
@@ -560,8 +564,8 @@ void bind_mesh(nb::module_& m) {
         "file and line.");
     m.def(
         "validate_tet_mesh",
-        [](const TetMesh& mesh, const std::string& source, Flag allow_degenerate) {
-            kdet::validate_tet_mesh(mesh, source, ReadOptions{allow_degenerate});
+        [](const TetMesh& mesh, const std::string& source, Arg<bool> allow_degenerate) {
+            kdet::validate_tet_mesh(mesh, source, ReadOptions{read_arg(allow_degenerate, "allow_degenerate")});
         },
         "mesh"_a, "source"_a = "TetMesh", nb::kw_only(), "allow_degenerate"_a = false,
         "Checks a mesh as the readers check files (finite coordinates, indices in range, no zero-volume tets "
@@ -689,30 +693,33 @@ void bind_detector(nb::module_& m) {
              "the next detect(), which raises kdet.Error on a non-finite value and keeps the previous positions.")
         .def(
             "set_self_collision",
-            [](PyDetector& self, std::int64_t object, Flag enabled) {
+            [](PyDetector& self, Arg<std::int64_t> object, Arg<bool> enabled) {
                 const ObjectId id = object_id(self, object);
-                locked(self, [&] { self.detector.set_self_collision(id, enabled); });
+                const bool on = read_arg(enabled, "enabled");
+                locked(self, [&] { self.detector.set_self_collision(id, on); });
             },
             "object"_a, "enabled"_a = true, "Switches self-collision of one object (off by default).")
         .def(
             "set_pair_collision",
-            [](PyDetector& self, std::int64_t a, std::int64_t b, Flag enabled) {
-                const ObjectId ia = object_id(self, a), ib = object_id(self, b);
-                locked(self, [&] { self.detector.set_pair_collision(ia, ib, enabled); });
+            [](PyDetector& self, Arg<std::int64_t> a, Arg<std::int64_t> b, Arg<bool> enabled) {
+                const ObjectId ia = object_id(self, a, "a"), ib = object_id(self, b, "b");
+                const bool on = read_arg(enabled, "enabled");
+                locked(self, [&] { self.detector.set_pair_collision(ia, ib, on); });
             },
             "a"_a, "b"_a, "enabled"_a, "Switches collision between two different objects (on by default).")
         .def(
             "set_static",
-            [](PyDetector& self, std::int64_t object, Flag is_static) {
+            [](PyDetector& self, Arg<std::int64_t> object, Arg<bool> is_static) {
                 const ObjectId id = object_id(self, object);
-                locked(self, [&] { self.detector.set_static(id, is_static); });
+                const bool fixed = read_arg(is_static, "is_static");
+                locked(self, [&] { self.detector.set_static(id, fixed); });
             },
             "object"_a, "is_static"_a = true,
             "Marks an object static (placed once, kept across frames; set_positions places it again) or moving. "
             "Pairs of two static objects are never reported.")
         .def(
             "is_static",
-            [](PyDetector& self, std::int64_t object) {
+            [](PyDetector& self, Arg<std::int64_t> object) {
                 const ObjectId id = object_id(self, object);
                 return locked(self, [&] { return self.detector.is_static(id); });
             },
@@ -731,20 +738,21 @@ void bind_detector(nb::module_& m) {
              "the frame runs again) and returns what detect() returns.")
         .def(
             "locate",
-            [](nb::handle handle, nb::handle points, nb::handle object, nb::handle within, Flag device_results) {
+            [](nb::handle handle, nb::handle points, nb::handle object, nb::handle within, Arg<bool> device_results) {
                 PyDetector& self = nb::cast<PyDetector&>(handle);
-                return detector_locate(handle, self.detector, self.mutex, points, object, within, device_results);
+                return detector_locate(handle, self.detector, self.mutex, points, object, within,
+                                       read_arg(device_results, "device_results"));
             },
             "points"_a, "object"_a = nb::none(), "within"_a = nb::none(), "device_results"_a = false,
             "Point location in one object (or all: None) at the positions as last set: kdet.locate()'s LocateResult, "
             "points (n, 3) host or GPU arrays; device_results=True gives DLPack arrays of the detector's buffers.")
         .def(
             "first_tet",
-            [](PyDetector& self, std::int64_t object) { return self.detector.first_tet(object_id(self, object)); },
+            [](PyDetector& self, Arg<std::int64_t> object) { return self.detector.first_tet(object_id(self, object)); },
             "object"_a, "Global id of the object's first tet (see DeviceFrameResult).")
         .def(
             "tet_count",
-            [](PyDetector& self, std::int64_t object) { return self.detector.tet_count(object_id(self, object)); },
+            [](PyDetector& self, Arg<std::int64_t> object) { return self.detector.tet_count(object_id(self, object)); },
             "object"_a)
         .def_prop_ro("object_count", [](PyDetector& self) { return self.detector.object_count(); })
         .def_prop_ro(

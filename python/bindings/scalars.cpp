@@ -1,5 +1,9 @@
 #include "scalars.hpp"
 
+#include "arrays.hpp"
+
+#include <kdet/error.hpp>
+
 #include <nanobind/stl/string.h>
 
 #include <limits>
@@ -56,6 +60,30 @@ bool read_real(nb::handle value, double& out) {
         out = negative ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
     }
     return true;
+}
+
+bool read_arg(Arg<bool> arg, const char* name) {
+    bool out = false;
+    if (!read_bool(arg.value, out))
+        throw nb::type_error((std::string(name) + ": expected a bool, got " + type_label(arg.value)).c_str());
+    return out;
+}
+
+std::int64_t read_arg(Arg<std::int64_t> arg, const char* name) {
+    long long out = 0;
+    bool overflow = false;
+    if (!read_integer(arg.value, out, overflow))
+        throw nb::type_error((std::string(name) + ": expected an int, got " + type_label(arg.value)).c_str());
+    if (overflow)
+        throw Error(std::string(name) + ": " + nb::cast<std::string>(nb::str(arg.value)) + " is beyond a 64-bit integer");
+    return out;
+}
+
+int read_arg(Arg<int> arg, const char* name) {
+    const std::int64_t out = read_arg(Arg<std::int64_t>{arg.value}, name);
+    if (out < std::numeric_limits<int>::min() || out > std::numeric_limits<int>::max())
+        throw Error(std::string(name) + ": " + std::to_string(out) + " is beyond a 32-bit integer");
+    return static_cast<int>(out);
 }
 
 } // namespace kdet::python

@@ -6,6 +6,8 @@
 
 #include <nanobind/nanobind.h>
 
+#include <cstdint>
+
 namespace kdet::python {
 
 namespace nb = nanobind;
@@ -21,32 +23,35 @@ bool read_integer(nb::handle value, long long& out, bool& overflow);
 /// double reads as an infinity of its sign); false for any other type.
 bool read_real(nb::handle value, double& out);
 
-/// @brief A bool argument of a binding that also takes np.bool_ (nanobind's bool takes True and False
-/// alone); stubs and help() show it as bool.
-struct Flag {
-    bool value = false;
-    operator bool() const { return value; }
+/// @brief A bool or int argument that a binding reads itself with read_arg(): nanobind passes any value
+/// through, so that one of the wrong type gets a one-line TypeError naming the argument ("enabled:
+/// expected a bool, got int") rather than nanobind's list of every signature. A bool takes np.bool_,
+/// an int NumPy integers; stubs and help() show the type as @p T's.
+template <class T>
+struct Arg {
+    nb::handle value;
 };
+
+/// @brief The bool @p arg holds, or a TypeError naming @p name.
+bool read_arg(Arg<bool> arg, const char* name);
+
+/// @brief The int @p arg holds, or a TypeError naming @p name (a kdet.Error for one beyond 64 bits).
+std::int64_t read_arg(Arg<std::int64_t> arg, const char* name);
+
+/// @brief As the 64-bit read, with a kdet.Error naming @p name for a value beyond an int's range.
+int read_arg(Arg<int> arg, const char* name);
 
 } // namespace kdet::python
 
 namespace nanobind::detail {
 
-template <>
-struct type_caster<kdet::python::Flag> {
-    NB_TYPE_CASTER(kdet::python::Flag, const_name("bool"))
+template <class T>
+struct type_caster<kdet::python::Arg<T>> {
+    NB_TYPE_CASTER(kdet::python::Arg<T>, make_caster<T>::Name)
 
     bool from_python(handle src, uint8_t, cleanup_list*) noexcept {
-        // read_bool may import NumPy, which can raise; a failed read is a plain mismatch here.
-        try {
-            return kdet::python::read_bool(src, value.value);
-        } catch (...) {
-            PyErr_Clear();
-            return false;
-        }
-    }
-    static handle from_cpp(kdet::python::Flag flag, rv_policy, cleanup_list*) noexcept {
-        return handle(flag.value ? Py_True : Py_False).inc_ref();
+        value.value = src;
+        return true;
     }
 };
 

@@ -29,14 +29,16 @@ struct PyScene {
     std::unique_ptr<Scene> scene;
 };
 
-std::size_t object_of(const PyScene& self, std::int64_t object) {
+std::size_t object_of(const PyScene& self, Arg<std::int64_t> object_arg, const char* name = "object") {
+    const std::int64_t object = read_arg(object_arg, name);
     if (object < 0 || static_cast<std::uint64_t>(object) >= self.scene->num_objects())
         throw Error("scene " + self.scene->name() + ": object " + std::to_string(object) + " out of range (" +
                     std::to_string(self.scene->num_objects()) + " objects)");
     return static_cast<std::size_t>(object);
 }
 
-int frame_of(const PyScene& self, std::int64_t frame) {
+int frame_of(const PyScene& self, Arg<std::int64_t> frame_arg) {
+    const std::int64_t frame = read_arg(frame_arg, "frame");
     if (frame < 0 || frame >= self.scene->num_frames())
         throw Error("scene " + self.scene->name() + ": frame " + std::to_string(frame) + " out of range (" +
                     std::to_string(self.scene->num_frames()) + " frames)");
@@ -67,11 +69,11 @@ void bind_scenes(nb::module_& m) {
         .def_prop_ro("changes_tets", [](const PyScene& s) { return s.scene->changes_tets(); },
                      "Whether some object's tets change between frames (then use tets(object, frame)).")
         .def(
-            "rest_mesh", [](const PyScene& s, std::int64_t object) { return s.scene->rest_mesh(object_of(s, object)); },
+            "rest_mesh", [](const PyScene& s, Arg<std::int64_t> object) { return s.scene->rest_mesh(object_of(s, object)); },
             "object"_a, "A copy of the object's rest mesh: the tets and vertices it is added with.")
         .def(
             "positions",
-            [](const PyScene& s, std::int64_t object, std::int64_t frame) {
+            [](const PyScene& s, Arg<std::int64_t> object, Arg<std::int64_t> frame) {
                 std::vector<float> xyz;
                 s.scene->positions(object_of(s, object), frame_of(s, frame), xyz);
                 return owned_rows<float, 3>(std::move(xyz));
@@ -79,25 +81,27 @@ void bind_scenes(nb::module_& m) {
             "object"_a, "frame"_a, "The object's vertex positions at the frame, (n, 3) float32.")
         .def(
             "tets",
-            [](const PyScene& s, std::int64_t object, std::int64_t frame) {
+            [](const PyScene& s, Arg<std::int64_t> object, Arg<std::int64_t> frame) {
                 std::vector<std::uint32_t> tets;
                 s.scene->tets(object_of(s, object), frame_of(s, frame), tets);
                 return owned_rows<std::uint32_t, 4>(std::move(tets));
             },
             "object"_a, "frame"_a, "The object's tets at the frame, (m, 4) uint32 into the rest mesh's vertices.")
         .def(
-            "is_static", [](const PyScene& s, std::int64_t object) { return s.scene->is_static(object_of(s, object)); },
+            "is_static", [](const PyScene& s, Arg<std::int64_t> object) { return s.scene->is_static(object_of(s, object)); },
             "object"_a, "Whether the object never moves (added static, its positions given once).")
         .def(
-            "checks_self", [](const PyScene& s, std::int64_t object) { return s.scene->checks_self(object_of(s, object)); },
+            "checks_self", [](const PyScene& s, Arg<std::int64_t> object) { return s.scene->checks_self(object_of(s, object)); },
             "object"_a)
         .def(
             "checks_pair",
-            [](const PyScene& s, std::int64_t a, std::int64_t b) { return s.scene->checks_pair(object_of(s, a), object_of(s, b)); },
+            [](const PyScene& s, Arg<std::int64_t> a, Arg<std::int64_t> b) {
+                return s.scene->checks_pair(object_of(s, a, "a"), object_of(s, b, "b"));
+            },
             "a"_a, "b"_a, "Whether the scene checks collisions between objects a and b.")
         .def(
             "collision_filter",
-            [](const PyScene& s, std::int64_t object) {
+            [](const PyScene& s, Arg<std::int64_t> object) {
                 const CollisionFilter f = s.scene->collision_filter(object_of(s, object));
                 return std::make_pair(f.group, f.mask);
             },
@@ -109,7 +113,9 @@ void bind_scenes(nb::module_& m) {
 
     m.def(
         "open_scene",
-        [](const std::filesystem::path& name, int resolution, std::int64_t tets, int frames) {
+        [](const std::filesystem::path& name, Arg<int> resolution_arg, Arg<std::int64_t> tets_arg, Arg<int> frames_arg) {
+            const int resolution = read_arg(resolution_arg, "resolution"), frames = read_arg(frames_arg, "frames");
+            const std::int64_t tets = read_arg(tets_arg, "tets");
             if (tets < 0) throw Error("tets: " + std::to_string(tets) + " is negative");
             SceneRequest request;
             request.resolution = resolution;
@@ -125,7 +131,8 @@ void bind_scenes(nb::module_& m) {
     m.def("scene_names", &scene_names, "The scene names open_scene() knows.");
     m.def(
         "add_scene_objects",
-        [](PyDetector& detector, const PyScene& s, Flag self) {
+        [](PyDetector& detector, const PyScene& s, Arg<bool> self_collision) {
+            const bool self = read_arg(self_collision, "self_collision");
             locked(detector, [&] { add_scene_objects(detector.detector, *s.scene, self); });
         },
         "detector"_a, "scene"_a, "self_collision"_a = false,

@@ -215,6 +215,43 @@ def test_numpys_scalars_are_read_as_pythons(octopus):
         detector.locate(octopus.vertices[:3], within=np.True_)
 
 
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda d: d.set_static(0, 0), r"is_static: expected a bool, got int"),
+        (lambda d: d.set_self_collision(0, "yes"), r"enabled: expected a bool, got str"),
+        (lambda d: d.set_pair_collision(0, 1.0, True), r"b: expected an int, got float"),
+        (lambda d: d.set_collision_filter(0, 1.0, 1), r"group: expected an int, got float"),
+        (lambda d: d.set_self_exclusion_rings(0, "2"), r"rings: expected an int, got str"),
+        (lambda d: d.exclude_rest_contacts(0, "1"), r"other: expected an int, got str"),
+        (lambda d: d.set_positions(np.float64(0), np.zeros((3, 3))), r"object: expected an int, got numpy\.float64"),
+        (lambda d: d.is_static(True), r"object: expected an int, got bool"),
+        (lambda d: d.detect(device_results=1), r"device_results: expected a bool, got int"),
+        (lambda d: d.locate(np.zeros((1, 3)), device_results="no"), r"device_results: expected a bool, got str"),
+        (lambda d: kdet.add_scene_objects(d, kdet.open_scene("procedural", tets=200, frames=2), 1),
+         r"self_collision: expected a bool, got int"),
+        (lambda d: kdet.open_scene("procedural", frames=2.5), r"frames: expected an int, got float"),
+    ],
+)
+def test_a_wrong_type_is_one_line_naming_the_argument(octopus, call, message):
+    # nanobind's own mismatch lists every signature over several lines; kdet reads its scalars itself
+    # (None is still nanobind's to refuse, before any reading).
+    detector = kdet.Detector()
+    detector.add_object(octopus)
+    detector.add_object(octopus)
+    with pytest.raises(TypeError, match=f"^{message}$"):
+        call(detector)
+
+
+def test_an_int_beyond_64_bits_is_refused_naming_the_argument(octopus):
+    detector = kdet.Detector()
+    detector.add_object(octopus)
+    with pytest.raises(kdet.Error, match=r"^object: 18446744073709551616 is beyond a 64-bit integer$"):
+        detector.set_positions(2**64, octopus.vertices)
+    with pytest.raises(kdet.Error, match=r"^rings: 4294967296 is beyond a 32-bit integer$"):
+        detector.set_self_exclusion_rings(0, 2**32)
+
+
 def pairs_with(a: kdet.TetMesh, b_vertices, b_tets) -> np.ndarray:
     detector = kdet.Detector()
     detector.add_object(a)
