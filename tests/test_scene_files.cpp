@@ -258,6 +258,63 @@ TEST(RecordedScene, BinaryRecordingPlaysBackExactly) {
 }
 
 
+TEST(RecordedScene, StaticObjectsAndCollisionFiltersAreRecorded) {
+    // heap: a static floor and boxes in collision groups; the recording must play back as the scene.
+    const fs::path dir = fresh_dir("recorded-heap");
+    const auto heap = open_scene("heap");
+    const std::string path = (dir / "heap.kdetrec").string();
+    write_recording(*heap, path);
+    const auto played = open_scene(path);
+    ASSERT_EQ(played->num_objects(), heap->num_objects());
+    std::size_t static_objects = 0, filtered = 0;
+    for (std::size_t o = 0; o < heap->num_objects(); ++o) {
+        EXPECT_EQ(played->is_static(o), heap->is_static(o)) << o;
+        EXPECT_EQ(played->checks_self(o), heap->checks_self(o)) << o;
+        const CollisionFilter want = heap->collision_filter(o), got = played->collision_filter(o);
+        EXPECT_EQ(got.group, want.group) << o;
+        EXPECT_EQ(got.mask, want.mask) << o;
+        static_objects += heap->is_static(o);
+        filtered += want.group != CollisionFilter{}.group;
+        for (std::size_t b = 0; b < heap->num_objects(); ++b) ASSERT_EQ(played->checks_pair(o, b), heap->checks_pair(o, b));
+    }
+    EXPECT_EQ(static_objects, 1u);
+    EXPECT_GT(filtered, 100u);
+    std::vector<float> a, b;
+    for (int f : {0, 57, heap->num_frames() - 1})
+        for (std::size_t o : {std::size_t{0}, std::size_t{1}, heap->num_objects() - 1}) {
+            heap->positions(o, f, a);
+            played->positions(o, f, b);
+            EXPECT_EQ(a, b) << "object " << o << " frame " << f;
+        }
+    // The layout of docs/scenes.md, the static floor's positions stored once, not per frame.
+    std::size_t bytes = 16 + 4, moving_floats = 0;
+    for (std::size_t o = 0; o < heap->num_objects(); ++o) {
+        bytes += 4 + 4 + 1 + 8 + 16 * heap->rest_mesh(o).num_tets();
+        const std::size_t floats = 3 * heap->rest_mesh(o).num_vertices();
+        if (heap->is_static(o)) bytes += 4 * floats;
+        else moving_floats += floats;
+        for (std::size_t other = o + 1; other < heap->num_objects(); ++other) bytes += heap->checks_pair(o, other) ? 8 : 0;
+    }
+    EXPECT_EQ(fs::file_size(path), bytes + 4 * moving_floats * static_cast<std::size_t>(heap->num_frames()));
+    // Unknown flags are refused where they stand.
+    {
+        std::fstream edit(path, std::ios::in | std::ios::out | std::ios::binary);
+        edit.seekp(24); // object 0: after the magic, the two counts and its vertex and tet counts
+        edit.put(static_cast<char>(4));
+    }
+    EXPECT_EQ(recording_error(path), path + ": byte 24: object 0: unknown flags 4 (1: self-collision, 2: static)");
+    fs::remove_all(dir);
+}
+
+TEST(RecordedScene, ASceneWhoseTetsChangeIsNotRecorded) {
+    const fs::path dir = fresh_dir("recorded-tearing");
+    const std::string path = (dir / "tearing.kdetrec").string();
+    EXPECT_EQ(error_message([&] { write_recording(*open_scene("tearing"), path); }),
+              path + ": scene tearing changes its tets from frame to frame, which a recording does not hold");
+    EXPECT_FALSE(fs::exists(path));
+    fs::remove_all(dir);
+}
+
 TEST(RecordedScene, CountsTheFileCannotHoldAreRefusedBeforeAnythingIsReserved) {
     // Without the check against the file's size, these counts reserve 64 GB for the tets, 103 GB for
     // the positions: std::bad_alloc (no file named) or the machine's memory, not this message.

@@ -130,6 +130,16 @@ void bind_scenes(nb::module_& m) {
         "`kdet prepare` made.");
     m.def("scene_names", &scene_names, "The scene names open_scene() knows.");
     m.def(
+        "write_recording",
+        [](const PyScene& s, const std::filesystem::path& path) {
+            nb::gil_scoped_release release;
+            kdet::write_recording(*s.scene, path.string());
+        },
+        "scene"_a, "path"_a,
+        "Records every frame of a scene into a .kdetrec file (docs/scenes.md), with its self-collision, checked "
+        "pairs, collision filters and static objects; open_scene(path) plays it back. A scene whose tets change "
+        "(changes_tets) raises kdet.Error.");
+    m.def(
         "add_scene_objects",
         [](PyDetector& detector, const PyScene& s, Arg<bool> self_collision) {
             const bool self = read_arg(self_collision, "self_collision");

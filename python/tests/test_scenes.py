@@ -95,6 +95,23 @@ def test_heap_filters_equal_brute_force_with_the_same_filters():
     np.testing.assert_array_equal(filtered, every[~same_layer])
 
 
+def test_a_recorded_heap_plays_back_as_the_heap(tmp_path):
+    heap = kdet.open_scene("heap")
+    kdet.write_recording(heap, tmp_path / "heap.kdetrec")
+    played = kdet.open_scene(tmp_path / "heap.kdetrec")
+    assert played.name == "heap" and played.num_frames == heap.num_frames
+    for o in range(heap.num_objects):
+        assert played.is_static(o) == heap.is_static(o)
+        assert played.collision_filter(o) == heap.collision_filter(o)
+    last = heap.num_frames - 1
+    (_, recorded), = list(kdet.run_scene(played, first_frame=last))
+    (_, built), = list(kdet.run_scene(heap, first_frame=last))
+    assert len(built.pairs) > 0
+    np.testing.assert_array_equal(recorded.pairs, built.pairs)
+    with pytest.raises(kdet.Error, match="scene tearing changes its tets from frame to frame"):
+        kdet.write_recording(kdet.open_scene("tearing"), tmp_path / "tearing.kdetrec")
+
+
 def test_scene_bad_input():
     scene = kdet.open_scene("tearing")
     with pytest.raises(kdet.Error, match=r"^scene tearing: object 5 out of range \(2 objects\)$"):

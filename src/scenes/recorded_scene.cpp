@@ -23,7 +23,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr char kMagic[8] = {'K', 'D', 'E', 'T', 'R', 'E', 'C', '1'};
+/// Recordings start with "KDETREC" and their version: 1 without static objects and filters, 2 with.
+constexpr char kMagic[7] = {'K', 'D', 'E', 'T', 'R', 'E', 'C'};
+constexpr unsigned char flag_self = 1, flag_static = 2;
 
 void check_frame(const std::string& scene, int frame, int frames) {
     if (frame < 0 || frame >= frames)
@@ -229,6 +231,10 @@ public:
         return std::find(pairs_.begin(), pairs_.end(), pair) != pairs_.end();
     }
     bool checks_self(std::size_t object) const override { return object < self_.size() && self_[object]; }
+    bool is_static(std::size_t object) const override { return object < static_.size() && static_[object]; }
+    CollisionFilter collision_filter(std::size_t object) const override {
+        return object < filters_.size() ? filters_[object] : CollisionFilter{};
+    }
 
 private:
     /// @brief Fails naming @p what when the file ends before @p offset + @p size, before anything is
@@ -257,8 +263,10 @@ private:
 
     void read_header() {
         std::uint64_t at = 0;
-        if (std::memcmp(read_at(0, 8, "the header").data(), kMagic, 8) != 0)
-            throw Error(path_ + ": byte 0: not a kdet recording (it starts with KDETREC1)");
+        const std::vector<unsigned char> magic = read_at(0, 8, "the header");
+        if (std::memcmp(magic.data(), kMagic, 7) != 0 || (magic[7] != '1' && magic[7] != '2'))
+            throw Error(path_ + ": byte 0: not a kdet recording (it starts with KDETREC1 or KDETREC2)");
+        const int version = magic[7] - '0';
         at = 8;
         const std::uint32_t objects = read_u32(at, "the header");
         frames_ = static_cast<int>(std::min<std::uint32_t>(read_u32(at, "the header"), INT32_MAX));
@@ -268,15 +276,26 @@ private:
             const std::string what = "object " + std::to_string(o);
             TetMesh mesh;
             const std::uint32_t vertices = read_u32(at, what), tets = read_u32(at, what);
-            self_.push_back(read_at(at, 1, what)[0] != 0);
+            const unsigned char flags = read_at(at, 1, what)[0];
+            if (version >= 2 && (flags & ~(flag_self | flag_static)) != 0)
+                throw Error(path_ + ": byte " + std::to_string(at) + ": " + what + ": unknown flags " + std::to_string(flags) +
+                            " (1: self-collision, 2: static)");
             at += 1;
+            self_.push_back(version >= 2 ? (flags & flag_self) != 0 : flags != 0);
+            static_.push_back(version >= 2 && (flags & flag_static) != 0);
+            CollisionFilter filter;
+            if (version >= 2) {
+                filter.group = read_u32(at, what);
+                filter.mask = read_u32(at, what);
+            }
+            filters_.push_back(filter);
             const std::vector<unsigned char> bytes = read_at(at, 16ull * tets, "the tets of " + what);
             at += 16ull * tets;
             mesh.tets.resize(4ull * tets);
             for (std::size_t i = 0; i < mesh.tets.size(); ++i) mesh.tets[i] = get_u32(&bytes[4 * i]);
             vertex_counts_.push_back(vertices);
-            object_offset_.push_back(frame_bytes_);
-            frame_bytes_ += 12ull * vertices;
+            object_offset_.push_back(static_.back() ? 0 : frame_bytes_);
+            if (!static_.back()) frame_bytes_ += 12ull * vertices;
             meshes_.push_back(std::move(mesh));
         }
         const std::uint32_t pairs = read_u32(at, "the pairs");
@@ -287,6 +306,13 @@ private:
                             " " + std::to_string(b));
             pairs_.emplace_back(std::min<std::size_t>(a, b), std::max<std::size_t>(a, b));
         }
+        // A static object's positions, once, in object order, before the frames.
+        for (std::size_t o = 0; o < meshes_.size(); ++o)
+            if (static_[o]) {
+                object_offset_[o] = at;
+                check_extent(at, 12ull * vertex_counts_[o], "the positions of static object " + std::to_string(o));
+                at += 12ull * vertex_counts_[o];
+            }
         data_offset_ = at;
         // The last frame must be there too: a cut-off file fails now, not half-way through a run.
         const std::uint64_t data_bytes = file_size_ - std::min(file_size_, data_offset_);
@@ -309,9 +335,10 @@ private:
         if (object >= meshes_.size()) throw Error("scene " + name_ + " has no object " + std::to_string(object));
         check_frame(name_, frame, frames_);
         const std::size_t count = 3 * static_cast<std::size_t>(vertex_counts_[object]);
-        const std::vector<unsigned char> bytes =
-            read_at(data_offset_ + frame_bytes_ * static_cast<std::uint64_t>(frame) + object_offset_[object], 4 * count,
-                    "frame " + std::to_string(frame));
+        const std::uint64_t offset =
+            static_[object] ? object_offset_[object]
+                            : data_offset_ + frame_bytes_ * static_cast<std::uint64_t>(frame) + object_offset_[object];
+        const std::vector<unsigned char> bytes = read_at(offset, 4 * count, "frame " + std::to_string(frame));
         out.resize(count);
         for (std::size_t i = 0; i < count; ++i) {
             const std::uint32_t bits = get_u32(&bytes[4 * i]);
@@ -326,9 +353,12 @@ private:
     int fd_ = -1;
     int frames_ = 0;
     std::vector<TetMesh> meshes_;
-    std::vector<bool> self_;
+    std::vector<bool> self_, static_;
+    std::vector<CollisionFilter> filters_;
     std::vector<std::pair<std::size_t, std::size_t>> pairs_;
-    std::vector<std::uint64_t> vertex_counts_, object_offset_;
+    std::vector<std::uint64_t> vertex_counts_;
+    std::vector<std::uint64_t> object_offset_; ///< in a frame's bytes; a static object's in the file
+
     std::uint64_t frame_bytes_ = 0, data_offset_ = 0, file_size_ = 0;
 };
 
@@ -339,16 +369,22 @@ std::unique_ptr<Scene> read_frame_folder(const std::string& path) { return std::
 std::unique_ptr<Scene> read_recording(const std::string& path) { return std::make_unique<RecordingScene>(path); }
 
 void write_recording(const Scene& scene, const std::string& path) {
+    if (scene.changes_tets())
+        throw Error(path + ": scene " + scene.name() + " changes its tets from frame to frame, which a recording does not hold");
     std::ofstream out(path, std::ios::binary);
     if (!out) throw Error(path + ": cannot create file");
-    out.write(kMagic, 8);
+    out.write(kMagic, 7);
+    out.put('2');
     put_u32(out, narrow(scene.num_objects(), "object count"));
     put_u32(out, narrow(static_cast<std::size_t>(scene.num_frames()), "frame count"));
     for (std::size_t o = 0; o < scene.num_objects(); ++o) {
         const TetMesh& mesh = scene.rest_mesh(o);
         put_u32(out, narrow(mesh.num_vertices(), "vertex count"));
         put_u32(out, narrow(mesh.num_tets(), "tet count"));
-        out.put(scene.checks_self(o) ? 1 : 0);
+        out.put(static_cast<char>((scene.checks_self(o) ? flag_self : 0) | (scene.is_static(o) ? flag_static : 0)));
+        const CollisionFilter filter = scene.collision_filter(o);
+        put_u32(out, filter.group);
+        put_u32(out, filter.mask);
         for (const std::uint32_t index : mesh.tets) put_u32(out, index);
     }
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
@@ -361,16 +397,19 @@ void write_recording(const Scene& scene, const std::string& path) {
         put_u32(out, b);
     }
     std::vector<float> positions;
-    for (int f = 0; f < scene.num_frames(); ++f) {
-        for (std::size_t o = 0; o < scene.num_objects(); ++o) {
-            scene.positions(o, f, positions);
-            for (const float x : positions) {
-                std::uint32_t bits;
-                std::memcpy(&bits, &x, 4);
-                put_u32(out, bits);
-            }
+    const auto put_positions = [&](std::size_t object, int frame) {
+        scene.positions(object, frame, positions);
+        for (const float x : positions) {
+            std::uint32_t bits;
+            std::memcpy(&bits, &x, 4);
+            put_u32(out, bits);
         }
-    }
+    };
+    for (std::size_t o = 0; o < scene.num_objects(); ++o)
+        if (scene.is_static(o)) put_positions(o, 0);
+    for (int f = 0; f < scene.num_frames(); ++f)
+        for (std::size_t o = 0; o < scene.num_objects(); ++o)
+            if (!scene.is_static(o)) put_positions(o, f);
     if (!out.flush()) throw Error(path + ": cannot write file");
 }
 

@@ -66,6 +66,7 @@ from ._kdet import (
     validate_tet_mesh,
     version,
     write_gmsh,
+    write_recording,
     write_tet_mesh,
     write_vtk,
 )
@@ -103,6 +104,7 @@ __all__ = [
     "validate_tet_mesh",
     "version",
     "write_gmsh",
+    "write_recording",
     "write_tet_mesh",
     "write_vtk",
 ]

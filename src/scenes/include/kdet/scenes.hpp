@@ -189,11 +189,14 @@ std::unique_ptr<Scene> read_scene_file(const std::string& path, const SceneReque
 std::unique_ptr<Scene> read_frame_folder(const std::string& path);
 
 /// @brief Plays back a recording in kdet's binary format (.kdetrec, see docs/scenes.md): the tets of
-/// each object once, then float32 positions per frame, read frame by frame from the file.
+/// each object once, then float32 positions per frame, read frame by frame from the file. Reads
+/// KDETREC2 and the older KDETREC1 (no static objects or collision filters).
 std::unique_ptr<Scene> read_recording(const std::string& path);
 
-/// @brief Records every frame of @p scene into @p path in the .kdetrec format, with its collision
-/// settings; positions are stored as float32, as the detector uses them.
+/// @brief Records every frame of @p scene into @p path in the .kdetrec format (KDETREC2), with its
+/// collision settings: self-collision, checked pairs, collision filters and static objects (whose
+/// positions are stored once). Positions are stored as float32, as the detector uses them. Throws for a
+/// scene whose tets change (Scene::changes_tets), which a recording cannot hold.
 void write_recording(const Scene& scene, const std::string& path);
 
 /// @brief Bends a straight bar so that, for angles above 2*pi, its two ends pass through each other.
