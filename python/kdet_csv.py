@@ -55,7 +55,7 @@ class BenchFile:
 
     @property
     def self_collisions(self) -> bool:
-        return self.header.get("self collisions", "no") == "yes"
+        return self.header.get("self collisions", "no") != "no"  # "yes", or "scene": the objects it marks
 
     @property
     def total_tets(self) -> int:

@@ -42,7 +42,7 @@ STAGES = [
     ("narrow phase time", "narrow phase"),
 ]
 # Parameters that tell apart two files of the same method in one figure.
-DISTINGUISHING_KEYS = ["overlap test", "hashing algorithm", "block size", "threads", "backend", "first frame", "#frames"]
+DISTINGUISHING_KEYS = ["self collisions", "overlap test", "hashing algorithm", "block size", "threads", "backend", "first frame", "#frames"]
 
 
 def series_label(bench: BenchFile, others: list[BenchFile]) -> str:

@@ -41,14 +41,14 @@ std::string settings(const BenchConfig& c) {
     std::ostringstream out;
     out << c.scene << " r" << c.request.resolution << " " << bench_method_name(c.options.method) << " "
         << to_string(c.options.narrow_phase) << " g" << c.options.block_size << " n" << c.runs << " self "
-        << c.self << " " << to_string(c.options.hash) << " " << c.output_dir << " " << to_string(c.options.backend)
+        << to_string(c.self) << " " << to_string(c.options.hash) << " " << c.output_dir << " " << to_string(c.options.backend)
         << " threads " << c.options.threads << " buckets " << c.options.bucket_capacity << " frames " << c.first_frame << ":" << c.last_frame << " quiet "
         << c.quiet << " help " << c.help << " procedural flag '" << c.procedural_flag << "'";
     return out.str();
 }
 
 TEST(BenchArgs, DefaultsAreTheThesiss) {
-    EXPECT_EQ(settings(parse_words({})), "procedural r1 kdet sat g128 n10 self 0 djb2 exports/benchmark_data cpu "
+    EXPECT_EQ(settings(parse_words({})), "procedural r1 kdet sat g128 n10 self no djb2 exports/benchmark_data cpu "
                                          "threads 0 buckets 0 frames 0:-1 quiet 0 help 0 procedural flag ''");
 }
 
@@ -56,7 +56,7 @@ TEST(BenchArgs, EveryFlagInAnyOrder) {
     const BenchConfig c = parse_words({"-r", "3", "-c", "gpu_no_loop", "-o", "sat_mtv", "-g", "64", "armadillos", "-n",
                                        "20", "-s", "y", "-h", "fnv-1a", "-d", "out/x", "--backend", "cuda", "--threads",
                                        "4", "--frames", "5:9", "--quiet", "--help", "--bucket-capacity", "32"});
-    EXPECT_EQ(settings(c), "armadillos r3 gpu_no_loop sat_mtv g64 n20 self 1 fnv-1a out/x cuda threads 4 buckets 32 frames 5:9 "
+    EXPECT_EQ(settings(c), "armadillos r3 gpu_no_loop sat_mtv g64 n20 self yes fnv-1a out/x cuda threads 4 buckets 32 frames 5:9 "
                            "quiet 1 help 1 procedural flag ''");
 }
 
@@ -79,8 +79,9 @@ TEST(BenchArgs, EveryAcceptedValue) {
     for (const auto& [name, test] : tests) EXPECT_EQ(parse_words({"-o", name}).options.narrow_phase, test) << name;
     for (int g : {16, 32, 64, 128, 256}) EXPECT_EQ(parse_words({"-g", std::to_string(g)}).options.block_size, g);
     for (int n : {1, 7, 20}) EXPECT_EQ(parse_words({"-n", std::to_string(n)}).runs, n);
-    for (const char* yes : {"yes", "y"}) EXPECT_TRUE(parse_words({"-s", yes}).self);
-    for (const char* no : {"no", "n"}) EXPECT_FALSE(parse_words({"-s", no}).self);
+    for (const char* yes : {"yes", "y"}) EXPECT_EQ(parse_words({"-s", yes}).self, SceneSelfCollision::every);
+    for (const char* no : {"no", "n"}) EXPECT_EQ(parse_words({"-s", no}).self, SceneSelfCollision::none);
+    EXPECT_EQ(parse_words({"-s", "scene"}).self, SceneSelfCollision::marked);
     const std::pair<const char*, HashFunction> hashes[] = {{"djb2", HashFunction::djb2},
                                                            {"fnv-1a", HashFunction::fnv1a},
                                                            {"morton", HashFunction::morton},
@@ -97,7 +98,7 @@ TEST(BenchArgs, TheThesissExampleCommandRunsUnchanged) {
     // Appendix A.1.3: benchmark_tet buddha_and_armadillo -r 2 -n 5 -c gpu_no_loop -o sat-mtv -d DIR
     const BenchConfig c = parse_words({"buddha_and_armadillo", "-r", "2", "-n", "5", "-c", "gpu_no_loop", "-o", "sat-mtv",
                                        "-d", "./../../exports/benchmark_data"});
-    EXPECT_EQ(settings(c), "buddha_and_armadillo r2 gpu_no_loop sat_mtv g128 n5 self 0 djb2 ./../../exports/benchmark_data "
+    EXPECT_EQ(settings(c), "buddha_and_armadillo r2 gpu_no_loop sat_mtv g128 n5 self no djb2 ./../../exports/benchmark_data "
                            "cpu threads 0 buckets 0 frames 0:-1 quiet 0 help 0 procedural flag ''");
     EXPECT_EQ(parse_words({"-c", "Brute-Force-Pairs", "-h", "FNV_1A", "--backend", "CPU"}).options.method,
               Method::brute_force_pairs);
@@ -133,7 +134,7 @@ TEST(BenchArgs, EveryMistakeIsOneLineNamingTheFlagAndWhatItAccepts) {
         {{"-g", "100"}, "invalid value '100' for -g: expected 16, 32, 64, 128 or 256"},
         {{"-n", "0"}, "invalid value '0' for -n: expected an integer in [1, 20]"},
         {{"-n", "21"}, "invalid value '21' for -n: expected an integer in [1, 20]"},
-        {{"-s", "maybe"}, "invalid value 'maybe' for -s: expected yes, y, no or n"},
+        {{"-s", "maybe"}, "invalid value 'maybe' for -s: expected yes, y, no, n or scene"},
         {{"-h", "md5"}, "invalid value 'md5' for -h: expected djb2, fnv-1a, simple or morton"},
         {{"-d", ""}, "invalid value '' for -d: expected a folder"},
         {{"--backend", "gpu"}, "invalid value 'gpu' for --backend: expected cpu or cuda"},
@@ -304,7 +305,7 @@ TEST(BenchRunner, HeaderFieldsAndFrameRange) {
     config.runs = 2;
     config.first_frame = 1;
     config.last_frame = 3;
-    config.self = true;
+    config.self = SceneSelfCollision::every;
     const auto scene = open_scene("procedural", config.request);
     std::vector<std::pair<int, int>> reported;
     const BenchProgress progress = [&](int run, int frame_index) {
@@ -405,7 +406,7 @@ TEST(BenchRunner, RingsAndFiltersFlags) {
     config = BenchConfig{};
     config.runs = 1;
     config.first_frame = config.last_frame = 119;
-    config.self = true;
+    config.self = SceneSelfCollision::every;
     const auto drape = open_scene("drape");
     const BenchOutcome plain = run_benchmark(config, *drape, [](int, int) { return true; });
     config.rings = 2;

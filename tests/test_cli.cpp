@@ -294,7 +294,7 @@ TEST(Cli, MistakesGiveOneLineNamingTheProblemAndANonZeroExit) {
         {"collide BAD --self", 1, "bad.mesh:6: "},
         {"collide BUNNY BUNNY --hash md5", 2, "invalid value 'md5' for --hash"},
         {"bench -c nope", 2, "invalid value 'nope' for -c: expected kdet, kdet_no_pairs, brute_force_loop or brute_force_pairs"},
-        {"bench -s maybe", 2, "invalid value 'maybe' for -s: expected yes, y, no or n"},
+        {"bench -s maybe", 2, "invalid value 'maybe' for -s: expected yes, y, no, n or scene"},
         {"bench -r 5", 2, "invalid value '5' for -r"},
         {"bench -o sat+mtv", 2, "invalid value 'sat+mtv' for -o"},
         {"bench -g 100", 2, "invalid value '100' for -g"},

@@ -141,7 +141,7 @@ TEST(OptionTable, KdetBenchTakesTheThesissExampleCommandUnchanged) {
     EXPECT_EQ(c.options.method, Method::brute_force_pairs);
     EXPECT_EQ(c.options.narrow_phase, NarrowPhase::sat_mtv);
     EXPECT_EQ(c.output_dir, "exports/benchmark_data");
-    EXPECT_FALSE(c.self);
+    EXPECT_EQ(c.self, SceneSelfCollision::none);
 }
 
 #ifdef KDET_CLI_PATH

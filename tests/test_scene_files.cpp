@@ -141,6 +141,42 @@ self left
     return dir / "boxes.scene";
 }
 
+TEST(SceneFile, SelfCollisionOfTheMarkedObjectsOnly) {
+    // One mesh of two overlapping boxes (vertices apart: they self-collide), twice, far apart; the file
+    // marks the first. SceneSelfCollision::marked (`-s scene`) checks it alone.
+    const fs::path dir = fresh_dir("marked-self");
+    TetMesh doubled = make_box_mesh(4, 2, 2, 0.1);
+    const TetMesh second = make_box_mesh(4, 2, 2, 0.1);
+    const auto offset = static_cast<std::uint32_t>(doubled.num_vertices());
+    for (std::size_t i = 0; i < second.positions.size(); ++i) doubled.positions.push_back(second.positions[i] + 0.03);
+    for (const std::uint32_t v : second.tets) doubled.tets.push_back(v + offset);
+    write_tetgen(doubled, (dir / "doubled").string());
+    std::ofstream(dir / "marked.scene") << "kdet-scene 1\nframes 1\nobject a\n  file doubled.node\nobject b\n"
+                                           "  file doubled.node\n  translate 5 0 0\nself a\n";
+    const auto scene = open_scene((dir / "marked.scene").string());
+    const auto pairs_with = [&](SceneSelfCollision self) {
+        Detector detector;
+        add_scene_objects(detector, *scene, self);
+        std::vector<float> xyz;
+        for (std::size_t o = 0; o < 2; ++o) {
+            scene->positions(o, 0, xyz);
+            detector.set_positions(static_cast<ObjectId>(o), xyz.data(), xyz.size() / 3);
+        }
+        return detector.detect().pairs;
+    };
+    const std::vector<TetPair> marked = pairs_with(SceneSelfCollision::marked), every = pairs_with(SceneSelfCollision::every);
+    EXPECT_TRUE(pairs_with(SceneSelfCollision::none).empty());
+    ASSERT_FALSE(marked.empty());
+    for (const TetPair& p : marked) EXPECT_TRUE(p.object_a == 0 && p.object_b == 0);
+    std::vector<TetPair> every_in_a, every_in_b;
+    for (const TetPair& p : every) (p.object_a == 0 ? every_in_a : every_in_b).push_back(p);
+    EXPECT_EQ(every_in_a, marked);
+    EXPECT_FALSE(every_in_b.empty());
+    for (const TetPair& p : every_in_b) EXPECT_TRUE(p.object_a == 1 && p.object_b == 1);
+    EXPECT_STREQ(to_string(SceneSelfCollision::marked), "scene");
+    fs::remove_all(dir);
+}
+
 TEST(SceneFile, PlaysBackDeterministicallyAndMovesEveryVertex) {
     const fs::path dir = fresh_dir("boxes");
     const fs::path path = write_box_scene(dir);

@@ -47,14 +47,15 @@ thesis options (any order):
   -o T                 overlap test: )" + find_option("test")->values_help(defaults) + R"(
   -g N                 CUDA block size: 16, 32, 64, 128 (default) or 256
   -n N                 runs 1-20 (default 10)
-  -s yes|y|no|n        self-collisions of every object (default no)
+  -s yes|y|no|n|scene  self-collisions of every object, of none (default), or of those the scene
+                       marks (a scene file's `self` lines, drape's sheet, a recording's flags)
   -h H                 grid hash: )" + find_option("hash")->values_help(defaults) + R"(  (-h is not help)
   -d DIR               output folder (default exports/benchmark_data)
 
 more options:
   --backend B          where detection runs: )" + find_option("backend")->values_help(defaults) + R"(; cuda needs a GPU
 )" + table_options_help(defaults) + R"(  --frames A:B         run frames A to B only (0-based, inclusive)
-  --rings K            with -s yes: also leave out tets within K mesh edges of each other in every
+  --rings K            with -s yes or scene: also leave out tets within K mesh edges of each other in every
                        object (self-exclusion rings, 0-)" + std::to_string(max_exclusion_rings) + R"(; default 0: only tets sharing a vertex)
   --filters on|off     the scene's collision filters between objects (heap's groups; default on)
   --quiet              no per-frame table and no progress bar; only the summary
@@ -112,7 +113,12 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
         block_size.parse(parse_choice(block_size.bench_flag, v, bench_block_sizes()), config.options, block_size.bench_flag);
     });
     parser.option("-n", "runs", [&](const std::string& v) { config.runs = static_cast<int>(parse_integer("-n", v, 1, 20)); });
-    parser.option("-s", "yes|no", [&](const std::string& v) { config.self = parse_choice("-s", v, {"yes", "y", "no", "n"})[0] == 'y'; });
+    parser.option("-s", "yes|no|scene", [&](const std::string& v) {
+        const std::string choice = parse_choice("-s", v, {"yes", "y", "no", "n", "scene"});
+        config.self = choice == "scene" ? SceneSelfCollision::marked
+                      : choice[0] == 'y' ? SceneSelfCollision::every
+                                         : SceneSelfCollision::none;
+    });
     parser.option("--rings", "K", [&](const std::string& v) {
         config.rings = static_cast<int>(parse_integer("--rings", v, 0, max_exclusion_rings));
     });
@@ -144,7 +150,8 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     parser.parse(argc, argv, first);
     if (!scene.empty()) config.scene = scene[0];
     if (!config.partition.empty() && !config.mpi) throw UsageError("bench: --partition needs --mpi");
-    if (config.rings > 0 && !config.self) throw UsageError("bench: --rings needs -s yes (rings act within an object)");
+    if (config.rings > 0 && config.self == SceneSelfCollision::none)
+        throw UsageError("bench: --rings needs -s yes or -s scene (rings act within an object)");
     if (config.mpi && config.rings > 0) throw UsageError("bench: --rings is not available with --mpi");
     return config;
 }

@@ -22,7 +22,7 @@ struct BenchConfig {
     SceneRequest request;                       ///< -r, and --tets / --scene-frames for "procedural"
     DetectorOptions options = bench_default_options(); ///< -c, -o, -h, -g, --backend, --threads
     int runs = 10;                              ///< -n
-    bool self = false;                          ///< -s
+    SceneSelfCollision self = SceneSelfCollision::none; ///< -s yes|no|scene
     int rings = 0;                              ///< --rings: self-exclusion rings of every object, with -s
     bool filters = true;                        ///< --filters: the scene's collision filters
     std::string output_dir = "exports/benchmark_data"; ///< -d

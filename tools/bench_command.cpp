@@ -64,7 +64,7 @@ void print_report(const BenchConfig& config, const Scene& scene, const BenchOutc
                 "backend %s on %s\n",
                 scene.name().c_str(), config.request.resolution, tets.c_str(),
                 config.first_frame, last_frame_of(config, scene), config.runs, method.c_str(),
-                to_string(config.options.narrow_phase), value("hashing algorithm").c_str(), config.self ? "yes" : "no",
+                to_string(config.options.narrow_phase), value("hashing algorithm").c_str(), to_string(config.self),
                 to_string(config.options.backend), value("device").c_str());
     // kdet_no_pairs flags tets and builds no pairs: its summary counts the tets.
     const bool builds_pairs = config.options.method != Method::kdet_no_pairs;

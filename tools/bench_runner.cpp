@@ -51,7 +51,7 @@ std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene
             {"algorithm", bench_method_name(o.method)},
             {"block size", std::to_string(o.block_size)},
             {"overlap test", to_string(o.narrow_phase)},
-            {"self collisions", config.self ? "yes" : "no"},
+            {"self collisions", to_string(config.self)},
             {"hashing algorithm", hash_label(o)},
             {"#frames", std::to_string(last_frame - config.first_frame + 1)},
             {"first frame", std::to_string(config.first_frame)},
@@ -84,7 +84,7 @@ std::string stem_of(const BenchConfig& config, const Scene& scene, int last_fram
     std::string stem = scene.name() + "_r" + std::to_string(config.request.resolution) + "_" +
                        bench_method_name(config.options.method) + "_" + to_string(config.options.narrow_phase) + "_" +
                        hash_label(config.options) + "_g" + std::to_string(config.options.block_size) + "_self-" +
-                       (config.self ? "yes" : "no") + "_" + to_string(config.options.backend) + "_" +
+                       to_string(config.self) + "_" + to_string(config.options.backend) + "_" +
                        std::to_string(tets) + "tets";
     if (config.first_frame != 0 || last_frame != scene.num_frames() - 1)
         stem += "_f" + std::to_string(config.first_frame) + "-" + std::to_string(last_frame);

@@ -71,7 +71,9 @@ int run_bench_mpi(const BenchConfig& config) {
         // kdet::mpi has switches alone: the scene's filters and static objects become switches with the
         // answers a Detector gives (no pair of two static objects, no static object's self-collision).
         for (std::size_t a = 0; a < scene->num_objects(); ++a) {
-            detector.set_self_collision(static_cast<ObjectId>(a), config.self && !scene->is_static(a));
+            const bool self = config.self == SceneSelfCollision::every ||
+                              (config.self == SceneSelfCollision::marked && scene->checks_self(a));
+            detector.set_self_collision(static_cast<ObjectId>(a), self && !scene->is_static(a));
             const CollisionFilter fa = scene->collision_filter(a);
             for (std::size_t b = a + 1; b < scene->num_objects(); ++b) {
                 const CollisionFilter fb = scene->collision_filter(b);
@@ -132,7 +134,7 @@ int run_bench_mpi(const BenchConfig& config) {
         for (const TetMesh& m : at_first) tets += m.num_tets();
         std::printf("scene %s: %zu tets on %d ranks (%s), frames %d-%d, %d run(s), self %s, backend %s\n",
                     scene->name().c_str(), tets, size, kind == mpi::Partition::slabs ? "slabs" : "random", first, last,
-                    config.runs, config.self ? "yes" : "no", to_string(config.options.backend));
+                    config.runs, to_string(config.self), to_string(config.options.backend));
         if (!config.quiet)
             std::printf("%6s %10s %10s %12s %17s %17s %9s %9s\n", "frame", "pairs", "tets_sent", "bytes_sent",
                         "owned_min-max", "local_min-max", "exch_ms", "total_ms");

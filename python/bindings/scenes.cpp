@@ -1,6 +1,7 @@
 // The benchmark scenes in Python: kdet.open_scene(), kdet.Scene and kdet.add_scene_objects(), as the
 // C++ scene API (kdet/scenes.hpp, the kdet_scenes target) gives them to `kdet bench`; the frame loop
 // that plays a scene into a Detector is kdet.run_scene() in the pure-Python part.
+#include "arrays.hpp"
 #include "detector.hpp"
 #include "scalars.hpp"
 #include "scenes.hpp"
@@ -35,6 +36,18 @@ std::size_t object_of(const PyScene& self, Arg<std::int64_t> object_arg, const c
         throw Error("scene " + self.scene->name() + ": object " + std::to_string(object) + " out of range (" +
                     std::to_string(self.scene->num_objects()) + " objects)");
     return static_cast<std::size_t>(object);
+}
+
+/// add_scene_objects' self_collision: True, False, or 'scene' for the objects the scene marks.
+SceneSelfCollision self_collision_of(nb::handle value) {
+    if (nb::isinstance<nb::str>(value)) {
+        if (nb::cast<std::string>(value) == "scene") return SceneSelfCollision::marked;
+        throw Error("self_collision: '" + nb::cast<std::string>(value) + "' is not a choice (True, False or 'scene')");
+    }
+    bool every = false;
+    if (!read_bool(value, every))
+        throw nb::type_error(("self_collision: expected a bool or 'scene', got " + type_label(value)).c_str());
+    return every ? SceneSelfCollision::every : SceneSelfCollision::none;
 }
 
 int frame_of(const PyScene& self, Arg<std::int64_t> frame_arg) {
@@ -141,14 +154,16 @@ void bind_scenes(nb::module_& m) {
         "(changes_tets) raises kdet.Error.");
     m.def(
         "add_scene_objects",
-        [](PyDetector& detector, const PyScene& s, Arg<bool> self_collision) {
-            const bool self = read_arg(self_collision, "self_collision");
+        [](PyDetector& detector, const PyScene& s, nb::handle self_collision) {
+            const SceneSelfCollision self = self_collision_of(self_collision);
             locked(detector, [&] { add_scene_objects(detector.detector, *s.scene, self); });
         },
         "detector"_a, "scene"_a, "self_collision"_a = false,
+        nb::sig("def add_scene_objects(detector: Detector, scene: Scene, self_collision: bool | str = False) -> None"),
         "Adds every object of the scene to the detector (ids in scene order from its object_count on), as `kdet bench` "
-        "does: self-collision of each as self_collision says, collisions between the object pairs the scene checks "
-        "only, its collision filters, and its static objects static.");
+        "does: self-collision of every object (self_collision=True, `-s yes`), of none (False) or of those the scene "
+        "marks ('scene', `-s scene`: a scene file's `self` lines), collisions between the object pairs the scene "
+        "checks only, its collision filters, and its static objects static.");
 }
 
 } // namespace kdet::python

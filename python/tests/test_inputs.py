@@ -229,7 +229,7 @@ def test_numpys_scalars_are_read_as_pythons(octopus):
         (lambda d: d.detect(device_results=1), r"device_results: expected a bool, got int"),
         (lambda d: d.locate(np.zeros((1, 3)), device_results="no"), r"device_results: expected a bool, got str"),
         (lambda d: kdet.add_scene_objects(d, kdet.open_scene("procedural", tets=200, frames=2), 1),
-         r"self_collision: expected a bool, got int"),
+         r"self_collision: expected a bool or 'scene', got int"),
         (lambda d: kdet.open_scene("procedural", frames=2.5), r"frames: expected an int, got float"),
     ],
 )

@@ -112,6 +112,19 @@ def test_a_recorded_heap_plays_back_as_the_heap(tmp_path):
         kdet.write_recording(kdet.open_scene("tearing"), tmp_path / "tearing.kdetrec")
 
 
+def test_self_collision_of_the_objects_the_scene_marks():
+    drape = kdet.open_scene("drape")
+    assert drape.checks_self(1) and not drape.checks_self(0)  # the sheet, not the static ball
+    last = drape.num_frames - 1
+    (_, marked), = list(kdet.run_scene(drape, self_collision="scene", first_frame=last))
+    marked = marked.pairs.copy()
+    (_, none), = list(kdet.run_scene(drape, first_frame=last))
+    assert len(marked) > len(none.pairs), "the folded sheet's self pairs"
+    assert ((marked[:, 0] == 1) & (marked[:, 2] == 1)).any()
+    with pytest.raises(kdet.Error, match=r"^self_collision: 'yes' is not a choice \(True, False or 'scene'\)$"):
+        kdet.add_scene_objects(kdet.Detector(), drape, "yes")
+
+
 def test_scene_bad_input():
     scene = kdet.open_scene("tearing")
     with pytest.raises(kdet.Error, match=r"^scene tearing: object 5 out of range \(2 objects\)$"):

@@ -240,7 +240,7 @@ TEST(ViewArgs, ScenesMeshesAndEveryFlag) {
                                 "--camera", "10,-30", "--zoom", "2", "--focus", "colliding"});
     EXPECT_EQ(c.source.scene, "armadillos");
     EXPECT_EQ(c.source.request.resolution, 3);
-    EXPECT_TRUE(c.self);
+    EXPECT_EQ(c.self, SceneSelfCollision::every);
     EXPECT_EQ(c.options.method, Method::brute_force_pairs);
     EXPECT_EQ(c.options.narrow_phase, NarrowPhase::sat_mtv);
     EXPECT_EQ(c.options.hash, HashFunction::morton);
@@ -279,6 +279,8 @@ TEST(ViewArgs, MistakesAreOneLineErrors) {
     EXPECT_NE(usage_error({"--clip", "w"}).find("x, y, z"), std::string::npos);
     EXPECT_NE(usage_error({"--opacity", "2"}).find("--opacity: expected a number in [0, 1]"), std::string::npos);
     EXPECT_NE(usage_error({"--exclusion-rings", "1"}).find("needs --self"), std::string::npos);
+    EXPECT_EQ(usage_error({"--self", "--self-scene"}), "view: --self and --self-scene are two choices; give one");
+    EXPECT_EQ(parse({"drape", "--self-scene", "--exclusion-rings", "1"}).self, SceneSelfCollision::marked);
     EXPECT_NE(usage_error({"--self", "--exclusion-rings", "5"}).find("--exclusion-rings"), std::string::npos);
     EXPECT_NE(usage_error({"--camera", "10"}).find("YAW,PITCH"), std::string::npos);
     EXPECT_NE(usage_error({"--panel"}).find("--screenshot"), std::string::npos);
@@ -331,7 +333,7 @@ std::vector<TetPair> reference_pairs(const Scene& scene, int frame, bool self) {
 TEST(ViewSession, ATornMeshFollowsTheScenesTetsFrameByFrame) {
     ViewSource source;
     source.scene = "tearing";
-    ViewSession session(source, DetectorOptions{}, false);
+    ViewSession session(source, DetectorOptions{}, SceneSelfCollision::none);
     const Scene& scene = session.scene();
     ASSERT_TRUE(scene.changes_tets());
     std::vector<std::uint32_t> tets;
@@ -369,7 +371,7 @@ TEST(ViewSession, ATornMeshFollowsTheScenesTetsFrameByFrame) {
 }
 
 TEST(ViewSession, ShowsTheDetectorsPairsForTheFrame) {
-    ViewSession session(procedural(4000, 21), DetectorOptions{}, false);
+    ViewSession session(procedural(4000, 21), DetectorOptions{}, SceneSelfCollision::none);
     EXPECT_FALSE(session.has_result());
     EXPECT_EQ(session.detector_memory(), 0u) << "no detector before the first detection";
     session.set_frame(10);
@@ -408,7 +410,7 @@ TEST(ViewSession, TheTetsWithinTheMarginOnlyAreThoseOfAFreshDetector) {
     // overlap another tet: a margin detector's tets minus a margin-0 detector's.
     DetectorOptions options;
     options.margin = 0.02f;
-    ViewSession session(procedural(4000, 21), options, false);
+    ViewSession session(procedural(4000, 21), options, SceneSelfCollision::none);
     session.set_frame(9);
     session.update();
     EXPECT_FALSE(session.options().distances) << "the user's options are shown as set";
@@ -467,7 +469,7 @@ TEST(ViewSession, EveryOptionChangesBeforeTheFirstDetection) {
     threads.bucket_capacity = 4;
     variants.push_back(threads);
     for (const DetectorOptions& options : variants) {
-        ViewSession session(source, DetectorOptions{}, false);
+        ViewSession session(source, DetectorOptions{}, SceneSelfCollision::none);
         session.set_options(options);
         session.set_frame(5);
         session.update();
@@ -475,8 +477,8 @@ TEST(ViewSession, EveryOptionChangesBeforeTheFirstDetection) {
         EXPECT_EQ(session.options().hash, options.hash);
         EXPECT_EQ(session.result().contacts.size(), options.contacts ? expected.size() : 0u);
     }
-    ViewSession session(source, DetectorOptions{}, false);
-    session.set_self(true);
+    ViewSession session(source, DetectorOptions{}, SceneSelfCollision::none);
+    session.set_self(SceneSelfCollision::every);
     session.set_frame(5);
     session.update();
     EXPECT_EQ(session.result().pairs, expected_self);
@@ -484,7 +486,7 @@ TEST(ViewSession, EveryOptionChangesBeforeTheFirstDetection) {
     // kdet_no_pairs flags the same tets and builds no pairs.
     DetectorOptions flags_only;
     flags_only.method = Method::kdet_no_pairs;
-    session.set_self(false);
+    session.set_self(SceneSelfCollision::none);
     session.set_options(flags_only);
     session.update();
     EXPECT_TRUE(session.result().pairs.empty());
@@ -502,7 +504,7 @@ TEST(ViewSession, FiftySwitchesOfSceneAndMethodKeepMemoryBounded) {
     const std::vector<ViewSource> sources = {procedural(6000, 9), octopus_pair(), procedural(2000, 9)};
     const std::vector<Method> methods = {Method::kdet, Method::brute_force_loop, Method::kdet_no_pairs};
     const std::vector<HashFunction> hashes = {HashFunction::morton, HashFunction::djb2};
-    ViewSession session(sources[0], DetectorOptions{}, false);
+    ViewSession session(sources[0], DetectorOptions{}, SceneSelfCollision::none);
     std::map<std::string, std::size_t> memory_of; // the detector's bytes for each setting
     std::size_t resident_after_warm_up = 0, most_resident = 0;
     for (int k = 0; k < 50; ++k) {
@@ -557,18 +559,18 @@ TEST(ViewSession, OpensEveryKindOfSource) {
     folder.scene = (dir / "frames").string();
     for (const ViewSource& source : {scene_file, recording, folder, octopus_pair()}) {
         SCOPED_TRACE(source.meshes.empty() ? source.scene : source.meshes[0]);
-        ViewSession session(source, DetectorOptions{}, true);
+        ViewSession session(source, DetectorOptions{}, SceneSelfCollision::every);
         session.set_frame(session.num_frames() - 1);
         session.update();
         EXPECT_EQ(session.result().pairs, reference_pairs(session.scene(), session.frame(), true));
         EXPECT_EQ(session.faces().size(), session.scene().num_objects());
     }
-    EXPECT_EQ(ViewSession(scene_file, DetectorOptions{}, false).num_frames(), 4);
-    EXPECT_EQ(ViewSession(folder, DetectorOptions{}, false).num_frames(), 3);
+    EXPECT_EQ(ViewSession(scene_file, DetectorOptions{}, SceneSelfCollision::none).num_frames(), 4);
+    EXPECT_EQ(ViewSession(folder, DetectorOptions{}, SceneSelfCollision::none).num_frames(), 3);
 }
 
 TEST(ViewSession, AFailedOpenKeepsTheSceneShown) {
-    ViewSession session(procedural(2000, 5), DetectorOptions{}, false);
+    ViewSession session(procedural(2000, 5), DetectorOptions{}, SceneSelfCollision::none);
     session.update();
     const std::uint64_t version = session.scene_version();
     ViewSource missing;
@@ -589,7 +591,7 @@ TEST(ViewPicking, PicksWhatIsDrawnAtThePixel) {
     DetectorOptions options;
     options.narrow_phase = NarrowPhase::sat_mtv;
     options.contacts = true;
-    ViewSession session(test::nested_boxes(), options, false);
+    ViewSession session(test::nested_boxes(), options, SceneSelfCollision::none);
     session.update();
     OrbitCamera camera;
     camera.frame(session.positions(), 1.0f);
@@ -674,7 +676,7 @@ TEST(ViewSession, ContactsOfAnyTestWhenTheViewerShowsThem) {
         DetectorOptions options;
         options.narrow_phase = t;
         options.contacts = true;
-        ViewSession session(test::nested_boxes(), options, false);
+        ViewSession session(test::nested_boxes(), options, SceneSelfCollision::none);
         session.update();
         const FrameResult& r = session.result();
         ASSERT_FALSE(r.pairs.empty()) << to_string(t);
@@ -691,7 +693,7 @@ TEST(ViewBenchmark, WritesTheFilesOfKdetBench) {
     options.narrow_phase = NarrowPhase::sat_mtv;
     options.contacts = true; // as the viewer sets it to draw normals; kdet bench runs without
     options.hash = HashFunction::fnv1a;
-    ViewSession session(source, options, true);
+    ViewSession session(source, options, SceneSelfCollision::every);
     const auto dir = temp_dir("bench");
     BenchJob job(session.source(), bench_config_of(session, 2, (dir / "view").string()));
     while (!job.finished()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -720,7 +722,7 @@ TEST(ViewBenchmark, WritesTheFilesOfKdetBench) {
 }
 
 TEST(ViewBenchmark, StopsWithoutWritingFiles) {
-    ViewSession session(procedural(20000, 120), DetectorOptions{}, false);
+    ViewSession session(procedural(20000, 120), DetectorOptions{}, SceneSelfCollision::none);
     const auto dir = temp_dir("stopped");
     BenchJob job(session.source(), bench_config_of(session, 20, dir.string()));
     job.stop();
@@ -731,7 +733,7 @@ TEST(ViewBenchmark, StopsWithoutWritingFiles) {
 }
 
 TEST(ViewBenchmark, ReportsAnErrorInOneLine) {
-    ViewSession session(procedural(1000, 3), DetectorOptions{}, false);
+    ViewSession session(procedural(1000, 3), DetectorOptions{}, SceneSelfCollision::none);
     const auto dir = temp_dir("blocked");
     std::ofstream(dir / "file") << "x";
     BenchJob job(session.source(), bench_config_of(session, 1, (dir / "file" / "below").string()));
@@ -751,7 +753,7 @@ namespace {
 
 TEST(ViewPoints, TheSessionLocatesAsKdetLocate) {
     const test::BoxAndPoints b = test::box_and_points();
-    ViewSession session(b.source, DetectorOptions{}, false);
+    ViewSession session(b.source, DetectorOptions{}, SceneSelfCollision::none);
     session.set_points(b.points, 0.5);
     session.update();
     const LocateResult expected = locate(b.box, b.points, LocateOptions{0.5, true});
@@ -784,7 +786,7 @@ TEST(ViewPoints, TheSessionLocatesAsKdetLocate) {
 
 TEST(ViewPoints, LocatedAgainOnlyWhenTheTetsOrPointsMove) {
     const test::BoxAndPoints b = test::box_and_points();
-    ViewSession session(b.source, DetectorOptions{}, false);
+    ViewSession session(b.source, DetectorOptions{}, SceneSelfCollision::none);
     session.set_points(b.points, 0.5);
     session.update();
     const std::uint64_t located = session.located_version();

@@ -414,7 +414,7 @@ TEST(ViewRenderer, EveryKindOfThingHasAColourOfItsOwn) {
 
 TEST(ViewRenderer, VertexBuffersAreUpdatedInPlace) {
     REQUIRE_GL();
-    ViewSession session(test::procedural(8000, 31), DetectorOptions{}, false);
+    ViewSession session(test::procedural(8000, 31), DetectorOptions{}, SceneSelfCollision::none);
     Renderer renderer;
     OffscreenTarget target(160, 120, 1);
     const auto play = [&] {
@@ -444,7 +444,7 @@ TEST(ViewRenderer, ATornMeshIsDrawnAsItsTetsChange) {
     REQUIRE_GL();
     ViewSource source;
     source.scene = "tearing";
-    ViewSession session(source, DetectorOptions{}, false);
+    ViewSession session(source, DetectorOptions{}, SceneSelfCollision::none);
     Renderer renderer;
     OffscreenTarget target(200, 150, 1);
     const auto picture = [&](const Renderer& r) {
@@ -478,7 +478,7 @@ TEST(ViewRenderer, ATornMeshIsDrawnAsItsTetsChange) {
 
 TEST(ViewRenderer, TheSelectionIsDrawnOverEverything) {
     REQUIRE_GL();
-    ViewSession session(test::nested_boxes(), DetectorOptions{}, false);
+    ViewSession session(test::nested_boxes(), DetectorOptions{}, SceneSelfCollision::none);
     session.update();
     Renderer renderer;
     renderer.update(session);
@@ -513,7 +513,7 @@ TEST(ViewRenderer, FiftySwitchesKeepBuffersAndMemoryBounded) {
     REQUIRE_GL();
     const std::vector<ViewSource> sources = {test::procedural(6000, 9), test::octopus_pair(), test::procedural(2000, 9)};
     const std::vector<Method> methods = {Method::kdet, Method::brute_force_loop, Method::kdet_no_pairs};
-    ViewSession session(sources[0], DetectorOptions{}, false);
+    ViewSession session(sources[0], DetectorOptions{}, SceneSelfCollision::none);
     Renderer renderer;
     OffscreenTarget target(200, 150, 4);
     std::vector<std::size_t> bytes_of(sources.size(), 0), detector_of(sources.size() * methods.size(), 0);
@@ -578,7 +578,7 @@ std::vector<std::uint8_t> draw_session(const Renderer& renderer, const Offscreen
 TEST(ViewRenderer, QueryPointsAndTheirTetsAreDrawn) {
     REQUIRE_GL();
     const test::BoxAndPoints b = test::box_and_points();
-    ViewSession session(b.source, DetectorOptions{}, false);
+    ViewSession session(b.source, DetectorOptions{}, SceneSelfCollision::none);
     session.update();
     Renderer renderer;
     renderer.update(session);
@@ -617,7 +617,7 @@ TEST(ViewRenderer, TheTetsWithinTheMarginOnlyHaveTheirOwnColour) {
     REQUIRE_GL();
     DetectorOptions options;
     options.margin = 0.02f;
-    ViewSession session(test::procedural(4000, 21), options, false);
+    ViewSession session(test::procedural(4000, 21), options, SceneSelfCollision::none);
     session.set_frame(9);
     session.update();
     Renderer renderer;
@@ -638,7 +638,7 @@ TEST(ViewRenderer, TheTetsWithinTheMarginOnlyHaveTheirOwnColour) {
 TEST(ViewRenderer, ASelectedPointShowsOnlyItsTets) {
     REQUIRE_GL();
     const test::BoxAndPoints b = test::box_and_points();
-    ViewSession session(b.source, DetectorOptions{}, false);
+    ViewSession session(b.source, DetectorOptions{}, SceneSelfCollision::none);
     session.set_points(b.points, 0.5);
     session.update();
     Renderer renderer;

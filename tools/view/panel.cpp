@@ -189,9 +189,11 @@ void Viewer::panel_scene() {
             open_source(source);
         }
     }
-    bool self = session_.self();
-    if (ImGui::Checkbox("self-collision", &self)) session_.set_self(self);
-    ImGui::BeginDisabled(!self);
+    // The order of SceneSelfCollision: none, every object, those the scene marks.
+    static const char* const self_choices[] = {"none", "every object", "as the scene marks"};
+    int self = static_cast<int>(session_.self());
+    if (ImGui::Combo("self-collision", &self, self_choices, 3)) session_.set_self(static_cast<SceneSelfCollision>(self));
+    ImGui::BeginDisabled(session_.self() == SceneSelfCollision::none);
     int rings = session_.exclusion_rings();
     ImGui::SliderInt("exclusion rings", &rings, 0, max_exclusion_rings);
     if (ImGui::IsItemHovered())

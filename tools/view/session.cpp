@@ -84,7 +84,7 @@ PointCounts count_points(const LocateResult& located) {
     return counts;
 }
 
-ViewSession::ViewSession(const ViewSource& source, const DetectorOptions& options, bool self)
+ViewSession::ViewSession(const ViewSource& source, const DetectorOptions& options, SceneSelfCollision self)
     : options_(options), self_(self) {
     open(source);
 }
@@ -119,7 +119,7 @@ void ViewSession::set_options(const DetectorOptions& options) {
     results_stale_ = true;
 }
 
-void ViewSession::set_self(bool self) {
+void ViewSession::set_self(SceneSelfCollision self) {
     if (self == self_) return;
     self_ = self;
     detector_.reset();
@@ -159,7 +159,7 @@ void ViewSession::build_detector() {
     options.distances = options.distances || options.margin > 0.0f;
     auto detector = std::make_unique<Detector>(options);
     add_scene_objects(*detector, *scene_, self_);
-    if (self_)
+    if (self_ != SceneSelfCollision::none)
         for (std::size_t o = 0; o < scene_->num_objects(); ++o)
             detector->set_self_exclusion_rings(static_cast<ObjectId>(o), exclusion_rings_);
     for (std::size_t o = 0; o < scene_->num_objects(); ++o) detector->set_static(static_cast<ObjectId>(o), static_[o] != 0);

@@ -53,14 +53,14 @@ PointCounts count_points(const LocateResult& located);
 class ViewSession {
 public:
     /// @brief Opens @p source (throws kdet::Error when it cannot).
-    ViewSession(const ViewSource& source, const DetectorOptions& options, bool self);
+    ViewSession(const ViewSource& source, const DetectorOptions& options, SceneSelfCollision self);
 
     /// @brief Switches to another source. Throws kdet::Error when it cannot be opened, and then keeps
     /// the current one. The frame is kept when the new scene has it, else it becomes 0.
     void open(const ViewSource& source);
     void set_options(const DetectorOptions& options);
-    /// @brief Self-collision of every object (as `kdet bench -s`).
-    void set_self(bool self);
+    /// @brief Self-collision of no object, every object, or those the scene marks (as `kdet bench -s`).
+    void set_self(SceneSelfCollision self);
     /// @brief Self-exclusion rings of every object while self-collision is on
     /// (Detector::set_self_exclusion_rings).
     void set_exclusion_rings(int rings);
@@ -82,7 +82,7 @@ public:
     const ViewSource& source() const { return source_; }
     const Scene& scene() const { return *scene_; }
     const DetectorOptions& options() const { return options_; }
-    bool self() const { return self_; }
+    SceneSelfCollision self() const { return self_; }
     int exclusion_rings() const { return exclusion_rings_; }
     /// @brief An object's collision filter in the current detector (the default before there is one).
     CollisionFilter collision_filter(std::size_t object) const;
@@ -144,7 +144,7 @@ private:
     std::vector<MeshFaces> faces_;
     std::vector<std::vector<std::uint32_t>> detector_tets_; ///< each object's tets as the detector has them
     DetectorOptions options_;
-    bool self_ = false;
+    SceneSelfCollision self_ = SceneSelfCollision::none;
     int exclusion_rings_ = 0;
     std::vector<char> static_; ///< per object: detected as static (the scene's flag unless switched off)
     int frame_ = 0;

@@ -26,8 +26,11 @@ SCENE is anything `kdet bench` opens: procedural (default), a thesis scene, a .s
 
 scene options:
   --self               self-collision of every object (as `kdet bench -s yes`)
-  --exclusion-rings K  with --self, also leave out tets within K mesh edges of each other (0-4,
-                       as `kdet collide --exclusion-rings`; the panel's slider changes it)
+  --self-scene         self-collision of the objects the scene marks (a scene file's `self`
+                       lines; as `kdet bench -s scene`)
+  --exclusion-rings K  with --self or --self-scene, also leave out tets within K mesh edges of
+                       each other (0-4, as `kdet collide --exclusion-rings`; the panel's slider
+                       changes it)
   --res N, -r N        resolution 1-4 of the thesis scenes (default 1)
   --tets N             tetrahedra of the procedural scene (default 100000)
   --scene-frames N     frames of the procedural scene (default 120)
@@ -145,7 +148,9 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     cli::CommandLine parser("view");
     parser.positionals(2, positionals);
     parser.flag("--help", config.help);
-    parser.flag("--self", config.self);
+    bool every = false, marked = false;
+    parser.flag("--self", every);
+    parser.flag("--self-scene", marked);
     parser.option("--exclusion-rings", "K", [&](const std::string& v) {
         config.exclusion_rings = static_cast<int>(parse_integer("--exclusion-rings", v, 0, max_exclusion_rings));
     });
@@ -219,8 +224,10 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     if (!config.screenshot.empty() && config.profile)
         throw cli::UsageError("view: --screenshot and --profile are two different runs; give one");
     if (within_given && config.points.empty()) throw cli::UsageError("view: --within applies to --points only");
-    if (config.exclusion_rings > 0 && !config.self)
-        throw cli::UsageError("view: --exclusion-rings acts within an object: it needs --self");
+    if (every && marked) throw cli::UsageError("view: --self and --self-scene are two choices; give one");
+    config.self = every ? SceneSelfCollision::every : marked ? SceneSelfCollision::marked : SceneSelfCollision::none;
+    if (config.exclusion_rings > 0 && config.self == SceneSelfCollision::none)
+        throw cli::UsageError("view: --exclusion-rings acts within an object: it needs --self or --self-scene");
     if (config.panel && config.screenshot.empty()) throw cli::UsageError("view: --panel applies to --screenshot only");
     return config;
 }

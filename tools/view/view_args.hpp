@@ -40,7 +40,7 @@ struct CameraRequest {
 struct ViewConfig {
     ViewSource source;
     DetectorOptions options;
-    bool self = false;
+    SceneSelfCollision self = SceneSelfCollision::none; ///< --self, --self-scene
     int exclusion_rings = 0;       ///< with self: Detector::set_self_exclusion_rings of every object
     int frame = 0;                 ///< 0-based frame to show first (checked when the scene is open)
     std::string screenshot;        ///< headless: draw frame `frame` into this PNG and exit

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any, Iterator, Optional, Tuple
+from typing import Any, Iterator, Optional, Tuple, Union
 
 import numpy as np
 
@@ -13,7 +13,7 @@ def run_scene(
     scene: Scene,
     detector: Optional[Detector] = None,
     *,
-    self_collision: bool = False,
+    self_collision: Union[bool, str] = False,
     first_frame: int = 0,
     last_frame: Optional[int] = None,
     **options: Any,
@@ -21,7 +21,7 @@ def run_scene(
     """Yields (frame, result) for frames first_frame to last_frame (default: the scene's last), inclusive.
 
     The scene's objects are added to `detector` (a new Detector(**options) when None) with
-    add_scene_objects(); every frame, the tets of an object whose tets changed are set (set_tets), the
+    add_scene_objects() (self_collision: True, False or 'scene', as `kdet bench -s`); every frame, the tets of an object whose tets changed are set (set_tets), the
     positions of every moving object are set, and the detector detects. A static object's positions are
     given at the first frame only: it stays placed, as `kdet bench` keeps it."""
     if detector is None:

@@ -70,11 +70,25 @@ public:
 void set_scene_tets(Detector& detector, const Scene& scene, int frame, std::vector<std::vector<std::uint32_t>>& current,
                     ObjectId first_id = 0);
 
+/// @brief The objects of a scene whose self-collision add_scene_objects() switches on.
+enum class SceneSelfCollision {
+    none,   ///< none (`kdet bench -s no`)
+    every,  ///< every object (`-s yes`, the thesis's self-collision runs)
+    marked, ///< those the scene marks (Scene::checks_self: a scene file's `self OBJECT`; `-s scene`)
+};
+
+/// @brief "no", "yes" or "scene": the value of `kdet bench -s` and its CSV files.
+const char* to_string(SceneSelfCollision self);
+
 /// @brief Adds every object of @p scene to @p detector (ids in scene order, from the detector's next
-/// id on), with self-collision of each object as @p self says (the thesis's `-s`, whatever the
-/// scene's checks_self), collisions between the object pairs the scene checks only, its collision
-/// filters, and its static objects static.
-void add_scene_objects(Detector& detector, const Scene& scene, bool self);
+/// id on), with self-collision of the objects @p self names, collisions between the object pairs the
+/// scene checks only, its collision filters, and its static objects static.
+void add_scene_objects(Detector& detector, const Scene& scene, SceneSelfCollision self);
+
+/// @brief add_scene_objects() with self-collision of every object (@p every) or of none.
+inline void add_scene_objects(Detector& detector, const Scene& scene, bool every) {
+    add_scene_objects(detector, scene, every ? SceneSelfCollision::every : SceneSelfCollision::none);
+}
 
 /// @brief Size of a ProceduralScene.
 struct ProceduralSceneOptions {
