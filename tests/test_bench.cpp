@@ -11,6 +11,7 @@
 #include "bench_csv.hpp"
 #include "bench_runner.hpp"
 
+#include "prepare_support.hpp"
 #include "run_command.hpp"
 
 #include <sys/wait.h>
@@ -553,6 +554,27 @@ TEST(BenchEndToEnd, CudaBackendGivesTheCpuCountsOrAClearError) {
     for (std::size_t f = 0; f < cpu.rows.size(); ++f)
         for (const char* column : {"collision pairs", "col tets A to B", "col tets B to A"})
             EXPECT_EQ(cpu.at(f, column), cuda.at(f, column)) << column << " frame " << f;
+}
+
+TEST(BenchCommand, AResolutionTheSceneDoesNotHaveIsRefusedAndTheFilesNameTheOneItHas) {
+    // pass_through_armadillos is at resolution 2 whatever -r says: -r 4 was run at 2 and named r4.
+    using test::run_prepare;
+    KDET_PREPARE_OR_SKIP("armadillo -r 2");
+    const auto dir = temp_dir("fixed-resolution");
+    const std::string flags = " --frames 0:0 -n 1 --quiet -d " + dir.string();
+    const auto [refused, message] = kdet_command("bench pass_through_armadillos -r 4" + flags, "&1");
+    EXPECT_EQ(refused, 2) << message;
+    EXPECT_EQ(message, "kdet bench: invalid value '4' for -r: scene 'pass_through_armadillos' is built at resolution 2 only\n");
+    ASSERT_EQ(kdet_command("bench pass_through_armadillos" + flags).first, 0);
+    std::size_t named = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        const std::string file = entry.path().filename().string();
+        EXPECT_EQ(file.rfind("pass_through_armadillos_r2_", 0), 0u) << file;
+        ++named;
+    }
+    EXPECT_EQ(named, 2u);
+    EXPECT_EQ(only_csv(dir, false).header["resolution"], "2");
+    std::filesystem::remove_all(dir);
 }
 
 #endif

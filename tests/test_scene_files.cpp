@@ -92,6 +92,14 @@ TEST(SceneFile, MistakesFoundWhilePlayingNameFileAndLine) {
     fs::create_directories(dir / "folder.scene");
     EXPECT_EQ(error_message([&] { read_scene_file((dir / "folder.scene").string()); }),
               (dir / "folder.scene").string() + ": cannot open scene file (it is a directory)");
+    // A mesh that cannot be had names the statement that asked for it.
+    std::ofstream(dir / "missing.scene") << "kdet-scene 1\nframes 3\nobject a\n file box.node\nobject b\n file gone.node\n";
+    EXPECT_EQ(error_message([&] { read_scene_file((dir / "missing.scene").string()); }),
+              (dir / "missing.scene").string() + ":6: object 'b': " + (dir / "gone.node").string() + ": cannot open file");
+    std::ofstream(dir / "model.scene") << "kdet-scene 1\nframes 3\nobject a\n mesh octopus\n";
+    EXPECT_EQ(error_message([&] { read_scene_file((dir / "model.scene").string()); })
+                  .rfind((dir / "model.scene").string() + ":4: object 'a': unknown model 'octopus' (known models: armadillo", 0),
+              0u);
     fs::remove_all(dir);
 }
 
@@ -139,6 +147,22 @@ collide left right
 self left
 )";
     return dir / "boxes.scene";
+}
+
+TEST(SceneFile, ResolutionIsTheOneTheMeshesWereBuiltAt) {
+    SceneRequest r3;
+    r3.resolution = 3;
+    EXPECT_EQ(open_scene("heap", r3)->resolution(), 3);
+    EXPECT_EQ(open_scene("drape")->resolution(), 1);
+    EXPECT_EQ(open_scene("procedural")->resolution(), 0);
+    EXPECT_EQ(open_scene("tearing", r3)->resolution(), 0);
+    const fs::path dir = fresh_dir("resolution");
+    EXPECT_EQ(open_scene(write_box_scene(dir).string(), r3)->resolution(), 0) << "mesh files only";
+    fs::remove_all(dir);
+    KDET_PREPARE_OR_SKIP("armadillo -r 2");
+    SceneRequest r4;
+    r4.resolution = 4;
+    EXPECT_EQ(open_scene("pass_through_armadillos", r4)->resolution(), 2) << "its file fixes it";
 }
 
 TEST(SceneFile, SelfCollisionOfTheMarkedObjectsOnly) {

@@ -34,7 +34,7 @@ std::string help_text() {
 Runs a scene frame by frame and writes per-frame times and pair counts as CSV (thesis appendix A.1.4):
   DIR/STEM.csv        per-frame averages over the runs
   DIR/STEM_runs.csv   every run of every frame
-where STEM names the parameters, e.g. procedural_r1_kdet_sat_djb2_g128_self-no_cpu_100000tets.
+where STEM names the parameters, e.g. procedural_r1_kdet_sat_djb2_g128_self-no_cpu_100272tets.
 Frames are numbered from 0. Times are in milliseconds.
 
 scene: procedural (default; two deforming tori, no data files needed) or another scene that kdet
@@ -105,6 +105,7 @@ BenchConfig parse_bench_args(int argc, char** argv, int first) {
     });
     parser.option("-r", "resolution", [&](const std::string& v) {
         config.request.resolution = static_cast<int>(parse_integer("-r", v, 1, 4));
+        config.resolution_given = true;
     });
     parser.detector_options(config.options, front_end_bench);
     // The thesis's block sizes, a few of those the library accepts.

@@ -29,6 +29,7 @@ struct BenchConfig {
     int first_frame = 0;                        ///< --frames A:B (0-based, inclusive)
     int last_frame = -1;                        ///< -1: up to the scene's last frame
     std::string procedural_flag;                ///< first procedural-only flag given, for the error
+    bool resolution_given = false;              ///< -r was given (a scene that fixes its own refuses another)
     bool quiet = false;
     bool help = false;
     bool mpi = false;                           ///< --mpi: run on the ranks of mpirun (kdet::mpi)

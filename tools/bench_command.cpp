@@ -39,6 +39,9 @@ std::unique_ptr<Scene> open_bench_scene(const BenchConfig& config) {
         if (!names_a_scene(config.scene)) throw UsageError(std::string("bench: ") + e.what());
         throw;
     }
+    if (config.resolution_given && scene->resolution() != 0 && scene->resolution() != config.request.resolution)
+        throw UsageError("bench: invalid value '" + std::to_string(config.request.resolution) + "' for -r: scene '" +
+                         scene->name() + "' is built at resolution " + std::to_string(scene->resolution()) + " only");
     if (config.first_frame >= scene->num_frames() || config.last_frame >= scene->num_frames())
         throw UsageError("bench: invalid value '" + std::to_string(config.first_frame) + ":" + std::to_string(config.last_frame) +
                          "' for --frames: scene '" + scene->name() + "' has frames 0 to " +
@@ -62,7 +65,7 @@ void print_report(const BenchConfig& config, const Scene& scene, const BenchOutc
                                                      : value("#tetsA") + "+" + value("#tetsB") + " tets";
     std::printf("scene %s (resolution %d): %s, frames %d-%d, %d run(s); method %s, test %s, hash %s, self %s, "
                 "backend %s on %s\n",
-                scene.name().c_str(), config.request.resolution, tets.c_str(),
+                scene.name().c_str(), resolution_of(config, scene), tets.c_str(),
                 config.first_frame, last_frame_of(config, scene), config.runs, method.c_str(),
                 to_string(config.options.narrow_phase), value("hashing algorithm").c_str(), to_string(config.self),
                 to_string(config.options.backend), value("device").c_str());

@@ -47,7 +47,7 @@ std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene
     const DetectorOptions& o = config.options;
     const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
     return {{"scene name", scene.name()},
-            {"resolution", std::to_string(config.request.resolution)},
+            {"resolution", std::to_string(resolution_of(config, scene))},
             {"algorithm", bench_method_name(o.method)},
             {"block size", std::to_string(o.block_size)},
             {"overlap test", to_string(o.narrow_phase)},
@@ -81,7 +81,7 @@ std::vector<HeaderField> header_of(const BenchConfig& config, const Scene& scene
 
 std::string stem_of(const BenchConfig& config, const Scene& scene, int last_frame) {
     const std::size_t tets = all_tets(scene);
-    std::string stem = scene.name() + "_r" + std::to_string(config.request.resolution) + "_" +
+    std::string stem = scene.name() + "_r" + std::to_string(resolution_of(config, scene)) + "_" +
                        bench_method_name(config.options.method) + "_" + to_string(config.options.narrow_phase) + "_" +
                        hash_label(config.options) + "_g" + std::to_string(config.options.block_size) + "_self-" +
                        to_string(config.self) + "_" + to_string(config.options.backend) + "_" +
@@ -92,6 +92,10 @@ std::string stem_of(const BenchConfig& config, const Scene& scene, int last_fram
     if (!config.filters) stem += "_filters-off";
     if (config.options.margin > 0) stem += "_margin" + margin_text(config.options);
     return stem;
+}
+
+int resolution_of(const BenchConfig& config, const Scene& scene) {
+    return scene.resolution() != 0 ? scene.resolution() : config.request.resolution;
 }
 
 int last_frame_of(const BenchConfig& config, const Scene& scene) {

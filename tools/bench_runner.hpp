@@ -31,6 +31,9 @@ using BenchProgress = std::function<bool(int run, int frame_index)>;
 /// @brief The last frame `config` selects in `scene` (its --frames B, else the scene's last frame).
 int last_frame_of(const BenchConfig& config, const Scene& scene);
 
+/// @brief The resolution its files name: the scene's own (Scene::resolution), else the requested one.
+int resolution_of(const BenchConfig& config, const Scene& scene);
+
 /// @brief The files' name without extension: the scene, resolution, method, test, hash, block size,
 /// self-collision, backend and tets, then what differs from a plain run (frames, rings, filters, margin).
 std::string stem_of(const BenchConfig& config, const Scene& scene, int last_frame);

@@ -79,6 +79,9 @@ void bind_scenes(nb::module_& m) {
         .def_prop_ro("name", [](const PyScene& s) { return s.scene->name(); })
         .def_prop_ro("num_objects", [](const PyScene& s) { return s.scene->num_objects(); })
         .def_prop_ro("num_frames", [](const PyScene& s) { return s.scene->num_frames(); })
+        .def_prop_ro(
+            "resolution", [](const PyScene& s) { return s.scene->resolution(); },
+            "The resolution (1-4) its meshes were built at, 0 for a scene without one (procedural, recordings).")
         .def_prop_ro("changes_tets", [](const PyScene& s) { return s.scene->changes_tets(); },
                      "Whether some object's tets change between frames (then use tets(object, frame)).")
         .def(

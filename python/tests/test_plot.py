@@ -28,7 +28,7 @@ def bench_folder(cli: Path, models: Path, tmp_path_factory: pytest.TempPathFacto
     # The armadillos move along x (their overlap grows frame by frame); the tearing scene's box moves
     # along y and z only.
     for scene, frames in (("pass_through_armadillos", "100:103"), ("tearing", "0:3")):
-        done = run([str(cli), "bench", scene, "-r", "1", "-n", "1", "--frames", frames, "-d", str(folder),
+        done = run([str(cli), "bench", scene, "-n", "1", "--frames", frames, "-d", str(folder),
                     "--quiet"], models=models)
         assert done.returncode == 0, done.stderr
     return folder

@@ -79,7 +79,7 @@ std::unique_ptr<Scene> make_drape_scene(int resolution) {
             out[3 * v + 2] = r * ct - hanging * st + drop;
         }
     };
-    return std::make_unique<scenes::GeneratedScene>("drape", kFrames, std::vector<TetMesh>{std::move(ball), std::move(sheet)},
+    return std::make_unique<scenes::GeneratedScene>("drape", resolution, kFrames, std::vector<TetMesh>{std::move(ball), std::move(sheet)},
                                                     std::vector<std::size_t>{0, 1}, std::vector<bool>{true, false},
                                                     std::vector<bool>{false, true}, std::move(motion));
 }

@@ -22,10 +22,10 @@ public:
     using Motion = std::function<void(std::size_t o, int frame, std::vector<double>& out)>;
 
     /// @brief Object o's rest mesh is meshes[mesh_of[o]].
-    GeneratedScene(std::string name, int frames, std::vector<TetMesh> meshes, std::vector<std::size_t> mesh_of,
+    GeneratedScene(std::string name, int resolution, int frames, std::vector<TetMesh> meshes, std::vector<std::size_t> mesh_of,
                    std::vector<bool> is_static, std::vector<bool> self, Motion motion)
-        : name_(std::move(name)), frames_(frames), meshes_(std::move(meshes)), mesh_of_(std::move(mesh_of)),
-          static_(std::move(is_static)), self_(std::move(self)), motion_(std::move(motion)) {}
+        : name_(std::move(name)), resolution_(resolution), frames_(frames), meshes_(std::move(meshes)),
+          mesh_of_(std::move(mesh_of)), static_(std::move(is_static)), self_(std::move(self)), motion_(std::move(motion)) {}
 
     std::string name() const override { return name_; }
     std::size_t num_objects() const override { return mesh_of_.size(); }
@@ -56,6 +56,7 @@ public:
     }
     bool checks_self(std::size_t object) const override { return object < self_.size() && self_[object]; }
     bool is_static(std::size_t object) const override { return object < static_.size() && static_[object]; }
+    int resolution() const override { return resolution_; }
 
 private:
     void check(std::size_t object, int frame) const {
@@ -67,6 +68,7 @@ private:
     }
 
     std::string name_;
+    int resolution_;
     int frames_;
     std::vector<TetMesh> meshes_;
     std::vector<std::size_t> mesh_of_;

@@ -89,7 +89,7 @@ std::unique_ptr<Scene> make_graded_scene(int resolution) {
             out[3 * v + 2] = feature[2] + py;
         }
     };
-    return std::make_unique<scenes::GeneratedScene>("graded", kFrames, std::vector<TetMesh>{std::move(block), torus},
+    return std::make_unique<scenes::GeneratedScene>("graded", resolution, kFrames, std::vector<TetMesh>{std::move(block), torus},
                                                     std::vector<std::size_t>{0, 1}, std::vector<bool>{true, false},
                                                     std::vector<bool>{false, false}, std::move(motion));
 }

@@ -82,7 +82,7 @@ std::unique_ptr<Scene> make_heap_scene(int resolution) {
         const std::uint32_t layer = static_cast<std::uint32_t>(b / side / side) % 2;
         filters[b + 1] = CollisionFilter{2u << layer, 1u | (4u >> layer)};
     }
-    auto scene = std::make_unique<scenes::GeneratedScene>("heap", kFrames, std::vector<TetMesh>{std::move(floor), std::move(body)},
+    auto scene = std::make_unique<scenes::GeneratedScene>("heap", resolution, kFrames, std::vector<TetMesh>{std::move(floor), std::move(body)},
                                                           std::move(mesh_of), std::move(is_static),
                                                           std::vector<bool>(bodies + 1, false), std::move(motion));
     scene->set_filters(std::move(filters));

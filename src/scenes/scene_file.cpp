@@ -138,6 +138,7 @@ bool parse_object_statement(const Statement& s, ObjectSpec& object, std::map<std
         s.expect_arguments(1, w == "mesh" ? "MODEL" : "PATH");
         if (!object.model.empty() || !object.file.empty()) s.fail("object '" + object.name + "' already has a mesh");
         (w == "mesh" ? object.model : object.file) = s.words[1];
+        object.mesh_line = s.line;
     } else if (w == "resolution") {
         s.expect_arguments(1, "N (1-4)");
         object.resolution = s.integer(1, 1, 4);

@@ -21,9 +21,9 @@ bool ends_with(const std::string& text, const std::string& suffix) {
 }
 
 std::unique_ptr<Scene> play(scenes::SceneSpec spec, const std::string& default_name, const SceneRequest& request,
-                            const std::string& base_dir) {
+                            const std::string& base_dir, bool user_file) {
     if (spec.name.empty()) spec.name = default_name;
-    return std::make_unique<scenes::ScriptedScene>(std::move(spec), request.resolution, base_dir);
+    return std::make_unique<scenes::ScriptedScene>(std::move(spec), request.resolution, base_dir, user_file);
 }
 
 } // namespace
@@ -51,7 +51,7 @@ std::unique_ptr<Scene> read_scene_file(const std::string& path, const SceneReque
     std::ostringstream text;
     text << in.rdbuf();
     const std::filesystem::path file(path);
-    return play(scenes::parse_scene(text.str(), path), file.stem().string(), request, file.parent_path().string());
+    return play(scenes::parse_scene(text.str(), path), file.stem().string(), request, file.parent_path().string(), true);
 }
 
 std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& request) {
@@ -63,7 +63,7 @@ std::unique_ptr<Scene> open_scene(const std::string& name, const SceneRequest& r
     if (name == "drape") return make_drape_scene(request.resolution);
     if (name == "graded") return make_graded_scene(request.resolution);
     for (const auto& [builtin, text] : scenes::builtin_scene_files())
-        if (name == builtin) return play(scenes::parse_scene(text, "scenes/" + builtin + ".scene"), builtin, request, ".");
+        if (name == builtin) return play(scenes::parse_scene(text, "scenes/" + builtin + ".scene"), builtin, request, ".", false);
     if (names_a_scene(name)) {
         if (ends_with(name, ".scene")) return read_scene_file(name, request);
         if (ends_with(name, ".kdetrec")) return read_recording(name);

@@ -52,13 +52,23 @@ double channel(const ObjectSpec& object, Channel c, double frame) {
 
 } // namespace
 
-ScriptedScene::ScriptedScene(SceneSpec spec, int resolution, const std::string& base_dir) : spec_(std::move(spec)) {
+ScriptedScene::ScriptedScene(SceneSpec spec, int resolution, const std::string& base_dir, bool user_file)
+    : spec_(std::move(spec)) {
+    bool mixed = false;
     for (const ObjectSpec& object : spec_.objects) {
-        if (!object.model.empty()) {
-            meshes_.push_back(prepared_mesh(object.model, object.resolution != 0 ? object.resolution : resolution));
-        } else {
-            const std::filesystem::path path = std::filesystem::path(base_dir) / object.file;
-            meshes_.push_back(read_tet_mesh(path.string()));
+        try {
+            if (!object.model.empty()) {
+                const int used = object.resolution != 0 ? object.resolution : resolution;
+                mixed = mixed || (resolution_ != 0 && resolution_ != used);
+                resolution_ = used;
+                meshes_.push_back(prepared_mesh(object.model, used));
+            } else {
+                const std::filesystem::path path = std::filesystem::path(base_dir) / object.file;
+                meshes_.push_back(read_tet_mesh(path.string()));
+            }
+        } catch (const Error& e) {
+            if (!user_file) throw;
+            throw Error(spec_.source + ":" + std::to_string(object.mesh_line) + ": object '" + object.name + "': " + e.what());
         }
         const TetMesh& mesh = meshes_.back();
         Vec lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -73,6 +83,7 @@ ScriptedScene::ScriptedScene(SceneSpec spec, int resolution, const std::string& 
         }
         rest_.push_back(rest);
     }
+    if (mixed) resolution_ = 0;
 }
 
 std::string ScriptedScene::name() const { return spec_.name; }

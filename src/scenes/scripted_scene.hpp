@@ -28,6 +28,7 @@ struct Key {
 struct ObjectSpec {
     std::string name;
     std::size_t line = 0;                  ///< where its `object` statement stands
+    std::size_t mesh_line = 0;             ///< where its `mesh` or `file` statement stands
     std::string model;                     ///< a prepared thesis model, or
     std::string file;                      ///< a tet mesh file (relative to the scene file)
     int resolution = 0;                    ///< 0: the one requested
@@ -66,8 +67,9 @@ std::array<double, 3> evaluate(const std::vector<Key>& keys, double frame);
 class ScriptedScene final : public Scene {
 public:
     /// @brief Loads the meshes: prepared models at the object's resolution (else @p resolution), files
-    /// relative to @p base_dir. Throws kdet::Error when a mesh is missing.
-    ScriptedScene(SceneSpec spec, int resolution, const std::string& base_dir);
+    /// relative to @p base_dir. Throws kdet::Error when a mesh is missing, prefixed with the file and the
+    /// line of the object's mesh statement when @p user_file (a built-in scene's file is not the user's).
+    ScriptedScene(SceneSpec spec, int resolution, const std::string& base_dir, bool user_file);
 
     std::string name() const override;
     std::size_t num_objects() const override;
@@ -78,6 +80,8 @@ public:
     bool checks_pair(std::size_t a, std::size_t b) const override;
     bool checks_self(std::size_t object) const override;
     bool is_static(std::size_t object) const override;
+    /// @brief That of its model objects when they agree (each its own or the requested), else 0.
+    int resolution() const override { return resolution_; }
 
     const SceneSpec& spec() const { return spec_; }
 
@@ -91,6 +95,7 @@ private:
     };
 
     SceneSpec spec_;
+    int resolution_ = 0;
     std::vector<TetMesh> meshes_;
     std::vector<RestFrame> rest_;
 };

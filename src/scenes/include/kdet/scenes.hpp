@@ -62,6 +62,10 @@ public:
     /// @brief Whether @p object never moves (its positions are the same in every frame): it is added as
     /// a static object (Detector::set_static) and its positions are given once (default: none).
     virtual bool is_static(std::size_t /*object*/) const { return false; }
+    /// @brief The resolution (1-4) its meshes were built at, or 0 for a scene that has none (procedural,
+    /// tearing, recordings, folders of frames, scene files of mesh files only). A scene may fix it
+    /// whatever was requested: pass_through_armadillos is at 2.
+    virtual int resolution() const { return 0; }
 };
 
 /// @brief Sets the tets of `scene`'s objects at `frame` in `detector` (ids in scene order from
