@@ -888,28 +888,28 @@ TEST(Detector, OneOffFunctionsRefuseWhatTheyCannotReturn) {
     const TetMesh a = random_soup(50, 2.0, 1.0, 63);
     const DetectorOptions no_pairs = with_method(Method::kdet_no_pairs);
     EXPECT_EQ(error_message([&] { collide(a, a, no_pairs); }),
-              "collide: method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector::detect().colliding");
+              "collide: method 'kdet_no_pairs' only flags colliding tets and builds no pairs; a Detector's detect() gives the flags");
     EXPECT_EQ(error_message([&] { collide_self(a, no_pairs); }),
-              "collide_self: method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector::detect().colliding");
+              "collide_self: method 'kdet_no_pairs' only flags colliding tets and builds no pairs; a Detector's detect() gives the flags");
     DetectorOptions on_device;
     on_device.results_to_host = false;
     EXPECT_EQ(error_message([&] { collide(a, a, on_device); }),
-              "collide: results_to_host=false keeps the pairs on the device, and collide returns them on the host; use "
-              "Detector::device_results()");
+              "collide: results_to_host=false keeps the pairs on the device, and collide returns them on the host; a Detector "
+              "gives device results");
     for (const bool contacts : {true, false}) {
         DetectorOptions extra;
         (contacts ? extra.contacts : extra.distances) = true;
         EXPECT_EQ(error_message([&] { collide_self(a, extra); }),
                   std::string("collide_self: ") + (contacts ? "contacts" : "distances") +
-                      " would be computed and dropped, as collide_self returns the pairs alone; use Detector::detect(), "
-                      "whose FrameResult holds them");
+                      " would be computed and dropped, as collide_self returns the pairs alone; a Detector's detect() "
+                      "results hold them");
     }
     LocateOptions counts_only;
     counts_only.results_to_host = false;
     const std::vector<double> point = {0.0, 0.0, 0.0};
     EXPECT_EQ(error_message([&] { locate(a, point, counts_only); }),
               "locate: results_to_host=false would leave a one-off point location only its counts (its device arrays "
-              "end with its detector); use Detector::locate() and device_locate_results()");
+              "end with its detector); a Detector's locate() keeps device results");
 }
 
 TEST(Detector, RejectsBadInputWithClearErrors) {

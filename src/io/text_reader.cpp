@@ -460,7 +460,8 @@ std::string degeneracy(const TetMesh& mesh, std::size_t tet, long long base) {
     const double tolerance = 1e-12 * longest * longest * longest;
     if (std::abs(orient) > tolerance) return {};
     return "degenerate tetrahedron: zero volume (|orient3d| " + short_number(std::abs(orient)) +
-           " <= 1e-12 * longest edge^3 = " + short_number(tolerance) + "; ReadOptions::allow_degenerate accepts it)";
+           " <= 1e-12 * longest edge^3 = " + short_number(tolerance) +
+           "; accepted with --allow-degenerate, allow_degenerate=True or ReadOptions::allow_degenerate)";
 }
 
 void check_last_tet(const TextFile& file, const Token& where, const TetMesh& mesh, long long base,

@@ -594,7 +594,7 @@ LocateResult locate(const TetMesh& mesh, const PositionsView& points, const Loca
                     const DetectorOptions& detector_options) {
     if (!options.results_to_host)
         throw Error("locate: results_to_host=false would leave a one-off point location only its counts (its device arrays "
-                    "end with its detector); use Detector::locate() and device_locate_results()");
+                    "end with its detector); a Detector's locate() keeps device results");
     Detector detector(detector_options);
     const ObjectId object = detector.add_object(mesh);
     detector.locate(points, object, options);
@@ -621,13 +621,13 @@ namespace {
 void check_one_off_options(const char* function, const DetectorOptions& options) {
     const std::string name(function);
     if (options.method == Method::kdet_no_pairs)
-        throw Error(name + ": method 'kdet_no_pairs' only flags colliding tets and builds no pairs; use Detector::detect().colliding");
+        throw Error(name + ": method 'kdet_no_pairs' only flags colliding tets and builds no pairs; a Detector's detect() gives the flags");
     if (!options.results_to_host)
         throw Error(name + ": results_to_host=false keeps the pairs on the device, and " + name +
-                    " returns them on the host; use Detector::device_results()");
+                    " returns them on the host; a Detector gives device results");
     if (options.contacts || options.distances)
         throw Error(name + ": " + (options.contacts ? "contacts" : "distances") + " would be computed and dropped, as " +
-                    name + " returns the pairs alone; use Detector::detect(), whose FrameResult holds them");
+                    name + " returns the pairs alone; a Detector's detect() results hold them");
 }
 
 std::vector<IndexPair> to_index_pairs(const FrameResult& result) {

@@ -187,9 +187,9 @@ constexpr const char* real_expected = "a finite number >= 0";
 const std::vector<OptionInfo>& option_table() {
     using O = DetectorOptions;
     static const std::vector<OptionInfo> table = {
-        choice<Backend, &O::backend>("backend", "backend", "--backend", "--backend", "backend", "B", "",
+        choice<Backend, &O::backend>("backend", "backend", "--backend", "--backend", "backend", "B", "where detection runs",
                                      every_front_end | front_end_locate),
-        choice<Method, &O::method>("method", "method", "--method", "-c", "method", "M", "", every_front_end),
+        choice<Method, &O::method>("method", "method", "--method", "-c", "method", "M", "pair search", every_front_end),
         choice<NarrowPhase, &O::narrow_phase>("test", "narrow_phase", "--test", "-o", "narrow phase", "T",
                                               "narrow phase", every_front_end),
         choice<HashFunction, &O::hash>("hash", "hash", "--hash", "-h", "hash", "H", "grid hash",

@@ -216,6 +216,16 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     if (positionals.size() == 1 && names_a_scene(positionals[0])) {
         config.source.scene = positionals[0];
     } else {
+        // One word that names no file (nor a TetGen NAME.node) is more likely a mistyped scene.
+        std::error_code ignored;
+        if (positionals.size() == 1 && !std::filesystem::exists(positionals[0], ignored) &&
+            std::filesystem::path(positionals[0]).extension().empty() &&
+            !std::filesystem::exists(positionals[0] + ".node", ignored)) {
+            std::string known;
+            for (const std::string& name : scene_names()) known += (known.empty() ? "" : ", ") + name;
+            throw cli::UsageError("view: '" + positionals[0] + "' is neither a scene (known scenes: " + known +
+                                  ") nor a mesh file");
+        }
         config.source.meshes = positionals;
     }
     const bool procedural = config.source.meshes.empty() && config.source.scene == "procedural";
