@@ -84,6 +84,8 @@ struct FrameResult {
 
 /// @brief Finds every colliding pair among the tets of all ranks of a communicator. The constructor,
 /// add_object(), detect() and gather_pairs() are collective: every rank calls them in the same order.
+/// Ranks out of step in the last three (one in add_object(), another in detect()) throw on every rank
+/// instead of waiting; so does gather_pairs() given two roots.
 /// Bad input on one rank makes the collective call throw the same one-line kdet::Error on every rank
 /// (prefixed "rank R: " with the lowest rank at fault), and leaves every rank's detector as it was.
 class Detector {

@@ -266,6 +266,7 @@ std::string Detector::Impl::check_directory(const Object& object) const {
 }
 
 ObjectId Detector::Impl::add(const ObjectPart& part) {
+    detail::agree_on_call(comm, detail::Call::add_object);
     Object object;
     const std::string local_error = validate(part, object);
     // One reduction carries the first bad rank and the spread of the global counts.
@@ -555,6 +556,7 @@ void Detector::Impl::collect_pairs(const kdet::FrameResult& frame) {
 
 const FrameResult& Detector::Impl::detect() {
     const double start = MPI_Wtime();
+    detail::agree_on_call(comm, detail::Call::detect);
     ExchangeStats stats;
     result.exchange = stats;
     const std::size_t record_bytes = 16 + objects.size() * sizeof(PartSummary);
@@ -686,6 +688,7 @@ const FrameResult& Detector::detect() { return impl_->detect(); }
 
 std::vector<TetPair> Detector::gather_pairs(int root) const {
     const Impl& d = *impl_;
+    detail::agree_on_call(d.comm, detail::Call::gather_pairs, root, "root");
     if (root < 0 || root >= d.size)
         throw Error("gather_pairs: root " + std::to_string(root) + " is not a rank of the communicator (0 to " +
                     std::to_string(d.size - 1) + ")");

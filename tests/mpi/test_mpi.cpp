@@ -507,6 +507,31 @@ TEST(Mpi, BadInputOnOneRankFailsOnEveryRank) {
                   std::to_string(last) + ")");
 }
 
+TEST(Mpi, RanksOutOfStepFailOnEveryRankInsteadOfWaiting) {
+    const int rank = world_rank(), size = world_size();
+    if (size < 2) GTEST_SKIP() << "needs two ranks";
+    const TetMesh soup = random_soup(200, 1.0, 1.0, 43);
+    std::vector<int> owners(soup.num_tets());
+    for (std::size_t t = 0; t < owners.size(); ++t) owners[t] = static_cast<int>(t % static_cast<std::size_t>(size));
+    const mpi::MeshPart part = mpi::local_part(soup, owners, rank);
+    mpi::Detector detector(MPI_COMM_WORLD, one_thread());
+    // Rank 0 detects while the others add an object.
+    const std::string message = same_error_everywhere([&] {
+        if (rank == 0) detector.detect();
+        else detector.add_object(part);
+    });
+    EXPECT_EQ(message, "collective calls out of step: a rank called add_object() where another called detect() (every rank "
+                       "makes the same collective calls in the same order)");
+    EXPECT_EQ(detector.object_count(), 0u);
+    // Each rank names itself the root.
+    EXPECT_EQ(same_error_everywhere([&] { (void)detector.gather_pairs(rank); }),
+              "gather_pairs(): the ranks give different roots (0 and " + std::to_string(size - 1) + "); give every rank the same");
+    // In step again, it works.
+    detector.add_object(part);
+    detector.detect();
+    EXPECT_EQ(detector.object_count(), 1u);
+}
+
 TEST(Mpi, OptionsOneRankRefusesOrThatDecideTheAnswerDifferFailOnEveryRank) {
     const int rank = world_rank(), size = world_size(), last = size - 1;
     DetectorOptions options = one_thread();
