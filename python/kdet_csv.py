@@ -55,7 +55,12 @@ class BenchFile:
 
     @property
     def self_collisions(self) -> bool:
-        return self.header.get("self collisions", "no") != "no"  # "yes", or "scene": the objects it marks
+        return self.self_setting != "no"
+
+    @property
+    def self_setting(self) -> str:
+        """`kdet bench -s`: "no", "yes" (every object) or "scene" (the objects the scene marks)."""
+        return self.header.get("self collisions", "no")
 
     @property
     def total_tets(self) -> int:

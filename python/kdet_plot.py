@@ -258,12 +258,15 @@ def memory_figure(files: list[BenchFile], title: str, path: str, written: list[s
 def total_time_figure(files: list[BenchFile], path: str, written: list[str]) -> None:
     methods = sorted({f.algorithm for f in files})
     fig, ax = plt.subplots(figsize=(7, 4))
-    for s, self_collisions in enumerate((False, True)):
+    labels = {"no": "without self-collisions", "yes": "with self-collisions",
+              "scene": "self-collisions the scene marks"}
+    settings = [s for s in labels if any(f.self_setting == s for f in files)]
+    width = 0.8 / len(settings)
+    for s, setting in enumerate(settings):
         totals = [sum(sum(f.column("device time")) for f in files
-                      if f.algorithm == m and f.self_collisions == self_collisions) for m in methods]
-        ax.bar(np.arange(len(methods)) + 0.4 * s, totals, width=0.4,
-               label="with self-collisions" if self_collisions else "without self-collisions")
-    ax.set_xticks(np.arange(len(methods)) + 0.2, methods)
+                      if f.algorithm == m and f.self_setting == setting) for m in methods]
+        ax.bar(np.arange(len(methods)) + width * s, totals, width=width, label=labels[setting])
+    ax.set_xticks(np.arange(len(methods)) + 0.4 - width / 2, methods)
     ax.set_ylabel("summed frame times (ms)")
     ax.set_title("Total time over all benchmarks")
     ax.legend(fontsize=8)

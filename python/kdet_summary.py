@@ -21,7 +21,7 @@ METHOD_ORDER = ["kdet", "kdet_no_pairs", "gpu", "gpu_no_loop"]
 
 def sort_key(bench: BenchFile) -> tuple:
     method = METHOD_ORDER.index(bench.algorithm) if bench.algorithm in METHOD_ORDER else len(METHOD_ORDER)
-    return (bench.scene, bench.resolution, bench.self_collisions, method, bench.path)
+    return (bench.scene, bench.resolution, bench.self_setting, method, bench.path)
 
 
 def summary_markdown(averages: list[BenchFile], skipped: list[str]) -> str:
@@ -40,7 +40,7 @@ def summary_markdown(averages: list[BenchFile], skipped: list[str]) -> str:
         memory = int(bench.header.get("peak memory bytes", "0")) / 2**20
         lines.append(
             f"| {bench.scene} | {bench.resolution} | {bench.total_tets} | {bench.algorithm} | "
-            f"{'yes' if bench.self_collisions else 'no'} | {len(times)} | {median(times):.3f} | "
+            f"{bench.self_setting} | {len(times)} | {median(times):.3f} | "
             f"{max(times):.3f} | {pairs:.0f} | {memory:.1f} |")
     if skipped:
         lines += ["", "## Not run", ""] + [f"- {line}" for line in skipped]

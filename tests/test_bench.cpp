@@ -558,10 +558,15 @@ TEST(BenchEndToEnd, CudaBackendGivesTheCpuCountsOrAClearError) {
 
 TEST(BenchCommand, AResolutionTheSceneDoesNotHaveIsRefusedAndTheFilesNameTheOneItHas) {
     // pass_through_armadillos is at resolution 2 whatever -r says: -r 4 was run at 2 and named r4.
-    using test::run_prepare;
-    KDET_PREPARE_OR_SKIP("armadillo -r 2");
     const auto dir = temp_dir("fixed-resolution");
     const std::string flags = " --frames 0:0 -n 1 --quiet -d " + dir.string();
+    // A scene of no resolution: -r would only rename its files.
+    const auto [none, none_message] = kdet_command("bench tearing -r 2" + flags, "&1");
+    EXPECT_EQ(none, 2) << none_message;
+    EXPECT_EQ(none_message,
+              "kdet bench: invalid value '2' for -r: scene 'tearing' has no resolution (its meshes are not built at one)\n");
+    using test::run_prepare;
+    KDET_PREPARE_OR_SKIP("armadillo -r 2");
     const auto [refused, message] = kdet_command("bench pass_through_armadillos -r 4" + flags, "&1");
     EXPECT_EQ(refused, 2) << message;
     EXPECT_EQ(message, "kdet bench: invalid value '4' for -r: scene 'pass_through_armadillos' is built at resolution 2 only\n");

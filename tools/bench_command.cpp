@@ -39,9 +39,7 @@ std::unique_ptr<Scene> open_bench_scene(const BenchConfig& config) {
         if (!names_a_scene(config.scene)) throw UsageError(std::string("bench: ") + e.what());
         throw;
     }
-    if (config.resolution_given && scene->resolution() != 0 && scene->resolution() != config.request.resolution)
-        throw UsageError("bench: invalid value '" + std::to_string(config.request.resolution) + "' for -r: scene '" +
-                         scene->name() + "' is built at resolution " + std::to_string(scene->resolution()) + " only");
+    if (config.resolution_given) check_resolution_flag("bench", "-r", config.request.resolution, *scene);
     if (config.first_frame >= scene->num_frames() || config.last_frame >= scene->num_frames())
         throw UsageError("bench: invalid value '" + std::to_string(config.first_frame) + ":" + std::to_string(config.last_frame) +
                          "' for --frames: scene '" + scene->name() + "' has frames 0 to " +

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <kdet/error.hpp>
+#include <kdet/scenes.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -52,6 +53,14 @@ std::string flag_of(const OptionInfo& option, FrontEnd front_end) {
 std::string hash_label(const DetectorOptions& options) {
     const bool grid = options.method == Method::kdet || options.method == Method::kdet_no_pairs;
     return grid ? to_string(options.hash) : "none";
+}
+
+void check_resolution_flag(const std::string& command, const std::string& flag, int requested, const Scene& scene) {
+    if (scene.resolution() == requested) return;
+    throw UsageError(command + ": invalid value '" + std::to_string(requested) + "' for " + flag + ": scene '" + scene.name() +
+                     "' " +
+                     (scene.resolution() == 0 ? std::string("has no resolution (its meshes are not built at one)")
+                                              : "is built at resolution " + std::to_string(scene.resolution()) + " only"));
 }
 
 std::uint64_t overlapping_pairs(const FrameResult& result) {

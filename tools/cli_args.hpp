@@ -18,6 +18,10 @@ namespace CLI {
 class App;
 }
 
+namespace kdet {
+class Scene;
+}
+
 namespace kdet::cli {
 
 /// @brief A mistake on the command line; the message names the flag and what it accepts.
@@ -58,6 +62,10 @@ std::string flag_of(const OptionInfo& option, FrontEnd front_end);
 /// @brief The grid hash @p options use, or "none" for the brute-force methods, which build no grid
 /// (as the thesis's files wrote it).
 std::string hash_label(const DetectorOptions& options);
+
+/// @brief Throws a UsageError "COMMAND: invalid value 'N' for FLAG: ..." when @p scene was not built at
+/// @p requested, the resolution its FLAG (-r, --res) gave: a scene without one, or one that fixes its own.
+void check_resolution_flag(const std::string& command, const std::string& flag, int requested, const Scene& scene);
 
 /// @brief Of a frame's pairs within the margin, those that overlap (distance 0); needs its distances.
 std::uint64_t overlapping_pairs(const FrameResult& result);

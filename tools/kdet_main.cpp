@@ -16,7 +16,9 @@ void kdet::cli::print_error(const char* message) { std::cerr << "kdet: error: " 
 namespace {
 
 /// True for a command given --mpi in a process that an MPI launcher started as a rank other than 0:
-/// errors found before MPI starts (a bad flag) are the same on every rank, so only rank 0 prints them.
+/// the usage errors and kdet::Errors that reach main() are the same on every rank (a bad flag, found
+/// before MPI starts; the MPI commands print their agreed errors on rank 0 themselves), so only rank 0
+/// prints them.
 bool quiet_rank(int argc, char** argv) {
     bool mpi = false;
     for (int k = 2; k < argc; ++k) mpi = mpi || std::strcmp(argv[k], "--mpi") == 0;
@@ -88,10 +90,10 @@ int main(int argc, char** argv) {
         if (!quiet_rank(argc, argv)) print_error(e.what());
         return exit_failure;
     } catch (const std::bad_alloc&) {
-        if (!quiet_rank(argc, argv)) print_error("out of memory");
+        print_error("out of memory"); // one rank's own trouble: every rank says its own
         return exit_failure;
     } catch (const std::exception& e) {
-        if (!quiet_rank(argc, argv)) print_error(e.what());
+        print_error(e.what());
         return exit_failure;
     }
 }

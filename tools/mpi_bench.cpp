@@ -71,9 +71,8 @@ int run_bench_mpi(const BenchConfig& config) {
         // kdet::mpi has switches alone: the scene's filters and static objects become switches with the
         // answers a Detector gives (no pair of two static objects, no static object's self-collision).
         for (std::size_t a = 0; a < scene->num_objects(); ++a) {
-            const bool self = config.self == SceneSelfCollision::every ||
-                              (config.self == SceneSelfCollision::marked && scene->checks_self(a));
-            detector.set_self_collision(static_cast<ObjectId>(a), self && !scene->is_static(a));
+            detector.set_self_collision(static_cast<ObjectId>(a),
+                                        self_collision_of(*scene, a, config.self) && !scene->is_static(a));
             const CollisionFilter fa = scene->collision_filter(a);
             for (std::size_t b = a + 1; b < scene->num_objects(); ++b) {
                 const CollisionFilter fb = scene->collision_filter(b);

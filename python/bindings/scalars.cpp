@@ -20,6 +20,18 @@ char numpy_kind(nb::handle value) {
     return nb::cast<std::string>(value.attr("dtype").attr("kind"))[0];
 }
 
+/// The int @p value holds, or a TypeError naming @p name; @p overflow is set beyond a long long.
+long long integer_arg(nb::handle value, const char* name, bool& overflow) {
+    long long out = 0;
+    if (!read_integer(value, out, overflow))
+        throw nb::type_error((std::string(name) + ": expected an int, got " + type_label(value)).c_str());
+    return out;
+}
+
+[[noreturn]] void beyond(nb::handle value, const char* name, const char* bits) {
+    throw Error(std::string(name) + ": " + nb::cast<std::string>(nb::str(value)) + " is beyond a " + bits + " integer");
+}
+
 } // namespace
 
 bool read_bool(nb::handle value, bool& out) {
@@ -70,19 +82,17 @@ bool read_arg(Arg<bool> arg, const char* name) {
 }
 
 std::int64_t read_arg(Arg<std::int64_t> arg, const char* name) {
-    long long out = 0;
     bool overflow = false;
-    if (!read_integer(arg.value, out, overflow))
-        throw nb::type_error((std::string(name) + ": expected an int, got " + type_label(arg.value)).c_str());
-    if (overflow)
-        throw Error(std::string(name) + ": " + nb::cast<std::string>(nb::str(arg.value)) + " is beyond a 64-bit integer");
+    const long long out = integer_arg(arg.value, name, overflow);
+    if (overflow) beyond(arg.value, name, "64-bit");
     return out;
 }
 
 int read_arg(Arg<int> arg, const char* name) {
-    const std::int64_t out = read_arg(Arg<std::int64_t>{arg.value}, name);
-    if (out < std::numeric_limits<int>::min() || out > std::numeric_limits<int>::max())
-        throw Error(std::string(name) + ": " + std::to_string(out) + " is beyond a 32-bit integer");
+    bool overflow = false;
+    const long long out = integer_arg(arg.value, name, overflow);
+    if (overflow || out < std::numeric_limits<int>::min() || out > std::numeric_limits<int>::max())
+        beyond(arg.value, name, "32-bit");
     return static_cast<int>(out);
 }
 

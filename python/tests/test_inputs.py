@@ -250,6 +250,8 @@ def test_an_int_beyond_64_bits_is_refused_naming_the_argument(octopus):
         detector.set_positions(2**64, octopus.vertices)
     with pytest.raises(kdet.Error, match=r"^rings: 4294967296 is beyond a 32-bit integer$"):
         detector.set_self_exclusion_rings(0, 2**32)
+    with pytest.raises(kdet.Error, match=r"^rings: 18446744073709551616 is beyond a 32-bit integer$"):
+        detector.set_self_exclusion_rings(0, 2**64)
 
 
 def pairs_with(a: kdet.TetMesh, b_vertices, b_tets) -> np.ndarray:

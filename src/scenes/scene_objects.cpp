@@ -14,12 +14,15 @@ const char* to_string(SceneSelfCollision self) {
     }
 }
 
+bool self_collision_of(const Scene& scene, std::size_t object, SceneSelfCollision self) {
+    return self == SceneSelfCollision::every || (self == SceneSelfCollision::marked && scene.checks_self(object));
+}
+
 void add_scene_objects(Detector& detector, const Scene& scene, SceneSelfCollision self) {
     const auto first = static_cast<ObjectId>(detector.object_count());
     for (std::size_t o = 0; o < scene.num_objects(); ++o) {
         const ObjectId id = detector.add_object(scene.rest_mesh(o));
-        detector.set_self_collision(id, self == SceneSelfCollision::every ||
-                                            (self == SceneSelfCollision::marked && scene.checks_self(o)));
+        detector.set_self_collision(id, self_collision_of(scene, o, self));
         detector.set_static(id, scene.is_static(o));
         const CollisionFilter filter = scene.collision_filter(o);
         if (filter.group != CollisionFilter{}.group || filter.mask != CollisionFilter{}.mask)

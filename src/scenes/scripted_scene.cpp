@@ -54,13 +54,13 @@ double channel(const ObjectSpec& object, Channel c, double frame) {
 
 ScriptedScene::ScriptedScene(SceneSpec spec, int resolution, const std::string& base_dir, bool user_file)
     : spec_(std::move(spec)) {
-    bool mixed = false;
+    bool follows_request = false;
     for (const ObjectSpec& object : spec_.objects) {
         try {
             if (!object.model.empty()) {
                 const int used = object.resolution != 0 ? object.resolution : resolution;
-                mixed = mixed || (resolution_ != 0 && resolution_ != used);
-                resolution_ = used;
+                follows_request = follows_request || object.resolution == 0;
+                if (resolution_ == 0) resolution_ = used;
                 meshes_.push_back(prepared_mesh(object.model, used));
             } else {
                 const std::filesystem::path path = std::filesystem::path(base_dir) / object.file;
@@ -83,7 +83,7 @@ ScriptedScene::ScriptedScene(SceneSpec spec, int resolution, const std::string& 
         }
         rest_.push_back(rest);
     }
-    if (mixed) resolution_ = 0;
+    if (follows_request) resolution_ = resolution;
 }
 
 std::string ScriptedScene::name() const { return spec_.name; }

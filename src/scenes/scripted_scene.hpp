@@ -80,7 +80,8 @@ public:
     bool checks_pair(std::size_t a, std::size_t b) const override;
     bool checks_self(std::size_t object) const override;
     bool is_static(std::size_t object) const override;
-    /// @brief That of its model objects when they agree (each its own or the requested), else 0.
+    /// @brief The requested one when a model object follows it, else the first model object's own; 0
+    /// without model objects (mesh files only).
     int resolution() const override { return resolution_; }
 
     const SceneSpec& spec() const { return spec_; }

@@ -280,8 +280,10 @@ TEST(ViewArgs, MistakesAreOneLineErrors) {
     EXPECT_NE(usage_error({"--opacity", "2"}).find("--opacity: expected a number in [0, 1]"), std::string::npos);
     EXPECT_NE(usage_error({"--exclusion-rings", "1"}).find("needs --self"), std::string::npos);
     EXPECT_EQ(usage_error({"--self", "--self-scene"}), "view: --self and --self-scene are two choices; give one");
-    EXPECT_EQ(usage_error({"armadilos"}).rfind("view: 'armadilos' is neither a scene (known scenes: procedural, ", 0), 0u);
+    EXPECT_EQ(usage_error({"armadilos"}).rfind("view: unknown scene 'armadilos' (known scenes: procedural, ", 0), 0u);
     EXPECT_EQ(parse({"drape", "--self-scene", "--exclusion-rings", "1"}).self, SceneSelfCollision::marked);
+    EXPECT_EQ(usage_error({"a.mesh", "b.mesh", "--self-scene"}),
+              "view: --self-scene follows a scene's marks, and mesh files have none (use --self)");
     EXPECT_NE(usage_error({"--self", "--exclusion-rings", "5"}).find("--exclusion-rings"), std::string::npos);
     EXPECT_NE(usage_error({"--camera", "10"}).find("YAW,PITCH"), std::string::npos);
     EXPECT_NE(usage_error({"--panel"}).find("--screenshot"), std::string::npos);

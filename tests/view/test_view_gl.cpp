@@ -92,7 +92,7 @@ bool is_highlight(const std::uint8_t* p) { return p[0] >= 60 && p[0] > 1.7 * p[1
 /// @brief A surface pixel: a cool colour, well away from the grey background.
 bool is_surface(const std::uint8_t* p) { return std::max(p[1], p[2]) > p[0] + 35; }
 
-bool is_normal_line(const std::uint8_t* p) { return p[0] > 235 && p[1] > 235 && p[2] > 235; }
+bool is_normal_line(const std::uint8_t* p) { return p[0] > 230 && p[1] > 130 && p[1] < 175 && p[2] > 180 && p[2] < 225; }
 
 std::size_t count(const Picture& picture, const std::function<bool(const std::uint8_t*)>& kind) {
     std::size_t n = 0;
@@ -345,7 +345,7 @@ TEST(ViewPicture, DisplayModes) {
     const auto dark = [](const std::uint8_t* p) { return p[0] < 40 && p[1] < 45 && p[2] < 55; };
     const Picture wire = screenshot(base + " --wireframe", "wire");
     EXPECT_GT(count(wire, dark), count(plain, dark) + 1000);
-    // Contact normals: white lines with --normals only, whatever the test (contacts are an option).
+    // Contact normals: pink lines with --normals only, whatever the test (contacts are an option).
     const Picture normals = screenshot(base + " --test sat_mtv --normals", "normals");
     EXPECT_GT(count(normals, is_normal_line), 200u);
     EXPECT_EQ(count(plain, is_normal_line), 0u);
@@ -375,7 +375,12 @@ TEST(ViewCommand, FrameOutOfRangeAndOneLineErrors) {
     const Outcome missing = run_command(std::string(KDET_CLI_PATH) + " view no_such_mesh.mesh --screenshot x.png");
     EXPECT_EQ(missing.exit_code, 1) << missing.out;
     EXPECT_NE(missing.out.find("no_such_mesh.mesh"), std::string::npos) << missing.out;
-    for (const Outcome& r : {far, missing}) EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    // A resolution the scene is not built at would only mislabel what is drawn.
+    const Outcome resolution = run_command(std::string(KDET_CLI_PATH) + " view tearing --res 3 --screenshot x.png");
+    EXPECT_EQ(resolution.exit_code, 2) << resolution.out;
+    EXPECT_NE(resolution.out.find("kdet view: invalid value '3' for --res: scene 'tearing' has no resolution"), std::string::npos)
+        << resolution.out;
+    for (const Outcome& r : {far, missing, resolution}) EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
     // Without a display the window cannot open: one line that says how to draw without one.
     const Outcome no_display =
         run_command("env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(KDET_CLI_PATH) + " view --tets 1000 --screenshot x.png");
@@ -387,21 +392,21 @@ TEST(ViewCommand, FrameOutOfRangeAndOneLineErrors) {
 // ---- OpenGL buffers, in this process ----
 
 TEST(ViewRenderer, EveryKindOfThingHasAColourOfItsOwn) {
-    // Objects, colliding tets, margin tets, the tets holding query points, the points by status and the
-    // contact normals: no two kinds may be near enough in colour to be taken for one another.
+    // Objects, colliding tets, margin tets, the tets holding query points, the points by status, the
+    // contact normals and a picked tet with its partners: no two kinds near enough to be confused.
     struct Kind {
         std::string name;
         Color color;
     };
     std::vector<Kind> kinds{{"colliding", highlight_color()}, {"margin", margin_color()}, {"located", located_color()},
-                            {"normals", normal_color()}};
+                            {"normals", normal_color()},     {"selected", selected_color()}, {"partners", partner_color()}};
     for (int status = 0; status < 3; ++status) kinds.push_back({"point " + std::to_string(status), point_color(status)});
     const auto distance = [](Color a, Color b) {
         return std::sqrt((a.r - b.r) * (a.r - b.r) + (a.g - b.g) * (a.g - b.g) + (a.b - b.b) * (a.b - b.b));
     };
     for (std::size_t i = 0; i < kinds.size(); ++i)
         for (std::size_t j = i + 1; j < kinds.size(); ++j) {
-            if (kinds[i].name == "normals" && kinds[j].name == "point 0") continue; // lines and dots: told apart by shape
+            if (kinds[i].name == "selected" && kinds[j].name == "point 0") continue; // one tet and dots: told apart by shape
             EXPECT_GT(distance(kinds[i].color, kinds[j].color), 0.3f) << kinds[i].name << " and " << kinds[j].name;
         }
     for (std::size_t object = 0; object < 6; ++object) {

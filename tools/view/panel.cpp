@@ -364,7 +364,7 @@ void Viewer::panel_selection() {
     if (session_.options().method == Method::kdet_no_pairs) {
         ImGui::TextDisabled("kdet_no_pairs flags tets and builds no pairs");
     } else if (colliding) {
-        ImGui::TextWrapped("collides with %zu tet(s) (yellow)", partners_.size());
+        ImGui::TextWrapped("collides with %zu tet(s) (teal)", partners_.size());
         constexpr std::size_t listed = 8;
         for (std::size_t k = 0; k < partners_.size() && k < listed; ++k) {
             const Partner& p = partners_[k];

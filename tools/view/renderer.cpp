@@ -135,7 +135,11 @@ Color point_color(int status) {
 
 Color located_color() { return {0.45f, 0.90f, 0.15f}; }
 
-Color normal_color() { return {0.97f, 0.97f, 0.97f}; }
+Color normal_color() { return {1.0f, 0.6f, 0.8f}; }
+
+Color selected_color() { return {0.95f, 0.95f, 0.95f}; }
+
+Color partner_color() { return {0.0f, 0.62f, 0.52f}; }
 
 Renderer::Renderer() {
     mesh_program_ = link(mesh_vertex_shader, mesh_fragment_shader);
@@ -511,15 +515,15 @@ void Renderer::draw(const OrbitCamera& camera, int x, int y, int width, int heig
     }
 
     if (selection_.vertices > 0) {
-        // The tets the selected one collides with in yellow over everything else (they usually
-        // lie inside other colliding tets), and the selected tet in white over them.
+        // The tets the selected one collides with over everything else (they usually lie inside
+        // other colliding tets), and the selected tet over them.
         glUniform1i(lit, 1);
         glBindVertexArray(selection_.array);
         glClear(GL_DEPTH_BUFFER_BIT);
-        set_color(mesh_program_, Color{1.0f, 0.82f, 0.25f}, 1.0f);
+        set_color(mesh_program_, partner_color(), 1.0f);
         glDrawArrays(GL_TRIANGLES, 12, static_cast<GLsizei>(selection_.vertices) - 12);
         glClear(GL_DEPTH_BUFFER_BIT);
-        set_color(mesh_program_, Color{0.95f, 0.95f, 0.95f}, 1.0f);
+        set_color(mesh_program_, selected_color(), 1.0f);
         glDrawArrays(GL_TRIANGLES, 0, 12);
         glBindVertexArray(0);
     }

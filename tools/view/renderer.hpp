@@ -32,8 +32,12 @@ Color margin_color();
 Color point_color(int status);
 /// @brief The tets that hold query points.
 Color located_color();
-/// @brief The contact normals' lines: white, apart from the margin's yellow they often lie over.
+/// @brief The contact normals' lines: pink, apart from the red and yellow tets they lie over.
 Color normal_color();
+/// @brief The tet picked with a click: white.
+Color selected_color();
+/// @brief The tets the picked one collides with: teal.
+Color partner_color();
 
 /// @brief At most this many contact normals are drawn (an even sample of the colliding pairs).
 constexpr std::size_t max_contact_lines = 1500;

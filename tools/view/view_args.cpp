@@ -158,6 +158,7 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     parser.detector_options(config.options, front_end_view);
     const auto resolution = [&](const std::string& flag, const std::string& v) {
         config.source.request.resolution = static_cast<int>(parse_integer(flag, v, 1, 4));
+        config.resolution_flag = flag;
     };
     parser.option("--res", "N", [&](const std::string& v) { resolution("--res", v); });
     parser.option("-r", "N", [&](const std::string& v) { resolution("-r", v); });
@@ -216,15 +217,17 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
     if (positionals.size() == 1 && names_a_scene(positionals[0])) {
         config.source.scene = positionals[0];
     } else {
-        // One word that names no file (nor a TetGen NAME.node) is more likely a mistyped scene.
+        // One word that names no file (nor a TetGen NAME.node) is more likely a mistyped scene: the
+        // registry's message names the known ones, as kdet bench's does.
         std::error_code ignored;
         if (positionals.size() == 1 && !std::filesystem::exists(positionals[0], ignored) &&
             std::filesystem::path(positionals[0]).extension().empty() &&
             !std::filesystem::exists(positionals[0] + ".node", ignored)) {
-            std::string known;
-            for (const std::string& name : scene_names()) known += (known.empty() ? "" : ", ") + name;
-            throw cli::UsageError("view: '" + positionals[0] + "' is neither a scene (known scenes: " + known +
-                                  ") nor a mesh file");
+            try {
+                open_scene(positionals[0]);
+            } catch (const Error& e) {
+                throw cli::UsageError(std::string("view: ") + e.what());
+            }
         }
         config.source.meshes = positionals;
     }
@@ -235,6 +238,8 @@ ViewConfig parse_view_args(int argc, char** argv, int first) {
         throw cli::UsageError("view: --screenshot and --profile are two different runs; give one");
     if (within_given && config.points.empty()) throw cli::UsageError("view: --within applies to --points only");
     if (every && marked) throw cli::UsageError("view: --self and --self-scene are two choices; give one");
+    if (marked && !config.source.meshes.empty())
+        throw cli::UsageError("view: --self-scene follows a scene's marks, and mesh files have none (use --self)");
     config.self = every ? SceneSelfCollision::every : marked ? SceneSelfCollision::marked : SceneSelfCollision::none;
     if (config.exclusion_rings > 0 && config.self == SceneSelfCollision::none)
         throw cli::UsageError("view: --exclusion-rings acts within an object: it needs --self or --self-scene");

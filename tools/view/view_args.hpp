@@ -42,6 +42,7 @@ struct ViewConfig {
     DetectorOptions options;
     SceneSelfCollision self = SceneSelfCollision::none; ///< --self, --self-scene
     int exclusion_rings = 0;       ///< with self: Detector::set_self_exclusion_rings of every object
+    std::string resolution_flag;   ///< --res or -r when given (checked against the scene once open)
     int frame = 0;                 ///< 0-based frame to show first (checked when the scene is open)
     std::string screenshot;        ///< headless: draw frame `frame` into this PNG and exit
     bool profile = false;          ///< headless: draw every frame once and print the times

@@ -26,6 +26,8 @@ int run_view(int argc, char** argv) {
         throw Error("view: --backend cuda is not available here: " + reason);
     config.options.contacts = view::wants_contacts(config.display, false);
     view::ViewSession session(config.source, config.options, config.self);
+    if (!config.resolution_flag.empty())
+        check_resolution_flag("view", config.resolution_flag, config.source.request.resolution, session.scene());
     session.set_exclusion_rings(config.exclusion_rings);
     if (!config.points.empty()) session.set_points(read_points(config.points), config.within);
     if (config.frame >= session.num_frames())

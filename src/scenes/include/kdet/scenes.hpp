@@ -64,7 +64,8 @@ public:
     virtual bool is_static(std::size_t /*object*/) const { return false; }
     /// @brief The resolution (1-4) its meshes were built at, or 0 for a scene that has none (procedural,
     /// tearing, recordings, folders of frames, scene files of mesh files only). A scene may fix it
-    /// whatever was requested: pass_through_armadillos is at 2.
+    /// whatever was requested: pass_through_armadillos is at 2. A scene file whose prepared models
+    /// follow the request for some objects and fix it for others gives the requested one.
     virtual int resolution() const { return 0; }
 };
 
@@ -83,6 +84,9 @@ enum class SceneSelfCollision {
 
 /// @brief "no", "yes" or "scene": the value of `kdet bench -s` and its CSV files.
 const char* to_string(SceneSelfCollision self);
+
+/// @brief Whether @p self switches on the self-collision of @p scene's @p object.
+bool self_collision_of(const Scene& scene, std::size_t object, SceneSelfCollision self);
 
 /// @brief Adds every object of @p scene to @p detector (ids in scene order, from the detector's next
 /// id on), with self-collision of the objects @p self names, collisions between the object pairs the
