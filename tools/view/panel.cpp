@@ -104,17 +104,6 @@ void row_ms(const char* name, double ms) {
     row(name, text);
 }
 
-/// @brief Whether the resolution (1-4) changes the scene: the thesis scenes but the one that is
-/// always at resolution 2, and scene files (their prepared models); not the generated ones.
-bool uses_resolution(const ViewSource& source) {
-    if (!source.meshes.empty() || source.scene == "procedural" || source.scene == "pass_through_armadillos" ||
-        source.scene == "tearing")
-        return false;
-    const std::vector<std::string> names = scene_names();
-    const std::string& s = source.scene;
-    return std::find(names.begin(), names.end(), s) != names.end() ||
-           (s.size() > 6 && s.compare(s.size() - 6, 6, ".scene") == 0);
-}
 
 } // namespace
 
@@ -181,7 +170,9 @@ void Viewer::panel_scene() {
             source.request.procedural.frames = frames;
             open_source(source);
         }
-    } else if (uses_resolution(source)) {
+    } else if (session_.scene().resolution() != 0 && session_.scene().resolution() == source.request.resolution) {
+        // A scene built at the requested resolution follows it; one that fixes its own (the
+        // pass-through scenes) or has none shows no slider.
         int resolution = source.request.resolution;
         ImGui::SliderInt("resolution", &resolution, 1, 4);
         if (ImGui::IsItemDeactivatedAfterEdit()) {
