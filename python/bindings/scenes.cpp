@@ -39,7 +39,7 @@ std::size_t object_of(const PyScene& self, Arg<std::int64_t> object_arg, const c
 }
 
 /// add_scene_objects' self_collision: True, False, or 'scene' for the objects the scene marks.
-SceneSelfCollision self_collision_of(nb::handle value) {
+SceneSelfCollision self_collision_arg(nb::handle value) {
     if (nb::isinstance<nb::str>(value)) {
         if (nb::cast<std::string>(value) == "scene") return SceneSelfCollision::marked;
         throw Error("self_collision: '" + nb::cast<std::string>(value) + "' is not a choice (True, False or 'scene')");
@@ -158,7 +158,7 @@ void bind_scenes(nb::module_& m) {
     m.def(
         "add_scene_objects",
         [](PyDetector& detector, const PyScene& s, nb::handle self_collision) {
-            const SceneSelfCollision self = self_collision_of(self_collision);
+            const SceneSelfCollision self = self_collision_arg(self_collision);
             locked(detector, [&] { add_scene_objects(detector.detector, *s.scene, self); });
         },
         "detector"_a, "scene"_a, "self_collision"_a = false,
